@@ -1,3 +1,30 @@
-"""ruledrobot: robot motion planning on ruled surfaces."""
+"""ruledrobot: robot motion planning on ruled surfaces.
+
+Quick tour::
+
+    import ruledrobot as rr
+    lines = rr.Lines.from_point_direction(points, directions)
+    res = rr.refine(lines, algorithm="dh", scheme="four_point", steps=4)
+    res.lines, res.frames
+    rr.subdivide(poses, scheme="chaikin", steps=3)     # SE(3) geodesic subdivision
+"""
+
+from .algorithms import RefineResult, refine
+from .geometry import se3, sphere
+from .geometry.lines import Lines
+from .geometry.ruled import RuledSurface
+from .subdivision import SCHEME_NAMES, subdivide
 
 __version__ = "0.1.0"
+
+__all__ = [
+    "SCHEME_NAMES",
+    "Lines",
+    "RefineResult",
+    "RuledSurface",
+    "__version__",
+    "refine",
+    "se3",
+    "sphere",
+    "subdivide",
+]

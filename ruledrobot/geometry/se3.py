@@ -469,3 +469,88 @@ def geodesic_many(A: FloatArray, B: FloatArray, ts: Sequence[float]) -> list[Flo
             q, p = pair.at(float(t))
             _pose_from_components(_rot_from_quat(q), p, out[lo:hi])
     return [o.reshape(*shape, 4, 4) for o in outs]
+
+
+# ---------------------------------------------------------------------------
+# the "qt" form: rows [qw, qx, qy, qz, px, py, pz] (..., 7), used internally by
+# the subdivision engine so that a refinement converts matrices only twice
+# ---------------------------------------------------------------------------
+
+
+def qt_from_matrix(T: ArrayLike) -> FloatArray:
+    """Poses (n, 4, 4) -> rows ``[qw, qx, qy, qz, px, py, pz]`` (n, 7), ``qw >= 0``."""
+    T = np.asarray(T, dtype=np.float64).reshape(-1, 4, 4)
+    q, p = _qt_from_matrices(T)
+    return np.stack([*q, *p], axis=-1)
+
+
+def matrix_from_qt(x: ArrayLike) -> FloatArray:
+    """Rows ``[qw, qx, qy, qz, px, py, pz]`` (n, 7) -> poses (n, 4, 4) (quaternions normalised)."""
+    x = np.asarray(x, dtype=np.float64).reshape(-1, 7)
+    q = x[:, :4] / np.sqrt(np.sum(x[:, :4] ** 2, axis=1))[:, None]
+    out = np.empty((x.shape[0], 4, 4))
+    _pose_from_components(_rot_from_quat(tuple(q.T)), tuple(x[:, 4:].T), out)
+    return out
+
+
+def _qt_split(x: FloatArray) -> tuple[tuple, tuple]:
+    c = np.ascontiguousarray(x.T)
+    return (c[0], c[1], c[2], c[3]), (c[4], c[5], c[6])
+
+
+def _qt_join(q: tuple, p: tuple) -> FloatArray:
+    return np.stack([*q, *p], axis=-1)
+
+
+def qt_geodesic_many(a: FloatArray, b: FloatArray, ts: Sequence[float]) -> list[FloatArray]:
+    """Geodesic points (n, 7) of qt pairs ``a``, ``b`` (n, 7) at each scalar t of ``ts``."""
+    n = a.shape[0]
+    outs = [np.empty((n, 7)) for _ in ts]
+    for lo in range(0, n, _CHUNK):
+        hi = min(lo + _CHUNK, n)
+        qa, pa = _qt_split(a[lo:hi])
+        qb, pb = _qt_split(b[lo:hi])
+        pair = ScrewPair.from_qt(qa, pa, qb, pb)
+        for t, out in zip(ts, outs, strict=True):
+            q, p = pair.at(float(t))
+            out[lo:hi] = _qt_join(q, p)
+    return outs
+
+
+def qt_geodesic(a: FloatArray, b: FloatArray, t: ArrayLike) -> FloatArray:
+    """Geodesic points (n, 7) of qt pairs at per-pair (n,) or scalar ``t``."""
+    t = np.asarray(t, dtype=np.float64)
+    if t.ndim == 0:
+        return qt_geodesic_many(a, b, [float(t)])[0]
+    qa, pa = _qt_split(a)
+    qb, pb = _qt_split(b)
+    q, p = ScrewPair.from_qt(qa, pa, qb, pb).at(np.broadcast_to(t, (a.shape[0],)))
+    return _qt_join(q, p)
+
+
+def qt_log_at(base: FloatArray, x: FloatArray) -> FloatArray:
+    """Left-invariant logarithm at ``base``: twists ``log(inv(base) x)`` (n, 6) of qt rows."""
+    qa, pa = _qt_split(base)
+    qb, pb = _qt_split(x)
+    omega, v = ScrewPair.from_qt(qa, pa, qb, pb).twist()
+    return np.stack([*omega, *v], axis=-1)
+
+
+def qt_exp_at(base: FloatArray, xi: FloatArray) -> FloatArray:
+    """``base @ exp(xi)`` for qt rows ``base`` (n, 7) and twists ``xi`` (n, 6)."""
+    E = exp(xi)
+    rel = qt_from_matrix(E)
+    qa, pa = _qt_split(base)
+    qr, pr = _qt_split(rel)
+    q = _qmul(qa, qr)
+    r = _qrotate(qa, pr)
+    return _qt_join(q, (pa[0] + r[0], pa[1] + r[1], pa[2] + r[2]))
+
+
+def qt_flip(x: FloatArray) -> FloatArray:
+    """Frames turned by pi about their own x axis (z and y reversed): ``T @ Rx(pi)``."""
+    q, p = _qt_split(x)
+    one = np.ones_like(q[0])
+    zero = np.zeros_like(q[0])
+    qf = _qmul(q, (zero, one, zero, zero))
+    return _qt_join(qf, p)
