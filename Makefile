@@ -21,7 +21,7 @@ demo: $(STAMP)
 ## Run the whole test suite (what CI runs).
 test: $(STAMP)
 	$(BIN)/ruff check ruledrobot tests scripts
-	$(BIN)/pytest
+	$(BIN)/pytest -q
 
 lint: $(STAMP)
 	$(BIN)/ruff check ruledrobot tests scripts

@@ -13,6 +13,7 @@ from .algorithms import RefineResult, refine
 from .geometry import se3, sphere
 from .geometry.lines import Lines
 from .geometry.ruled import RuledSurface
+from .io.lines import load_lines, read_lines_document, save_lines
 from .subdivision import SCHEME_NAMES, subdivide
 
 __version__ = "0.1.0"
@@ -23,7 +24,10 @@ __all__ = [
     "RefineResult",
     "RuledSurface",
     "__version__",
+    "load_lines",
+    "read_lines_document",
     "refine",
+    "save_lines",
     "se3",
     "sphere",
     "subdivide",

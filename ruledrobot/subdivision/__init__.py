@@ -114,9 +114,9 @@ def subdivide(
         if arr.ndim != 3:
             raise ValueError(f"poses: expected shape (N, 4, 4), got {arr.shape}")
     else:
-        arr = as_float_array(arr, "points")
         if arr.ndim != 2:
             raise ValueError(f"points: expected shape (N, d), got {arr.shape}")
+        arr = as_float_array(arr, "points", (arr.shape[1],))
         if space == "sphere" and arr.shape[1] != 3:
             raise ValueError(f"unit vectors: expected shape (N, 3), got {arr.shape}")
     check_length(sch, arr.shape[0], space == "se3" and "poses" or "points")

@@ -99,7 +99,7 @@ def _chaikin(space: Space, E: FloatArray, n: int, closed: bool) -> FloatArray:
 
 def _bspline3(space: Space, E: FloatArray, n: int, closed: bool) -> FloatArray:
     """Cubic Lane–Riesenfeld: edge points = midpoints m_i, vertex points
-    ``(p_{i-1} + 6 p_i + p_{i+1})/8 = geodesic(p_i, mid(m_{i-1}, m_i), 1/4)``.
+    ``(p_{i-1} + 6 p_i + p_{i+1})/8 = mid(p_i, mid(m_{i-1}, m_i))``.
 
     Open sequences keep their end elements (the natural end condition).
     """
@@ -107,11 +107,11 @@ def _bspline3(space: Space, E: FloatArray, n: int, closed: bool) -> FloatArray:
         P = E[0 : n + 2]  # p_{-1} .. p_n
         M = space.geodesic_many(P[:-1], P[1:], [0.5])[0]  # M[k] = mid(p_{k-1}, p_k)
         mm = space.geodesic_many(M[:-1], M[1:], [0.5])[0]  # between m_{i-1}, m_i
-        v = space.geodesic(P[1:-1], mm, 0.25)
+        v = space.geodesic(P[1:-1], mm, 0.5)
         return interleave(v, M[1:])
     M = space.geodesic_many(E[:-1], E[1:], [0.5])[0]  # M[k] = mid(p_k, p_{k+1})
     mm = space.geodesic_many(M[:-1], M[1:], [0.5])[0]
-    v = space.geodesic(E[1:-1], mm, 0.25)
+    v = space.geodesic(E[1:-1], mm, 0.5)
     v = np.concatenate([E[:1], v, E[-1:]])
     return interleave(v, M)
 

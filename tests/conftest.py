@@ -1,0 +1,55 @@
+"""Shared test fixtures and data generators."""
+
+from __future__ import annotations
+
+import os
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, settings
+
+settings.register_profile(
+    "ci", max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow]
+)
+settings.register_profile("dev", max_examples=100, deadline=None)
+settings.load_profile("ci" if os.environ.get("CI") else "dev")
+
+
+def random_rotations(rng: np.random.Generator, n: int) -> np.ndarray:
+    """Uniform random rotation matrices (n, 3, 3)."""
+    q = rng.normal(size=(n, 4))
+    q /= np.linalg.norm(q, axis=1, keepdims=True)
+    w, x, y, z = q.T
+    return np.stack(
+        [
+            1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y),
+            2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
+            2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y),
+        ],
+        axis=-1,
+    ).reshape(n, 3, 3)  # fmt: skip
+
+
+def random_poses(rng: np.random.Generator, n: int, scale: float = 1.0) -> np.ndarray:
+    """Random rigid motions (n, 4, 4)."""
+    T = np.zeros((n, 4, 4))
+    T[:, :3, :3] = random_rotations(rng, n)
+    T[:, :3, 3] = scale * rng.normal(size=(n, 3))
+    T[:, 3, 3] = 1.0
+    return T
+
+
+def helical_motion(phi: np.ndarray, pitch: float) -> np.ndarray:
+    """Rotation by phi about z plus translation pitch * phi along z: (n, 4, 4)."""
+    phi = np.asarray(phi, dtype=float)
+    c, s = np.cos(phi), np.sin(phi)
+    T = np.zeros((*phi.shape, 4, 4))
+    T[..., 0, 0], T[..., 0, 1], T[..., 1, 0], T[..., 1, 1] = c, -s, s, c
+    T[..., 2, 2] = T[..., 3, 3] = 1.0
+    T[..., 2, 3] = pitch * phi
+    return T
+
+
+@pytest.fixture
+def rng() -> np.random.Generator:
+    return np.random.default_rng(12345)
