@@ -97,7 +97,10 @@ def refine(
     kind = "closed with a flip" if res.flip else ("closed" if res.closed else "open")
     l = res.lines.plucker
     constraint = float(
-        max(np.abs(np.linalg.norm(l[:, :3], axis=1) - 1).max(), np.abs((l[:, :3] * l[:, 3:]).sum(1)).max())
+        max(
+            np.abs(np.linalg.norm(l[:, :3], axis=1) - 1).max(),
+            np.abs((l[:, :3] * l[:, 3:]).sum(1)).max(),
+        )
     )
     console.print(
         f"{len(doc.lines)} -> {len(res.lines)} rulings ({kind}), {algorithm.value}/{scheme.value}, "
@@ -122,7 +125,9 @@ def gallery(
         mark = "[green]ok[/]" if ok else "[bold red]FAILED[/]"
         console.print(f"{mark}  {ex['name']}  ({ex['algorithm']}/{ex['scheme']})")
         for c in ex["checks"]:
-            console.print(f"      {c['name']}: {c['value']:.3g} (limit {c['limit']:.3g})", highlight=False)
+            console.print(
+                f"      {c['name']}: {c['value']:.3g} (limit {c['limit']:.3g})", highlight=False
+            )
     console.print(f"wrote {out}/checks.json and {len(result['examples'])} PNGs in {out}")
     if not result["passed"]:
         raise typer.Exit(code=1)

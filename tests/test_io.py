@@ -26,8 +26,9 @@ def test_json_round_trip(tmp_path, lines):
 
 def test_json_plucker_rows_frames_striction(tmp_path, lines):
     res = rr.refine(lines, "dh", "four_point", 1)
-    p = rr.save_lines(tmp_path / "r.json", res.lines, frames=res.frames, striction=res.striction,
-                      plucker=True)
+    p = rr.save_lines(
+        tmp_path / "r.json", res.lines, frames=res.frames, striction=res.striction, plucker=True
+    )
     doc = rr.read_lines_document(p)
     np.testing.assert_allclose(doc.lines.plucker, res.lines.plucker, atol=1e-15)
     np.testing.assert_allclose(doc.frames, res.frames)
@@ -45,16 +46,27 @@ def test_csv_round_trip(tmp_path, lines):
 @pytest.mark.parametrize(
     ("name", "content", "message"),
     [
-        ("a.json", "{\n  \"lines\": [1, 2,\n", r"a\.json: line \d+: not valid JSON"),
+        ("a.json", '{\n  "lines": [1, 2,\n', r"a\.json: line \d+: not valid JSON"),
         ("a.json", '{"lines": [{"point": [0, 0, 0]}]}', r"lines\[0\] lacks \['direction'\]"),
-        ("a.json", '{"lines": [{"point": [0,0,0], "direction": [1,0,0]},'
-                   ' {"point": [0,0,0], "direction": [0,0,0]}]}', r"lines\[1\]\.direction is the zero"),
+        (
+            "a.json",
+            '{"lines": [{"point": [0,0,0], "direction": [1,0,0]},'
+            ' {"point": [0,0,0], "direction": [0,0,0]}]}',
+            r"lines\[1\]\.direction is the zero",
+        ),
         ("a.json", '{"lines": [[1, 0, 0, 0, 1, 0], [1, 0, 0, 1, 0, 0]]}', r"lines\[1\]: l \. m"),
         ("a.json", '{"format": "other/2", "lines": []}', r"format 'other/2' is not supported"),
         ("a.json", '{"units": "mm", "lines": []}', r"units 'mm'"),
-        ("a.json", '{"lines": [{"point": [0, "x", 0], "direction": [1, 0, 0]}]}',
-         r"lines\[0\]\.point: expected numbers"),
-        ("a.csv", "px,py,pz,dx,dy,dz\n0,0,0,1,0,0\n0,0,0,1,0\n", r"a\.csv: line 3: expected 6 values"),
+        (
+            "a.json",
+            '{"lines": [{"point": [0, "x", 0], "direction": [1, 0, 0]}]}',
+            r"lines\[0\]\.point: expected numbers",
+        ),
+        (
+            "a.csv",
+            "px,py,pz,dx,dy,dz\n0,0,0,1,0,0\n0,0,0,1,0\n",
+            r"a\.csv: line 3: expected 6 values",
+        ),
         ("a.csv", "x,y,z\n", r"line 1: expected the header"),
         ("a.csv", "px,py,pz,dx,dy,dz\n0,0,nan,1,0,0\n", r"line 2: contains NaN"),
         ("a.csv", "px,py,pz,dx,dy,dz\n0,0,0,0,0,0\n", r"line 2: direction is the zero vector"),

@@ -144,8 +144,9 @@ def test_rotvec_near_pi_is_stable():
         axis = np.array([1.0, -2.0, 0.5]) / np.linalg.norm([1.0, -2.0, 0.5])
         R = se3.rotation_about_axis(axis, np.pi - eps)
         rv = se3.rotvec_from_matrix(R)
-        np.testing.assert_allclose(se3.rotation_about_axis(rv / np.linalg.norm(rv),
-                                                           np.linalg.norm(rv)), R, atol=1e-12)
+        np.testing.assert_allclose(
+            se3.rotation_about_axis(rv / np.linalg.norm(rv), np.linalg.norm(rv)), R, atol=1e-12
+        )
 
 
 def test_validate_poses_names_the_item():

@@ -23,7 +23,9 @@ def test_geodesic_is_constant_speed_great_circle(rng):
     np.testing.assert_allclose(sphere.geodesic(a, b, 1.0), b, atol=1e-14)
     # slerp formula (paper Eq. 12) on [0, 1]
     t = 0.37
-    slerp = (np.sin((1 - t) * phi)[:, None] * a + np.sin(t * phi)[:, None] * b) / np.sin(phi)[:, None]
+    slerp = (np.sin((1 - t) * phi)[:, None] * a + np.sin(t * phi)[:, None] * b) / np.sin(phi)[
+        :, None
+    ]
     np.testing.assert_allclose(sphere.geodesic(a, b, t), slerp, atol=1e-12)
 
 

@@ -16,7 +16,8 @@ from typing import Literal
 
 import numpy as np
 
-from ..geometry._arrays import FloatArray
+from ..geometry import se3
+from ..geometry._arrays import FloatArray, cross
 from ..geometry.lines import Lines, plucker_from_point_direction
 from ..geometry.ruled import RuledSurface
 from ..subdivision import check_length, check_steps, get_scheme, refine_plucker
@@ -92,13 +93,16 @@ def refine(
         x = refine_plucker(surf.lines.plucker, sch, steps, surf.closed, flip)
         return RefineResult(Lines(x), **common)
     if algorithm == "combined":
-        s = refine_sequence(EuclideanSpace(), surf.striction_points(), sch, steps, surf.closed, flip)
+        s = refine_sequence(
+            EuclideanSpace(), surf.striction_points(), sch, steps, surf.closed, flip
+        )
         sph = SphereSpace()
         l = refine_sequence(sph, surf.spherical_image(), sch, steps, surf.closed, flip)
         return RefineResult(Lines(plucker_from_point_direction(s, l)), striction=s, **common)
     space = SE3Space()
-    q = refine_sequence(space, space.encode(surf.dh_frames()), sch, steps, surf.closed, flip)
+    # frames built here are rigid by construction: encode without re-validating
+    q = refine_sequence(space, se3.qt_from_matrix(surf.dh_frames()), sch, steps, surf.closed, flip)
     frames = space.decode(q)
     origin, z = frames[:, :3, 3], frames[:, :3, 2]
-    lines_out = Lines(np.concatenate([z, np.cross(origin, z)], axis=1))
+    lines_out = Lines(np.concatenate([z, cross(origin, z)], axis=1))
     return RefineResult(lines_out, frames=frames, striction=origin.copy(), **common)

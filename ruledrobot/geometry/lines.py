@@ -21,7 +21,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ._arrays import FloatArray, as_float_array, first_index, norm
+from ._arrays import FloatArray, as_float_array, cross, dot, first_index, norm
 
 __all__ = [
     "CommonNormal",
@@ -51,7 +51,7 @@ def plucker_from_point_direction(points: ArrayLike, directions: ArrayLike) -> Fl
         raise ValueError(f"directions{first_index(bad)}: zero direction vector; expected non-zero")
     l = d / n[..., None]
     p, l = np.broadcast_arrays(p, l)
-    return np.concatenate([l, np.cross(p, l)], axis=-1)
+    return np.concatenate([l, cross(p, l)], axis=-1)
 
 
 def plucker_from_two_points(a: ArrayLike, b: ArrayLike) -> FloatArray:
@@ -82,7 +82,7 @@ def validate_plucker(rows: ArrayLike, name: str = "lines", tol: float = 1e-9) ->
             f"{name}{i}: direction must be a unit vector, |l| = {ln[bad][0]:.12g} "
             f"(tolerance {tol:g})"
         )
-    lm = np.abs(np.einsum("...i,...i->...", l, m))
+    lm = np.abs(dot(l, m))
     bad = lm > tol * np.maximum(1.0, norm(m))
     if np.any(bad):
         raise ValueError(
@@ -107,9 +107,9 @@ def plucker_project(x: ArrayLike) -> FloatArray:
         raise ValueError(f"plucker{first_index(bad)}: direction part is zero; no line")
     l = p / n[..., None]
     m = pb / n[..., None]
-    m = m - np.einsum("...i,...i->...", l, m)[..., None] * l
+    m = m - dot(l, m)[..., None] * l
     # one more Gram–Schmidt pass removes the last rounding residue of l . m
-    m = m - np.einsum("...i,...i->...", l, m)[..., None] * l
+    m = m - dot(l, m)[..., None] * l
     return np.concatenate([l, m], axis=-1)
 
 
@@ -173,7 +173,7 @@ def plucker_nearest(x: ArrayLike) -> FloatArray:
 def point_nearest_origin(plucker: ArrayLike) -> FloatArray:
     """Point of each line (..., 6) closest to the origin: ``l x m`` (..., 3)."""
     x = np.asarray(plucker, dtype=np.float64)
-    return np.cross(x[..., :3], x[..., 3:])
+    return cross(x[..., :3], x[..., 3:])
 
 
 def plucker_transform(T: ArrayLike, plucker: ArrayLike) -> FloatArray:
@@ -182,7 +182,7 @@ def plucker_transform(T: ArrayLike, plucker: ArrayLike) -> FloatArray:
     x = np.asarray(plucker, dtype=np.float64)
     R, t = T[..., :3, :3], T[..., :3, 3]
     l = np.einsum("...ij,...j->...i", R, x[..., :3])
-    m = np.einsum("...ij,...j->...i", R, x[..., 3:]) + np.cross(t, l)
+    m = np.einsum("...ij,...j->...i", R, x[..., 3:]) + cross(t, l)
     return np.concatenate([l, m], axis=-1)
 
 
@@ -214,7 +214,7 @@ class CommonNormal:
 def _any_normal(l: FloatArray) -> FloatArray:
     """A unit vector normal to each unit vector l (..., 3), smooth away from a seam."""
     e = np.where(np.abs(l[..., :1]) < 0.9, [1.0, 0.0, 0.0], [0.0, 1.0, 0.0])
-    n = np.cross(l, e)
+    n = cross(l, e)
     return n / norm(n)[..., None]
 
 
@@ -235,15 +235,15 @@ def common_normal(
     x1 = np.asarray(line1, dtype=np.float64)
     x2 = np.asarray(line2, dtype=np.float64)
     l1, m1, l2, m2 = x1[..., :3], x1[..., 3:], x2[..., :3], x2[..., 3:]
-    p1 = np.cross(l1, m1)
-    p2 = np.cross(l2, m2)
-    c = np.cross(l1, l2)
-    s2 = np.einsum("...i,...i->...", c, c)
+    p1 = cross(l1, m1)
+    p2 = cross(l2, m2)
+    c = cross(l1, l2)
+    s2 = dot(c, c)
     s = np.sqrt(s2)
-    cosang = np.einsum("...i,...i->...", l1, l2)
+    cosang = dot(l1, l2)
     d = p2 - p1
-    dl1 = np.einsum("...i,...i->...", d, l1)
-    dl2 = np.einsum("...i,...i->...", d, l2)
+    dl1 = dot(d, l1)
+    dl2 = dot(d, l2)
     parallel = s <= angle_tol
     s2safe = np.where(parallel, 1.0, s2)
     t1 = (dl1 - cosang * dl2) / s2safe
@@ -253,24 +253,33 @@ def common_normal(
         ref = p1
     else:
         ref = np.asarray(reference, dtype=np.float64)
-    r1 = np.einsum("...i,...i->...", ref - p1, l1)
-    r2 = np.einsum("...i,...i->...", ref - p2, l2)
+    r1 = dot(ref - p1, l1)
+    r2 = dot(ref - p2, l2)
     t1 = np.where(parallel, r1, t1)
     t2 = np.where(parallel, r2, t2)
     f1 = p1 + t1[..., None] * l1
     f2 = p2 + t2[..., None] * l2
+    # non-parallel lines: the normal is exactly along n = l1 x l2 / s; the signed
+    # distance (p2 - p1) . n is well conditioned even when the feet are not
+    n = c / np.where(parallel, 1.0, s)[..., None]
+    signed = dot(d, n)
+    # parallel lines: the gap between the feet, made exactly normal to l1
     gap = f2 - f1
-    dist = norm(gap)
+    gap = gap - dot(gap, l1)[..., None] * l1
+    gap_len = norm(gap)
+    dist = np.where(parallel, gap_len, np.abs(signed))
     intersecting = ~parallel & (dist <= dist_tol)
-    # direction: from L1 to L2; for intersecting lines along l1 x l2
-    along = c / np.where(parallel, 1.0, s)[..., None]
-    direction = gap / np.where(dist > dist_tol, dist, 1.0)[..., None]
-    direction = np.where((dist > dist_tol)[..., None], direction, along)
-    identical = parallel & (dist <= dist_tol)
+    sign = np.where(signed < 0.0, -1.0, 1.0)
+    direction = np.where(
+        parallel[..., None],
+        gap / np.where(gap_len > 0.0, gap_len, 1.0)[..., None],
+        n * np.where(intersecting, 1.0, sign)[..., None],
+    )
+    identical = parallel & (gap_len <= dist_tol)
     if np.any(identical):
         direction = np.where(identical[..., None], _any_normal(l1), direction)
     # twist angle about the normal direction, in (-pi, pi]
-    sin_a = np.einsum("...i,...i->...", c, direction)
+    sin_a = dot(c, direction)
     angle = np.arctan2(sin_a, cosang)
     dist = np.where(intersecting, 0.0, dist)
     f2 = np.where(intersecting[..., None], f1, f2)

@@ -45,7 +45,7 @@ from typing import Literal
 import numpy as np
 
 from . import se3
-from ._arrays import FloatArray, norm
+from ._arrays import FloatArray, cross, norm
 from .lines import CommonNormal, Lines, common_normal
 
 __all__ = ["RuledSurface", "dh_transform"]
@@ -54,7 +54,9 @@ __all__ = ["RuledSurface", "dh_transform"]
 def dh_transform(theta: FloatArray, d: FloatArray, a: FloatArray, alpha: FloatArray) -> FloatArray:
     """``Trans_x(a) Rot_x(alpha) Rot_z(theta) Trans_z(d)`` (..., 4, 4): one link of a
     DH row as returned by :meth:`RuledSurface.dh_parameters` (Craig's ordering)."""
-    theta, d, a, alpha = np.broadcast_arrays(*(np.asarray(v, dtype=np.float64) for v in (theta, d, a, alpha)))
+    theta, d, a, alpha = np.broadcast_arrays(
+        *(np.asarray(v, dtype=np.float64) for v in (theta, d, a, alpha))
+    )
     ct, st, ca, sa = np.cos(theta), np.sin(theta), np.cos(alpha), np.sin(alpha)
     T = np.zeros((*theta.shape, 4, 4))
     T[..., 0, 0] = ct
@@ -147,7 +149,9 @@ class RuledSurface:
         self._normals.append(cn)
         return cn
 
-    def _parallel_rule(self, cn: CommonNormal, first: FloatArray, second: FloatArray) -> CommonNormal:
+    def _parallel_rule(
+        self, cn: CommonNormal, first: FloatArray, second: FloatArray
+    ) -> CommonNormal:
         m = self.n_pairs
         ref = np.full((m, 3), np.nan)
         fallback = None
@@ -260,8 +264,8 @@ class RuledSurface:
         if np.any(stalled):
             x = self.common_normals().direction
             xs = np.concatenate([x, x[-1:]]) if not self.closed else x
-            e2[stalled] = np.cross(xs[stalled], l[stalled])
-        e3 = np.cross(l, e2)
+            e2[stalled] = cross(xs[stalled], l[stalled])
+        e3 = cross(l, e2)
         T = np.zeros((n, 4, 4))
         T[:, :3, 0], T[:, :3, 1], T[:, :3, 2] = l, e2, e3
         T[:, :3, 3] = self.striction_points()
@@ -276,7 +280,7 @@ class RuledSurface:
         m = self.n_pairs
         T = np.zeros((n, 4, 4))
         T[:m, :3, 0] = cn.direction
-        T[:m, :3, 1] = np.cross(l[:m], cn.direction)
+        T[:m, :3, 1] = cross(l[:m], cn.direction)
         T[:m, :3, 2] = l[:m]
         T[:m, :3, 3] = cn.foot1
         T[:, 3, 3] = 1.0
@@ -291,10 +295,10 @@ class RuledSurface:
             return T[0] @ dh_transform(0.0, 0.0, cn.distance[0], cn.angle[0])
         ext = se3.geodesic(T[n - 3], T[n - 2], 2.0)
         line = self.lines.plucker[-1]
-        l, p0 = line[:3], np.cross(line[:3], line[3:])
+        l, p0 = line[:3], cross(line[:3], line[3:])
         origin = p0 + ((ext[:3, 3] - p0) @ l) * l
         z = ext[:3, 2]
-        axis = np.cross(z, l)
+        axis = cross(z, l)
         s, c = norm(axis), float(z @ l)
         if s > 1e-15:
             R = se3.rotation_about_axis(axis / s, np.arctan2(s, c))

@@ -162,53 +162,62 @@ def _pose_from_components(rot: tuple, trans: tuple, out: FloatArray) -> None:
 
 @dataclass(frozen=True)
 class ScrewPair:
-    """The screw (shortest uniform motion) between poses A and B, ready to evaluate.
+    """The screw (shortest uniform motion) ``D = inv(A) B`` of poses A and B.
 
-    All fields are component tuples of arrays with the batch shape of the pair.
-    Build with :meth:`from_qt`; evaluate with :meth:`at`.  The logarithm of the
-    pair is computed once, every evaluation costs one sin and one cos.
+    All fields are arrays (or component tuples of arrays) with the batch shape
+    of the pair.  Build with :meth:`from_relative` or :meth:`from_qt`; evaluate
+    ``exp(t log D)`` with :meth:`relative_at` (one sin and one cos per call).
     """
 
-    qa: tuple  # quaternion of A (w, x, y, z)
-    pa: tuple  # translation of A
-    phi: FloatArray  # half rotation angle of inv(A) B, in [0, pi/2]
+    phi: FloatArray  # half rotation angle, in [0, pi/2]
     sin_phi: FloatArray
     cos_phi: FloatArray
     axis: tuple  # unit rotation axis u (zero vector when phi == 0)
-    axial: tuple  # (u . p) u, p = translation of inv(A) B
+    axial: tuple  # (u . p) u, p = translation of D
     perp: tuple  # p - axial
     cross: tuple  # u x perp
+    any_small: bool  # some sin(phi) < 1e-6 (the series branch is needed)
 
     @classmethod
-    def from_qt(cls, qa: tuple, pa: tuple, qb: tuple, pb: tuple) -> ScrewPair:
-        """Decompose the relative motion inv(A) B given quaternion/translation parts."""
-        qaw, qax, qay, qaz = qa
-        conj = (qaw, -qax, -qay, -qaz)
-        w, x, y, z = _qmul(conj, qb)
-        # shortest motion: rotation angle <= pi  <=>  w >= 0
-        sign = np.copysign(1.0, w)
+    def from_relative(cls, q: tuple, p: tuple) -> ScrewPair:
+        """Decompose D given its unit quaternion ``q`` (any sign) and translation ``p``."""
+        w, x, y, z = q
+        sign = np.copysign(1.0, w)  # shortest motion: rotation angle <= pi <=> w >= 0
         w, x, y, z = w * sign, x * sign, y * sign, z * sign
         s = np.sqrt(x * x + y * y + z * z)
         phi = np.arctan2(s, w)
         inv_s = 1.0 / np.where(s > 0.0, s, 1.0)
         ux, uy, uz = x * inv_s, y * inv_s, z * inv_s
-        px, py, pz = _qrotate(conj, (pb[0] - pa[0], pb[1] - pa[1], pb[2] - pa[2]))
+        px, py, pz = p
         dot = ux * px + uy * py + uz * pz
         ax_, ay_, az_ = dot * ux, dot * uy, dot * uz
         qx, qy, qz = px - ax_, py - ay_, pz - az_
         cross = (uy * qz - uz * qy, uz * qx - ux * qz, ux * qy - uy * qx)
-        return cls(qa, pa, phi, s, w, (ux, uy, uz), (ax_, ay_, az_), (qx, qy, qz), cross)
+        small = bool(np.any(s < 1e-6))
+        return cls(phi, s, w, (ux, uy, uz), (ax_, ay_, az_), (qx, qy, qz), cross, small)
+
+    @classmethod
+    def from_qt(cls, qa: tuple, pa: tuple, qb: tuple, pb: tuple) -> ScrewPair:
+        """The screw of inv(A) B from quaternion/translation parts of A and B."""
+        conj = (qa[0], -qa[1], -qa[2], -qa[3])
+        q = _qmul(conj, qb)
+        p = _qrotate(conj, (pb[0] - pa[0], pb[1] - pa[1], pb[2] - pa[2]))
+        return cls.from_relative(q, p)
 
     def relative_at(self, t: float | FloatArray) -> tuple[tuple, tuple]:
-        """Quaternion and translation of exp(t log(inv(A) B)) (the motion relative to A)."""
+        """Quaternion and translation of ``exp(t log D)`` (see the module doc)."""
         tphi = t * self.phi
         s = np.sin(tphi)
         c = np.cos(tphi)
-        S, C, phi = self.sin_phi, self.cos_phi, self.phi
+        S, C = self.sin_phi, self.cos_phi
         cos_rest = C * c + S * s  # cos((1 - t) phi)
         sin_rest = S * c - C * s  # sin((1 - t) phi)
-        small = S < 1e-6
-        ratio = np.where(small, t * (1.0 + (1.0 - t * t) * phi * phi / 6.0), s / np.where(small, 1.0, S))
+        if self.any_small:
+            small = S < 1e-6
+            series = t * (1.0 + (1.0 - t * t) * self.phi * self.phi / 6.0)
+            ratio = np.where(small, series, s / np.where(small, 1.0, S))
+        else:
+            ratio = s / S
         ux, uy, uz = self.axis
         a, p, x = self.axial, self.perp, self.cross
         rc, rs = ratio * cos_rest, ratio * sin_rest
@@ -219,16 +228,8 @@ class ScrewPair:
         )
         return (c, s * ux, s * uy, s * uz), trans
 
-    def at(self, t: float | FloatArray) -> tuple[tuple, tuple]:
-        """Quaternion and translation of geodesic(A, B, t) in world coordinates."""
-        q_rel, p_rel = self.relative_at(t)
-        q = _qmul(self.qa, q_rel)
-        r = _qrotate(self.qa, p_rel)
-        pa = self.pa
-        return q, (pa[0] + r[0], pa[1] + r[1], pa[2] + r[2])
-
     def twist(self) -> tuple[tuple, tuple]:
-        """Exponential coordinates [omega, v] of inv(A) B as component tuples."""
+        """Exponential coordinates [omega, v] of D as component tuples."""
         phi, S, C = self.phi, self.sin_phi, self.cos_phi
         small = S < 1e-8
         # phi/sin(phi) -> 1 and phi cot(phi) -> 1 as phi -> 0
@@ -238,6 +239,57 @@ class ScrewPair:
         fc = f * C
         v = tuple(a[k] + fc * p[k] - phi * x[k] for k in range(3))
         return omega, v
+
+
+def _qt_compose(qa: tuple, pa: tuple, q: tuple, p: tuple) -> tuple[tuple, tuple]:
+    """(qa, pa) * (q, p) on component tuples."""
+    r = _qrotate(qa, p)
+    return _qmul(qa, q), (pa[0] + r[0], pa[1] + r[1], pa[2] + r[2])
+
+
+def _geodesic_matrix_chunk(
+    A: FloatArray, B: FloatArray, t: float | FloatArray, out: FloatArray
+) -> None:
+    """Geodesic points of pose chunks A, B (c, 4, 4) written into ``out`` (c, 4, 4).
+
+    Works on rotation-matrix rows: ``D = R_A^T R_B`` is formed directly (one
+    Shepperd conversion), and the result ``R_A R(t)`` composed as matrices.
+    """
+    ra, pa = _pose_components(A)
+    rb, pb = _pose_components(B)
+    a00, a01, a02, a10, a11, a12, a20, a21, a22 = ra
+    b00, b01, b02, b10, b11, b12, b20, b21, b22 = rb
+    d = (
+        a00 * b00 + a10 * b10 + a20 * b20, a00 * b01 + a10 * b11 + a20 * b21,
+        a00 * b02 + a10 * b12 + a20 * b22, a01 * b00 + a11 * b10 + a21 * b20,
+        a01 * b01 + a11 * b11 + a21 * b21, a01 * b02 + a11 * b12 + a21 * b22,
+        a02 * b00 + a12 * b10 + a22 * b20, a02 * b01 + a12 * b11 + a22 * b21,
+        a02 * b02 + a12 * b12 + a22 * b22,
+    )  # fmt: skip
+    dx, dy, dz = pb[0] - pa[0], pb[1] - pa[1], pb[2] - pa[2]
+    pd = (
+        a00 * dx + a10 * dy + a20 * dz,
+        a01 * dx + a11 * dy + a21 * dz,
+        a02 * dx + a12 * dy + a22 * dz,
+    )
+    q, p = ScrewPair.from_relative(_quat_from_rot(d), pd).relative_at(t)
+    r00, r01, r02, r10, r11, r12, r20, r21, r22 = _rot_from_quat(q)
+    flat = out.reshape(-1, 16)
+    flat[:, 0] = a00 * r00 + a01 * r10 + a02 * r20
+    flat[:, 1] = a00 * r01 + a01 * r11 + a02 * r21
+    flat[:, 2] = a00 * r02 + a01 * r12 + a02 * r22
+    flat[:, 4] = a10 * r00 + a11 * r10 + a12 * r20
+    flat[:, 5] = a10 * r01 + a11 * r11 + a12 * r21
+    flat[:, 6] = a10 * r02 + a11 * r12 + a12 * r22
+    flat[:, 8] = a20 * r00 + a21 * r10 + a22 * r20
+    flat[:, 9] = a20 * r01 + a21 * r11 + a22 * r21
+    flat[:, 10] = a20 * r02 + a21 * r12 + a22 * r22
+    px, py, pz = p
+    flat[:, 3] = pa[0] + a00 * px + a01 * py + a02 * pz
+    flat[:, 7] = pa[1] + a10 * px + a11 * py + a12 * pz
+    flat[:, 11] = pa[2] + a20 * px + a21 * py + a22 * pz
+    flat[:, 12:15] = 0.0
+    flat[:, 15] = 1.0
 
 
 # ---------------------------------------------------------------------------
@@ -407,11 +459,7 @@ def log(T: ArrayLike) -> FloatArray:
     shape = T.shape[:-2]
     flat = T.reshape(-1, 4, 4)
     rot, trans = _pose_components(flat)
-    q = _quat_from_rot(rot)
-    one = np.ones_like(q[0])
-    zero = np.zeros_like(q[0])
-    pair = ScrewPair.from_qt((one, zero, zero, zero), (zero, zero, zero), q, trans)
-    omega, v = pair.twist()
+    omega, v = ScrewPair.from_relative(_quat_from_rot(rot), trans).twist()
     return np.stack([*omega, *v], axis=-1).reshape(*shape, 6)
 
 
@@ -443,11 +491,7 @@ def geodesic(A: ArrayLike, B: ArrayLike, t: ArrayLike) -> FloatArray:
     out = np.empty((n, 4, 4))
     for lo in range(0, n, _CHUNK):
         hi = min(lo + _CHUNK, n)
-        qa, pa = _qt_from_matrices(A[lo:hi])
-        qb, pb = _qt_from_matrices(B[lo:hi])
-        pair = ScrewPair.from_qt(qa, pa, qb, pb)
-        q, p = pair.at(tt if scalar_t else tt[lo:hi])
-        _pose_from_components(_rot_from_quat(q), p, out[lo:hi])
+        _geodesic_matrix_chunk(A[lo:hi], B[lo:hi], tt if scalar_t else tt[lo:hi], out[lo:hi])
     return out.reshape(*shape, 4, 4)
 
 
@@ -462,12 +506,8 @@ def geodesic_many(A: FloatArray, B: FloatArray, ts: Sequence[float]) -> list[Flo
     outs = [np.empty((n, 4, 4)) for _ in ts]
     for lo in range(0, n, _CHUNK):
         hi = min(lo + _CHUNK, n)
-        qa, pa = _qt_from_matrices(A[lo:hi])
-        qb, pb = _qt_from_matrices(B[lo:hi])
-        pair = ScrewPair.from_qt(qa, pa, qb, pb)
         for t, out in zip(ts, outs, strict=True):
-            q, p = pair.at(float(t))
-            _pose_from_components(_rot_from_quat(q), p, out[lo:hi])
+            _geodesic_matrix_chunk(A[lo:hi], B[lo:hi], float(t), out[lo:hi])
     return [o.reshape(*shape, 4, 4) for o in outs]
 
 
@@ -480,16 +520,22 @@ def geodesic_many(A: FloatArray, B: FloatArray, ts: Sequence[float]) -> list[Flo
 def qt_from_matrix(T: ArrayLike) -> FloatArray:
     """Poses (n, 4, 4) -> rows ``[qw, qx, qy, qz, px, py, pz]`` (n, 7), ``qw >= 0``."""
     T = np.asarray(T, dtype=np.float64).reshape(-1, 4, 4)
-    q, p = _qt_from_matrices(T)
-    return np.stack([*q, *p], axis=-1)
+    out = np.empty((T.shape[0], 7))
+    for lo in range(0, T.shape[0], _CHUNK):
+        q, p = _qt_from_matrices(T[lo : lo + _CHUNK])
+        out[lo : lo + _CHUNK] = np.stack([*q, *p], axis=-1)
+    return out
 
 
 def matrix_from_qt(x: ArrayLike) -> FloatArray:
     """Rows ``[qw, qx, qy, qz, px, py, pz]`` (n, 7) -> poses (n, 4, 4) (quaternions normalised)."""
     x = np.asarray(x, dtype=np.float64).reshape(-1, 7)
-    q = x[:, :4] / np.sqrt(np.sum(x[:, :4] ** 2, axis=1))[:, None]
     out = np.empty((x.shape[0], 4, 4))
-    _pose_from_components(_rot_from_quat(tuple(q.T)), tuple(x[:, 4:].T), out)
+    for lo in range(0, x.shape[0], _CHUNK):
+        c = np.ascontiguousarray(x[lo : lo + _CHUNK].T)
+        inv = 1.0 / np.sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2] + c[3] * c[3])
+        q = (c[0] * inv, c[1] * inv, c[2] * inv, c[3] * inv)
+        _pose_from_components(_rot_from_quat(q), (c[4], c[5], c[6]), out[lo : lo + _CHUNK])
     return out
 
 
@@ -512,8 +558,8 @@ def qt_geodesic_many(a: FloatArray, b: FloatArray, ts: Sequence[float]) -> list[
         qb, pb = _qt_split(b[lo:hi])
         pair = ScrewPair.from_qt(qa, pa, qb, pb)
         for t, out in zip(ts, outs, strict=True):
-            q, p = pair.at(float(t))
-            out[lo:hi] = _qt_join(q, p)
+            q, p = pair.relative_at(float(t))
+            out[lo:hi] = _qt_join(*_qt_compose(qa, pa, q, p))
     return outs
 
 
@@ -524,8 +570,8 @@ def qt_geodesic(a: FloatArray, b: FloatArray, t: ArrayLike) -> FloatArray:
         return qt_geodesic_many(a, b, [float(t)])[0]
     qa, pa = _qt_split(a)
     qb, pb = _qt_split(b)
-    q, p = ScrewPair.from_qt(qa, pa, qb, pb).at(np.broadcast_to(t, (a.shape[0],)))
-    return _qt_join(q, p)
+    q, p = ScrewPair.from_qt(qa, pa, qb, pb).relative_at(np.broadcast_to(t, (a.shape[0],)))
+    return _qt_join(*_qt_compose(qa, pa, q, p))
 
 
 def qt_log_at(base: FloatArray, x: FloatArray) -> FloatArray:
@@ -542,9 +588,7 @@ def qt_exp_at(base: FloatArray, xi: FloatArray) -> FloatArray:
     rel = qt_from_matrix(E)
     qa, pa = _qt_split(base)
     qr, pr = _qt_split(rel)
-    q = _qmul(qa, qr)
-    r = _qrotate(qa, pr)
-    return _qt_join(q, (pa[0] + r[0], pa[1] + r[1], pa[2] + r[2]))
+    return _qt_join(*_qt_compose(qa, pa, qr, pr))
 
 
 def qt_flip(x: FloatArray) -> FloatArray:

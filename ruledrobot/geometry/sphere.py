@@ -13,7 +13,7 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ._arrays import FloatArray, as_float_array, first_index, norm
+from ._arrays import FloatArray, as_float_array, dot, first_index, norm
 
 __all__ = ["exp", "geodesic", "geodesic_many", "log", "validate_unit"]
 
@@ -34,10 +34,10 @@ def validate_unit(v: ArrayLike, name: str = "unit vectors", tol: float = 1e-9) -
 
 def _pair(a: FloatArray, b: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
     """Angle phi, sin(phi) and the unit tangent at a towards b (zero when a == b)."""
-    dot = np.einsum("...i,...i->...", a, b)
-    w = b - dot[..., None] * a
+    cos = dot(a, b)
+    w = b - cos[..., None] * a
     s = norm(w)
-    phi = np.arctan2(s, dot)
+    phi = np.arctan2(s, cos)
     anti = norm(a + b) <= ANTIPODAL_TOL
     if np.any(anti):
         raise ValueError(

@@ -111,14 +111,20 @@ def _read_json(path: Path, text: str) -> LinesDocument:
         if not isinstance(fr, list) or len(fr) != len(lines):
             raise ValueError(f"{where}: 'frames' must hold one 4x4 matrix per line")
         frames = np.asarray(
-            [_vector(sum(f, []) if f and isinstance(f[0], list) else f, 16, f"{where}: frames[{i}]")
-             for i, f in enumerate(fr)]
+            [
+                _vector(
+                    sum(f, []) if f and isinstance(f[0], list) else f, 16, f"{where}: frames[{i}]"
+                )
+                for i, f in enumerate(fr)
+            ]
         ).reshape(-1, 4, 4)
     if "striction" in doc:
         st = doc["striction"]
         if not isinstance(st, list) or len(st) != len(lines):
             raise ValueError(f"{where}: 'striction' must hold one point per line")
-        striction = np.asarray([_vector(p, 3, f"{where}: striction[{i}]") for i, p in enumerate(st)])
+        striction = np.asarray(
+            [_vector(p, 3, f"{where}: striction[{i}]") for i, p in enumerate(st)]
+        )
     return LinesDocument(lines, closed, frames, striction)
 
 

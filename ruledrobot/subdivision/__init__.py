@@ -58,12 +58,25 @@ def refine_plucker(
 
 
 @overload
-def subdivide(elements: Lines, scheme: str = ..., steps: int = ..., closed: bool = ...,
-              space: SpaceName | None = ..., flip: bool | None = ..., **params: float) -> Lines: ...
+def subdivide(
+    elements: Lines,
+    scheme: str = ...,
+    steps: int = ...,
+    closed: bool = ...,
+    space: SpaceName | None = ...,
+    flip: bool | None = ...,
+    **params: float,
+) -> Lines: ...
 @overload
-def subdivide(elements: ArrayLike, scheme: str = ..., steps: int = ..., closed: bool = ...,
-              space: SpaceName | None = ..., flip: bool | None = ...,
-              **params: float) -> FloatArray: ...
+def subdivide(
+    elements: ArrayLike,
+    scheme: str = ...,
+    steps: int = ...,
+    closed: bool = ...,
+    space: SpaceName | None = ...,
+    flip: bool | None = ...,
+    **params: float,
+) -> FloatArray: ...
 
 
 def subdivide(
@@ -119,7 +132,7 @@ def subdivide(
         arr = as_float_array(arr, "points", (arr.shape[1],))
         if space == "sphere" and arr.shape[1] != 3:
             raise ValueError(f"unit vectors: expected shape (N, 3), got {arr.shape}")
-    check_length(sch, arr.shape[0], space == "se3" and "poses" or "points")
+    check_length(sch, arr.shape[0], (space == "se3" and "poses") or "points")
     if flip and not closed:
         raise ValueError("flip=True needs closed=True")
     x = sp.encode(arr)

@@ -193,7 +193,9 @@ def get_scheme(name: str, **params: float) -> Scheme:
     """
     allowed = {"four_point": {"w"}, "ternary_four_point": {"mu"}}
     if name not in SCHEME_NAMES:
-        raise ValueError(f"scheme: unknown scheme {name!r}; expected one of {', '.join(SCHEME_NAMES)}")
+        raise ValueError(
+            f"scheme: unknown scheme {name!r}; expected one of {', '.join(SCHEME_NAMES)}"
+        )
     extra = set(params) - allowed.get(name, set())
     if extra:
         ok = ", ".join(sorted(allowed.get(name, set()))) or "none"
