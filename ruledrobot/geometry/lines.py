@@ -218,6 +218,14 @@ def _any_normal(l: FloatArray) -> FloatArray:
     return n / norm(n)[..., None]
 
 
+def _cross3(a: tuple, b: tuple) -> tuple:
+    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
+
+
+def _dot3(a: tuple, b: tuple) -> FloatArray:
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
 def common_normal(
     line1: ArrayLike,
     line2: ArrayLike,
@@ -234,55 +242,68 @@ def common_normal(
     """
     x1 = np.asarray(line1, dtype=np.float64)
     x2 = np.asarray(line2, dtype=np.float64)
-    l1, m1, l2, m2 = x1[..., :3], x1[..., 3:], x2[..., :3], x2[..., 3:]
-    p1 = cross(l1, m1)
-    p2 = cross(l2, m2)
-    c = cross(l1, l2)
-    s2 = dot(c, c)
+    shape = np.broadcast_shapes(x1.shape, x2.shape)
+    # struct of arrays: one contiguous array per coordinate
+    a = np.ascontiguousarray(np.moveaxis(np.broadcast_to(x1, shape), -1, 0))
+    b = np.ascontiguousarray(np.moveaxis(np.broadcast_to(x2, shape), -1, 0))
+    l1, m1, l2, m2 = tuple(a[:3]), tuple(a[3:]), tuple(b[:3]), tuple(b[3:])
+    p1 = _cross3(l1, m1)
+    p2 = _cross3(l2, m2)
+    c = _cross3(l1, l2)
+    s2 = _dot3(c, c)
     s = np.sqrt(s2)
-    cosang = dot(l1, l2)
-    d = p2 - p1
-    dl1 = dot(d, l1)
-    dl2 = dot(d, l2)
+    cosang = _dot3(l1, l2)
+    d = tuple(p2[k] - p1[k] for k in range(3))
+    dl1 = _dot3(d, l1)
+    dl2 = _dot3(d, l2)
     parallel = s <= angle_tol
-    s2safe = np.where(parallel, 1.0, s2)
+    any_parallel = bool(parallel.any())
+    s2safe = np.where(parallel, 1.0, s2) if any_parallel else s2
     t1 = (dl1 - cosang * dl2) / s2safe
     t2 = (cosang * dl1 - dl2) / s2safe
-    # parallel: project the reference point onto both lines
-    if reference is None:
-        ref = p1
-    else:
-        ref = np.asarray(reference, dtype=np.float64)
-    r1 = dot(ref - p1, l1)
-    r2 = dot(ref - p2, l2)
-    t1 = np.where(parallel, r1, t1)
-    t2 = np.where(parallel, r2, t2)
-    f1 = p1 + t1[..., None] * l1
-    f2 = p2 + t2[..., None] * l2
     # non-parallel lines: the normal is exactly along n = l1 x l2 / s; the signed
     # distance (p2 - p1) . n is well conditioned even when the feet are not
-    n = c / np.where(parallel, 1.0, s)[..., None]
-    signed = dot(d, n)
-    # parallel lines: the gap between the feet, made exactly normal to l1
-    gap = f2 - f1
-    gap = gap - dot(gap, l1)[..., None] * l1
-    gap_len = norm(gap)
-    dist = np.where(parallel, gap_len, np.abs(signed))
-    intersecting = ~parallel & (dist <= dist_tol)
+    inv_s = 1.0 / (np.where(parallel, 1.0, s) if any_parallel else s)
+    n = tuple(ck * inv_s for ck in c)
+    signed = _dot3(d, n)
+    dist = np.abs(signed)
     sign = np.where(signed < 0.0, -1.0, 1.0)
-    direction = np.where(
-        parallel[..., None],
-        gap / np.where(gap_len > 0.0, gap_len, 1.0)[..., None],
-        n * np.where(intersecting, 1.0, sign)[..., None],
-    )
-    identical = parallel & (gap_len <= dist_tol)
-    if np.any(identical):
-        direction = np.where(identical[..., None], _any_normal(l1), direction)
+    if any_parallel:
+        # parallel lines: feet at the projections of the reference point
+        if reference is None:
+            ref = p1
+        else:
+            r = np.moveaxis(
+                np.broadcast_to(np.asarray(reference, dtype=np.float64), (*shape[:-1], 3)), -1, 0
+            )
+            ref = tuple(r)
+        t1 = np.where(parallel, _dot3(tuple(ref[k] - p1[k] for k in range(3)), l1), t1)
+        t2 = np.where(parallel, _dot3(tuple(ref[k] - p2[k] for k in range(3)), l2), t2)
+    f1 = tuple(p1[k] + t1 * l1[k] for k in range(3))
+    f2 = tuple(p2[k] + t2 * l2[k] for k in range(3))
+    intersecting = ~parallel & (dist <= dist_tol)
+    flip = np.where(intersecting, 1.0, sign)
+    direction = tuple(nk * flip for nk in n)
+    if any_parallel:
+        # the gap between the feet, made exactly normal to l1
+        gap = tuple(f2[k] - f1[k] for k in range(3))
+        along = _dot3(gap, l1)
+        gap = tuple(gap[k] - along * l1[k] for k in range(3))
+        gap_len = np.sqrt(_dot3(gap, gap))
+        inv_g = 1.0 / np.where(gap_len > 0.0, gap_len, 1.0)
+        direction = tuple(np.where(parallel, gap[k] * inv_g, direction[k]) for k in range(3))
+        dist = np.where(parallel, gap_len, dist)
+        identical = parallel & (gap_len <= dist_tol)
+        if np.any(identical):
+            other = np.moveaxis(_any_normal(np.stack(l1, axis=-1)), -1, 0)
+            direction = tuple(np.where(identical, other[k], direction[k]) for k in range(3))
     # twist angle about the normal direction, in (-pi, pi]
-    sin_a = dot(c, direction)
-    angle = np.arctan2(sin_a, cosang)
+    angle = np.arctan2(_dot3(c, direction), cosang)
     dist = np.where(intersecting, 0.0, dist)
-    f2 = np.where(intersecting[..., None], f1, f2)
+    f2 = tuple(np.where(intersecting, f1[k], f2[k]) for k in range(3))
+    f1 = np.stack(f1, axis=-1)
+    f2 = np.stack(f2, axis=-1)
+    direction = np.stack(direction, axis=-1)
     return CommonNormal(f1, f2, direction, dist, angle, parallel, intersecting)
 
 
