@@ -14,9 +14,9 @@ $(STAMP): pyproject.toml
 
 setup: $(STAMP)
 
-## Run the main job on the built-in example.
+## Run the main job on the built-in examples (the paper's gallery, until the robot chain lands).
 demo: $(STAMP)
-	$(BIN)/ruledrobot demo
+	$(BIN)/ruledrobot gallery --out out/gallery
 
 ## Run the whole test suite (what CI runs).
 test: $(STAMP)
