@@ -1,0 +1,51 @@
+"""Robot layer: UR catalogue (DH), forward kinematics, analytic IK, path IK.
+
+Typical use::
+
+    import ruledrobot as rr
+
+    robot = rr.robot.load("ur5e").with_tool([0, 0, 0.15, 0, 0, 0])
+    T = robot.fk(q)                      # (..., 6) -> (..., 4, 4) TCP poses
+    sols = robot.ik(T)                   # (..., 4, 4) -> (..., 8, 6), NaN rows = no solution
+    path = robot.path_ik(poses)          # (N, 4, 4) -> PathIKResult (continuous q, flags)
+
+Units m, rad, s; poses are float64 4x4 homogeneous matrices.  See
+``docs/robot.md`` for the catalogue, frames, branch numbering and the
+path-IK rules.
+"""
+
+from __future__ import annotations
+
+from numpy.typing import ArrayLike
+
+from ._checks import FloatArray
+from .catalogue import MODEL_NAMES, load
+from .ik import IKSolutions, URGeometry, wrap_angle
+from .model import DEFAULT_ACCELERATION, RobotModel
+from .path import PathIKResult, PathStatus, path_ik
+
+__all__ = [
+    "DEFAULT_ACCELERATION",
+    "MODEL_NAMES",
+    "IKSolutions",
+    "PathIKResult",
+    "PathStatus",
+    "RobotModel",
+    "URGeometry",
+    "fk",
+    "ik",
+    "load",
+    "path_ik",
+    "wrap_angle",
+]
+
+
+def fk(model: RobotModel, q: ArrayLike) -> FloatArray:
+    """``model.fk(q)``: TCP poses (..., 4, 4) in the world frame of joint positions (..., 6)."""
+    return model.fk(q)
+
+
+def ik(model: RobotModel, T: ArrayLike, *, q6_seed: ArrayLike = 0.0,
+       return_info: bool = False, check: bool = True) -> FloatArray | IKSolutions:
+    """``model.ik(T, ...)``: all 8 analytic solutions (..., 8, 6) of TCP poses (..., 4, 4)."""
+    return model.ik(T, q6_seed=q6_seed, return_info=return_info, check=check)  # type: ignore[call-overload]
