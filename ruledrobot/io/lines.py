@@ -110,14 +110,13 @@ def _read_json(path: Path, text: str) -> LinesDocument:
         fr = doc["frames"]
         if not isinstance(fr, list) or len(fr) != len(lines):
             raise ValueError(f"{where}: 'frames' must hold one 4x4 matrix per line")
-        frames = np.asarray(
-            [
-                _vector(
-                    sum(f, []) if f and isinstance(f[0], list) else f, 16, f"{where}: frames[{i}]"
-                )
-                for i, f in enumerate(fr)
-            ]
-        ).reshape(-1, 4, 4)
+        rows = []
+        for i, f in enumerate(fr):
+            # a frame is 16 numbers (row-major) or a nested 4x4 list
+            if isinstance(f, list) and f and all(isinstance(r, list) for r in f):
+                f = [v for r in f for v in r]
+            rows.append(_vector(f, 16, f"{where}: frames[{i}]"))
+        frames = np.asarray(rows).reshape(-1, 4, 4)
     if "striction" in doc:
         st = doc["striction"]
         if not isinstance(st, list) or len(st) != len(lines):
