@@ -8,6 +8,8 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, settings
 
+from ruledrobot.geometry.surfaces import helical_motion  # noqa: F401  (re-exported for tests)
+
 settings.register_profile(
     "ci", max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow]
 )
@@ -36,17 +38,6 @@ def random_poses(rng: np.random.Generator, n: int, scale: float = 1.0) -> np.nda
     T[:, :3, :3] = random_rotations(rng, n)
     T[:, :3, 3] = scale * rng.normal(size=(n, 3))
     T[:, 3, 3] = 1.0
-    return T
-
-
-def helical_motion(phi: np.ndarray, pitch: float) -> np.ndarray:
-    """Rotation by phi about z plus translation pitch * phi along z: (n, 4, 4)."""
-    phi = np.asarray(phi, dtype=float)
-    c, s = np.cos(phi), np.sin(phi)
-    T = np.zeros((*phi.shape, 4, 4))
-    T[..., 0, 0], T[..., 0, 1], T[..., 1, 0], T[..., 1, 1] = c, -s, s, c
-    T[..., 2, 2] = T[..., 3, 3] = 1.0
-    T[..., 2, 3] = pitch * phi
     return T
 
 

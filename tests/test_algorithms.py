@@ -80,6 +80,22 @@ def test_projection_keeps_cylindroid_striction_on_the_double_line():
     assert np.hypot(s[:, 0], s[:, 1]).max() < 1e-9
 
 
+@pytest.mark.parametrize("scheme", ["four_point", "chaikin", "bspline3"])
+def test_dh_keeps_cylindroid_on_its_double_line(scheme):
+    """The DH x axis of the cylindroid flips at its turning rulings; the dh refinement
+    uses sign-continuous frames, so the refined rulings still cross the z axis at
+    right angles (the frames' screw axes are the z axis itself)."""
+    phi = np.arange(8) * np.pi / 8
+    pts = np.stack([0 * phi, 0 * phi, 0.5 * np.sin(2 * phi)], 1)
+    lines = rr.Lines.from_point_direction(pts, np.stack([np.cos(phi), np.sin(phi), 0 * phi], 1))
+    towards = rr.RuledSurface(lines, closed=True).dh_frames("towards_next")[:, :3, 0]
+    assert np.any((towards * np.roll(towards, -1, axis=0)).sum(1) < 0)  # the flip is real
+    res = rr.refine(lines, "dh", scheme, 4, closed=True)
+    assert np.abs(res.lines.direction[:, 2]).max() < 1e-12
+    assert np.hypot(*res.lines.point[:, :2].T).max() < 1e-12
+    assert np.hypot(*res.striction[:, :2].T).max() < 1e-12
+
+
 def test_dh_keeps_equally_spaced_hyperboloid_rulings_on_the_quadric():
     a, c = 1.0, 1.5
     u = np.linspace(0, 4, 8)

@@ -104,3 +104,17 @@ def test_failed_write_leaves_nothing(tmp_path, lines):
         raise RuntimeError("boom")
     assert target.read_text() == before
     assert [p.name for p in tmp_path.iterdir()] == ["out.json"]
+
+
+def test_written_files_get_ordinary_permissions(tmp_path, lines):
+    import os
+
+    umask = os.umask(0o022)
+    try:
+        p = rr.save_lines(tmp_path / "a.json", lines)
+        assert p.stat().st_mode & 0o777 == 0o644
+        os.chmod(p, 0o640)
+        rr.save_lines(p, lines)
+        assert p.stat().st_mode & 0o777 == 0o640
+    finally:
+        os.umask(umask)

@@ -123,6 +123,22 @@ def test_dh_closed_with_flip_parameters(rng):
     np.testing.assert_allclose(T @ dh_transform(*dh.T), nxt, atol=1e-12)
 
 
+def test_continuous_frames_share_origins_and_axes(rng):
+    u = np.linspace(0, 3, 9)
+    pts = np.stack([0 * u, 0 * u, 0.4 * np.sin(2 * u)], 1)  # distribution parameter changes sign
+    surf = rr.RuledSurface(
+        rr.Lines.from_point_direction(pts, np.stack([np.cos(u), np.sin(u), 0 * u], 1))
+    )
+    check_dh_frames(surf)
+    a, b = surf.dh_frames("towards_next"), surf.dh_frames("continuous")
+    np.testing.assert_allclose(a[:, :3, 2:], b[:, :3, 2:], atol=1e-12)
+    xs = b[:, :3, 0]
+    assert np.all((xs[:-1] * xs[1:]).sum(1) > 0.9)
+    np.testing.assert_allclose(np.abs((a[:, :3, 0] * xs).sum(1)), 1.0, atol=1e-12)
+    with pytest.raises(ValueError, match="x_axis"):
+        surf.dh_frames("sideways")
+
+
 def test_dh_end_rule_keeps_helical_orbit():
     L0 = rr.Lines.from_point_direction([[1.0, 0.3, 0.0]], [[0.2, 0.7, 0.6]]).plucker[0]
     phi = np.linspace(0, 2, 6)

@@ -6,7 +6,10 @@
   the spherical image refined geodesically on S^2, lines rebuilt from both;
 * ``dh``: the DH frames of the rulings refined by geodesic subdivision in
   SE(3); the refined frames give the lines (their z axes), an approximate
-  striction curve (their origins) and a smooth frame motion.
+  striction curve (their origins) and a smooth frame motion.  The frames are
+  taken with sign-continuous x axes (``RuledSurface.dh_frames("continuous")``):
+  the same origins and z axes as the design's DH frames, without the half
+  turns where the distribution parameter changes sign.
 """
 
 from __future__ import annotations
@@ -101,7 +104,8 @@ def refine(
         return RefineResult(Lines(plucker_from_point_direction(s, l)), striction=s, **common)
     space = SE3Space()
     # frames built here are rigid by construction: encode without re-validating
-    q = refine_sequence(space, se3.qt_from_matrix(surf.dh_frames()), sch, steps, surf.closed, flip)
+    frames = se3.qt_from_matrix(surf.dh_frames(x_axis="continuous"))
+    q = refine_sequence(space, frames, sch, steps, surf.closed, flip)
     frames = space.decode(q)
     origin, z = frames[:, :3, 3], frames[:, :3, 2]
     lines_out = Lines(np.concatenate([z, cross(origin, z)], axis=1))

@@ -45,7 +45,7 @@ from typing import Literal
 import numpy as np
 
 from . import se3
-from ._arrays import FloatArray, cross, norm
+from ._arrays import FloatArray, cross, dot, norm
 from .lines import CommonNormal, Lines, common_normal
 
 __all__ = ["RuledSurface", "dh_transform"]
@@ -272,21 +272,60 @@ class RuledSurface:
         T[:, 3, 3] = 1.0
         return T
 
-    def dh_frames(self) -> FloatArray:
-        """DH frames (N, 4, 4) of the rulings (see module doc for the end rule)."""
+    def dh_frames(
+        self, x_axis: Literal["towards_next", "continuous"] = "towards_next"
+    ) -> FloatArray:
+        """DH frames (N, 4, 4) of the rulings (see module doc for the end rule).
+
+        ``x_axis="towards_next"`` (the DH convention of the design): x along the
+        common normal pointing from ruling i to ruling i+1.  Where the
+        distribution parameter changes sign (the cylindroid at its turning
+        rulings; developables everywhere, by rounding) that direction flips by pi
+        between neighbours.  ``x_axis="continuous"``: the same origins and z
+        axes, with x = sigma (l_i x l_{i+1})/|l_i x l_{i+1}| and one global sign
+        sigma (that of the first pair's DH x axis), which is continuous wherever
+        the spherical image is regular.  The ``dh`` refinement uses it: the
+        refined rulings depend only on origins and z axes, and the screw
+        geodesics between frames no longer make half turns.
+        """
+        if x_axis not in ("towards_next", "continuous"):
+            raise ValueError(f"x_axis: expected 'towards_next' or 'continuous', got {x_axis!r}")
         cn = self.common_normals()
+        x = cn.direction if x_axis == "towards_next" else self._continuous_x(cn)
         l = self.lines.direction
         n = len(l)
         m = self.n_pairs
         T = np.zeros((n, 4, 4))
-        T[:m, :3, 0] = cn.direction
-        T[:m, :3, 1] = cross(l[:m], cn.direction)
+        T[:m, :3, 0] = x
+        T[:m, :3, 1] = cross(l[:m], x)
         T[:m, :3, 2] = l[:m]
         T[:m, :3, 3] = cn.foot1
         T[:, 3, 3] = 1.0
         if not self.closed:
             T[-1] = self._last_frame(T, cn)
         return T
+
+    def _continuous_x(self, cn: CommonNormal) -> FloatArray:
+        """Sign-continuous common-normal directions per pair (see :meth:`dh_frames`)."""
+        x = cn.direction.copy()
+        m = self.n_pairs
+        c = cross(self.lines.direction[:m], self._next_lines()[:, :3])
+        ok = ~cn.parallel
+        n_hat = c / np.where(ok, norm(c), 1.0)[:, None]
+        ref = np.flatnonzero(ok & ~cn.intersecting)
+        sigma = 1.0 if ref.size == 0 else float(np.sign(dot(x[ref[0]], n_hat[ref[0]])) or 1.0)
+        x[ok] = sigma * n_hat[ok]
+        if np.any(cn.parallel) and np.any(ok):
+            # a parallel pair's normal is the gap direction: orient it like the
+            # nearest non-parallel pair before it (or after it, at the start)
+            idx = np.arange(m)
+            before = np.maximum.accumulate(np.where(ok, idx, -1))
+            after = np.minimum.accumulate(np.where(ok, idx, m)[::-1])[::-1]
+            near = np.where(before >= 0, before, after)
+            par = cn.parallel
+            flip = dot(x[par], x[near[par]]) < 0.0
+            x[np.flatnonzero(par)[flip]] *= -1.0
+        return x
 
     def _last_frame(self, T: FloatArray, cn: CommonNormal) -> FloatArray:
         n = len(self.lines)

@@ -1,0 +1,66 @@
+"""The ruledrobot command line: refine, errors, help texts."""
+
+from __future__ import annotations
+
+import numpy as np
+from typer.testing import CliRunner
+
+import ruledrobot as rr
+from ruledrobot.cli import app
+
+runner = CliRunner()
+
+
+def test_help_lists_commands_with_examples():
+    result = runner.invoke(app, ["--help"])
+    assert result.exit_code == 0
+    for name in ("refine", "gallery"):
+        assert name in result.output
+        sub = runner.invoke(app, [name, "--help"])
+        assert sub.exit_code == 0 and "Example:" in sub.output
+
+
+def test_refine_writes_lines_frames_and_mesh(tmp_path, rng):
+    lines = rr.Lines.from_point_direction(rng.normal(size=(6, 3)), rng.normal(size=(6, 3)))
+    src = rr.save_lines(tmp_path / "in.csv", lines)
+    out = tmp_path / "out" / "refined.json"
+    mesh = tmp_path / "out" / "refined.stl"
+    result = runner.invoke(
+        app,
+        [
+            "refine",
+            str(src),
+            "--out",
+            str(out),
+            "--algorithm",
+            "dh",
+            "--steps",
+            "2",
+            "--mesh",
+            str(mesh),
+            "--half-width",
+            "0.2",
+        ],
+    )
+    assert result.exit_code == 0, result.output
+    assert f"wrote {out}" in result.output.replace("\n", "")
+    doc = rr.read_lines_document(out)
+    expected = rr.refine(lines, "dh", "four_point", 2)
+    np.testing.assert_allclose(doc.lines.plucker, expected.lines.plucker, atol=1e-12)
+    np.testing.assert_allclose(doc.frames, expected.frames, atol=1e-12)
+    assert mesh.stat().st_size > 84
+
+
+def test_refine_reports_bad_input_without_traceback(tmp_path):
+    bad = tmp_path / "bad.json"
+    bad.write_text('{"lines": [[1, 0, 0, 0, 1, 0], [3, 0, 0, 0, 1, 0]]}')
+    result = runner.invoke(app, ["refine", str(bad), "--out", str(tmp_path / "o.json")])
+    assert result.exit_code == 2
+    assert "lines[1]: direction must be a unit vector" in result.output
+    assert "Traceback" not in result.output
+    assert not (tmp_path / "o.json").exists()
+    few = rr.save_lines(
+        tmp_path / "few.json", rr.Lines.from_point_direction(np.eye(3), np.ones((3, 3)))
+    )
+    result = runner.invoke(app, ["refine", str(few), "--scheme", "six_point"])
+    assert result.exit_code == 2 and "needs at least 6" in result.output
