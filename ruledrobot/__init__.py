@@ -18,6 +18,16 @@ from .subdivision import SCHEME_NAMES, subdivide
 
 __version__ = "0.1.0"
 
+
+def __getattr__(name: str):
+    """Import the heavier sub-packages on first use (``rr.robot``), keeping ``import`` fast."""
+    if name in ("robot",):
+        import importlib
+
+        return importlib.import_module(f".{name}", __name__)
+    raise AttributeError(f"module 'ruledrobot' has no attribute {name!r}")
+
+
 __all__ = [
     "SCHEME_NAMES",
     "Lines",
@@ -27,6 +37,7 @@ __all__ = [
     "load_lines",
     "read_lines_document",
     "refine",
+    "robot",
     "save_lines",
     "se3",
     "sphere",

@@ -306,24 +306,47 @@ def validate_poses(T: ArrayLike, name: str = "poses", tol: float = 1e-6) -> Floa
     """Return ``T`` as float64 (..., 4, 4) after checking it is a rigid motion.
 
     Checks finiteness, the last row ``[0, 0, 0, 1]``, orthonormal rotation
-    columns and determinant +1 (all to ``tol``); raises ValueError naming the
-    first offending index.
+    columns and a right-handed frame (all to ``tol``); raises ValueError naming
+    the first offending index.  Works on component rows in cache-sized chunks
+    (six column dot products and one triple product), cheap on 10^5 poses.
     """
     T = as_float_array(T, name, (4, 4))
-    bottom = np.abs(T[..., 3, :] - np.array([0.0, 0.0, 0.0, 1.0])).max(axis=-1)
-    if np.any(bottom > tol):
-        raise ValueError(f"{name}{first_index(bottom > tol)}: last row must be [0, 0, 0, 1]")
-    R = T[..., :3, :3]
-    err = np.abs(np.swapaxes(R, -1, -2) @ R - np.eye(3)).max(axis=(-1, -2))
-    if np.any(err > tol):
-        raise ValueError(
-            f"{name}{first_index(err > tol)}: rotation part is not orthonormal "
-            f"(|R^T R - I| = {err.max():.2e}, tolerance {tol:g})"
-        )
-    det = np.linalg.det(R)
-    if np.any(det < 0):
-        raise ValueError(f"{name}{first_index(det < 0)}: rotation part is a reflection (det < 0)")
+    shape = T.shape[:-2]
+    flat = T.reshape(-1, 16)
+    n = flat.shape[0]
+    err = np.empty(n)
+    for lo in range(0, n, _CHUNK):
+        c = flat[lo : lo + _CHUNK].T
+        x, y, z = (c[0], c[4], c[8]), (c[1], c[5], c[9]), (c[2], c[6], c[10])
+        e = np.abs(_dot3(x, x) - 1.0)
+        e = np.maximum(e, np.abs(_dot3(y, y) - 1.0))
+        e = np.maximum(e, np.abs(_dot3(z, z) - 1.0))
+        e = np.maximum(e, np.abs(_dot3(x, y)))
+        e = np.maximum(e, np.abs(_dot3(x, z)))
+        e = np.maximum(e, np.abs(_dot3(y, z)))
+        # right-handed: (x cross y) . z = det R = +1; a reflection gives -1
+        xy = (x[1] * y[2] - x[2] * y[1], x[2] * y[0] - x[0] * y[2], x[0] * y[1] - x[1] * y[0])
+        e = np.maximum(e, np.abs(_dot3(xy, z) - 1.0))
+        for k in (12, 13, 14):
+            e = np.maximum(e, np.abs(c[k]))
+        err[lo : lo + _CHUNK] = np.maximum(e, np.abs(c[15] - 1.0))
+    bad = err > tol
+    if bad.any():
+        i = int(np.argmax(bad))
+        where = first_index(bad.reshape(shape)) if shape else ""
+        Ti = flat[i].reshape(4, 4)
+        if np.abs(Ti[3] - np.array([0.0, 0.0, 0.0, 1.0])).max() > tol:
+            what = "last row must be [0, 0, 0, 1]"
+        elif np.linalg.det(Ti[:3, :3]) < 0.0:
+            what = "rotation part is a reflection (det < 0)"
+        else:
+            what = f"rotation part is not orthonormal (error {err[i]:.2e}, tolerance {tol:g})"
+        raise ValueError(f"{name}{where}: {what}")
     return T
+
+
+def _dot3(u: tuple, v: tuple) -> FloatArray:
+    return u[0] * v[0] + u[1] * v[1] + u[2] * v[2]
 
 
 def compose(A: ArrayLike, B: ArrayLike) -> FloatArray:

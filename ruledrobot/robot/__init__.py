@@ -19,8 +19,8 @@ from __future__ import annotations
 from numpy.typing import ArrayLike
 
 from ._checks import FloatArray
+from .analytic_ik import IKSolutions, URGeometry, wrap_angle
 from .catalogue import MODEL_NAMES, load
-from .ik import IKSolutions, URGeometry, wrap_angle
 from .model import DEFAULT_ACCELERATION, RobotModel
 from .path import PathIKResult, PathStatus, path_ik
 
@@ -45,7 +45,13 @@ def fk(model: RobotModel, q: ArrayLike) -> FloatArray:
     return model.fk(q)
 
 
-def ik(model: RobotModel, T: ArrayLike, *, q6_seed: ArrayLike = 0.0,
-       return_info: bool = False, check: bool = True) -> FloatArray | IKSolutions:
+def ik(
+    model: RobotModel,
+    T: ArrayLike,
+    *,
+    q6_seed: ArrayLike = 0.0,
+    return_info: bool = False,
+    check: bool = True,
+) -> FloatArray | IKSolutions:
     """``model.ik(T, ...)``: all 8 analytic solutions (..., 8, 6) of TCP poses (..., 4, 4)."""
     return model.ik(T, q6_seed=q6_seed, return_info=return_info, check=check)  # type: ignore[call-overload]

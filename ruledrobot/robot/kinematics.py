@@ -1,0 +1,184 @@
+"""Forward kinematics and the geometric Jacobian of a standard-DH serial chain.
+
+Convention (classic / standard Denavit-Hartenberg, as Universal Robots publish
+their tables): the transform from frame ``i-1`` to frame ``i`` is ::
+
+    A_i(q_i) = Rz(theta_i) Tz(d_i) Tx(a_i) Rx(alpha_i),   theta_i = q_i + theta_offset_i
+
+and the flange pose in the robot base frame is ``A_1 A_2 ... A_n``.  Joint ``i``
+turns about the z axis of frame ``i-1``.
+
+Both functions work on *component arrays*: the three axes and the origin of
+the running frame are kept as 12 arrays of shape ``(n,)`` and updated in
+closed form per joint (a loop over the joints, never over poses), which is
+cheaper than ``n`` batched 4x4 matrix products and keeps every intermediate
+contiguous.  Long batches are processed in cache-sized chunks.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ._checks import FloatArray
+
+_CHUNK = 8192  # poses per chunk: ~30 component arrays of 64 kB stay in L2
+
+Frame = tuple[list, list, list, list]  # x, y, z, p; each a list of 3 arrays or floats
+
+
+def _start_frame(base: FloatArray) -> Frame:
+    """Component form of a constant 4x4 pose (columns x, y, z, origin)."""
+    return (
+        [float(base[0, 0]), float(base[1, 0]), float(base[2, 0])],
+        [float(base[0, 1]), float(base[1, 1]), float(base[2, 1])],
+        [float(base[0, 2]), float(base[1, 2]), float(base[2, 2])],
+        [float(base[0, 3]), float(base[1, 3]), float(base[2, 3])],
+    )
+
+
+def _snap(v: float) -> float:
+    """cos/sin of a DH twist: exact 0 and +-1 where the angle is a multiple of pi/2."""
+    if abs(v) < 1e-15:
+        return 0.0
+    if abs(abs(v) - 1.0) < 1e-15:
+        return float(np.copysign(1.0, v))
+    return v
+
+
+def _joint_step(
+    frame: Frame, c: FloatArray, s: FloatArray, d: float, a: float, ca: float, sa: float
+) -> Frame:
+    """Apply ``Rz(theta) Tz(d) Tx(a) Rx(alpha)`` (c, s = cos, sin theta) to a frame."""
+    x, y, z, p = frame
+    xr = [c * x[k] + s * y[k] for k in range(3)]
+    yr = [c * y[k] - s * x[k] for k in range(3)]
+    if sa == 0.0:
+        yn = yr if ca == 1.0 else [ca * v for v in yr]
+        zn = z if ca == 1.0 else [ca * v for v in z]
+    elif ca == 0.0:
+        yn = z if sa == 1.0 else [sa * v for v in z]
+        zn = [-v for v in yr] if sa == 1.0 else [-sa * v for v in yr]
+    else:
+        yn = [ca * yr[k] + sa * z[k] for k in range(3)]
+        zn = [ca * z[k] - sa * yr[k] for k in range(3)]
+    pn = list(p)
+    if d != 0.0:
+        pn = [pn[k] + d * z[k] for k in range(3)]
+    if a != 0.0:
+        pn = [pn[k] + a * xr[k] for k in range(3)]
+    return xr, yn, zn, pn
+
+
+def _apply_tool(frame: Frame, tool: FloatArray) -> Frame:
+    """Right-multiply the frame by a constant pose ``tool`` (flange -> TCP)."""
+    x, y, z, p = frame
+    cols = []
+    for j in range(3):
+        cols.append([tool[0, j] * x[k] + tool[1, j] * y[k] + tool[2, j] * z[k] for k in range(3)])
+    t = tool[:3, 3]
+    pn = [p[k] + t[0] * x[k] + t[1] * y[k] + t[2] * z[k] for k in range(3)]
+    return cols[0], cols[1], cols[2], pn
+
+
+def _write_pose(frame: Frame, out: FloatArray) -> None:
+    """Write a component frame into ``out`` of shape (n, 4, 4)."""
+    x, y, z, p = frame
+    flat = out.reshape(-1, 16)
+    for r in range(3):
+        flat[:, 4 * r + 0] = x[r]
+        flat[:, 4 * r + 1] = y[r]
+        flat[:, 4 * r + 2] = z[r]
+        flat[:, 4 * r + 3] = p[r]
+    flat[:, 12:15] = 0.0
+    flat[:, 15] = 1.0
+
+
+def dh_fk(
+    q: FloatArray,
+    d: FloatArray,
+    a: FloatArray,
+    alpha: FloatArray,
+    theta_offset: FloatArray,
+    base: FloatArray | None = None,
+    tool: FloatArray | None = None,
+) -> FloatArray:
+    """Flange (or TCP) poses of a standard-DH chain.
+
+    Parameters
+    ----------
+    q : (n, J) joint positions [rad] (already validated, J = number of joints).
+    d, a, alpha, theta_offset : (J,) DH parameters [m, m, rad, rad].
+    base : optional 4x4 pose of the robot base in the world frame.
+    tool : optional 4x4 pose of the TCP in the flange frame.
+
+    Returns
+    -------
+    (n, 4, 4) poses ``base @ A_1(q_1) ... A_J(q_J) @ tool``.
+    """
+    n = q.shape[0]
+    out = np.empty((n, 4, 4))
+    theta = np.ascontiguousarray((q + theta_offset).T)  # (J, n), contiguous rows per joint
+    ct, st = np.cos(theta), np.sin(theta)
+    twists = [(_snap(float(np.cos(al))), _snap(float(np.sin(al)))) for al in alpha]
+    start = _start_frame(np.eye(4) if base is None else base)
+    for lo in range(0, n, _CHUNK):
+        hi = min(lo + _CHUNK, n)
+        frame = start
+        for j in range(theta.shape[0]):
+            ca, sa = twists[j]
+            frame = _joint_step(frame, ct[j, lo:hi], st[j, lo:hi], float(d[j]), float(a[j]), ca, sa)
+        if tool is not None:
+            frame = _apply_tool(frame, tool)
+        _write_pose(_broadcast(frame, hi - lo), out[lo:hi])
+    return out
+
+
+def _broadcast(frame: Frame, n: int) -> Frame:
+    """Frame components as arrays of length n (a joint-free chain keeps floats)."""
+    return tuple([np.broadcast_to(v, (n,)) for v in vec] for vec in frame)  # type: ignore[return-value]
+
+
+def dh_jacobian(
+    q: FloatArray,
+    d: FloatArray,
+    a: FloatArray,
+    alpha: FloatArray,
+    theta_offset: FloatArray,
+    base: FloatArray | None = None,
+    tool: FloatArray | None = None,
+) -> FloatArray:
+    """Geometric Jacobian at the flange/TCP, expressed in the world (base) frame.
+
+    Returns ``(n, 6, J)``: rows ``[v; omega]`` (linear velocity of the TCP point
+    [m/s], then angular velocity [rad/s], both in the frame of the FK output,
+    i.e. UR's speedl order ``[xd, yd, zd, wx, wy, wz]``), column ``i`` =
+    ``[z_{i-1} x (p_tcp - p_{i-1}); z_{i-1}]`` for revolute joint ``i``.
+    """
+    n, J = q.shape
+    out = np.empty((n, 6, J))
+    theta = np.ascontiguousarray((q + theta_offset).T)
+    ct, st = np.cos(theta), np.sin(theta)
+    twists = [(_snap(float(np.cos(al))), _snap(float(np.sin(al)))) for al in alpha]
+    start = _start_frame(np.eye(4) if base is None else base)
+    for lo in range(0, n, _CHUNK):
+        hi = min(lo + _CHUNK, n)
+        m = hi - lo
+        frame = _broadcast(start, m)
+        axes = []
+        for j in range(J):
+            axes.append((frame[2], frame[3]))  # z_{j}, p_{j} of the frame before joint j+1
+            ca, sa = twists[j]
+            frame = _joint_step(frame, ct[j, lo:hi], st[j, lo:hi], float(d[j]), float(a[j]), ca, sa)
+        if tool is not None:
+            frame = _apply_tool(frame, tool)
+        pe = frame[3]
+        blk = out[lo:hi]
+        for j, (z, p) in enumerate(axes):
+            rx, ry, rz = pe[0] - p[0], pe[1] - p[1], pe[2] - p[2]
+            blk[:, 0, j] = z[1] * rz - z[2] * ry
+            blk[:, 1, j] = z[2] * rx - z[0] * rz
+            blk[:, 2, j] = z[0] * ry - z[1] * rx
+            blk[:, 3, j] = z[0]
+            blk[:, 4, j] = z[1]
+            blk[:, 5, j] = z[2]
+    return out

@@ -1,0 +1,536 @@
+"""The robot model: a standard-DH serial arm with limits, masses, base and tool.
+
+A :class:`RobotModel` is immutable.  The catalogue (:func:`ruledrobot.robot.load`)
+builds the Universal Robots arms; :meth:`RobotModel.from_dh` builds any other
+arm from its DH table.  :meth:`~RobotModel.with_tool`, :meth:`~RobotModel.with_base`
+and :meth:`~RobotModel.with_limits` return modified copies.
+
+Frames (see ``docs/robot.md``):
+
+* **world**: the frame the user's poses live in.  ``base`` is the pose of the
+  robot base frame (DH frame 0, the UR controller's ``base``) in the world;
+  identity by default, so world = robot base.
+* **flange**: DH frame n (the UR ``tool0`` / tool flange frame).
+* **TCP**: ``tool`` is the pose of the tool centre point in the flange frame
+  (UR's "TCP offset"); identity by default, so TCP = flange.
+
+``fk`` maps joints to TCP poses in the world, ``ik`` and ``path_ik`` map TCP
+poses in the world to joints: ``T_world_tcp = base @ A_1 ... A_n @ tool``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Literal, overload
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from . import analytic_ik as _ik
+from ._checks import (
+    FloatArray,
+    as_array,
+    as_joint_vector,
+    as_pose_or_vector,
+    as_poses,
+    readonly,
+)
+from .kinematics import dh_fk, dh_jacobian
+
+if TYPE_CHECKING:
+    from .path import PathIKResult
+
+#: Default joint acceleration limit [rad/s^2].  UR publishes none; this is the
+#: URScript ``movej`` default acceleration (``a=1.4``), a conservative value
+#: every UR arm reaches on every joint.  Override with ``with_limits``.
+DEFAULT_ACCELERATION = 1.4
+
+_UR_ALPHA = np.array([np.pi / 2, 0.0, 0.0, np.pi / 2, -np.pi / 2, 0.0])
+
+
+def _identity() -> FloatArray:
+    return readonly(np.eye(4))
+
+
+def _inverse(T: FloatArray) -> FloatArray:
+    out = np.eye(4)
+    out[:3, :3] = T[:3, :3].T
+    out[:3, 3] = -T[:3, :3].T @ T[:3, 3]
+    return out
+
+
+def _left_mul(L: FloatArray, X: FloatArray) -> FloatArray:
+    """``L @ X[k]`` for a constant 4x4 ``L`` and poses X (n, 4, 4), as one GEMM."""
+    return np.ascontiguousarray(np.tensordot(X, L, axes=([1], [1])).transpose(0, 2, 1))
+
+
+def _right_mul(X: FloatArray, R: FloatArray) -> FloatArray:
+    """``X[k] @ R`` for poses X (n, 4, 4) and a constant 4x4 ``R``, as one GEMM."""
+    return (X.reshape(-1, 4) @ R).reshape(X.shape)
+
+
+@dataclass(frozen=True, eq=False, kw_only=True)
+class RobotModel:
+    """A serial arm in standard DH form, with limits, masses, base and tool.
+
+    All arrays are float64, read-only; ``J`` is the number of joints (6 for
+    the analytic IK).  Units: m, rad, s, kg, N m.
+
+    Attributes
+    ----------
+    name : model name (``"ur5e"``, ``"custom"``, ...).
+    d, a, alpha : (J,) standard-DH parameters; ``A_i = Rz(q_i + theta_offset_i)
+        Tz(d_i) Tx(a_i) Rx(alpha_i)`` (UR convention: all offsets 0).
+    theta_offset : (J,) joint zero offsets [rad].
+    lower, upper : (J,) joint position limits [rad] (``+-inf`` = unlimited).
+    max_velocity : (J,) joint speed limits [rad/s].
+    max_acceleration : (J,) joint acceleration limits [rad/s^2] (UR publishes
+        none; catalogue default :data:`DEFAULT_ACCELERATION`).
+    max_torque : (J,) joint torque limits [N m].
+    link_mass : (J,) link masses [kg] (link i moves with joint i).
+    link_com : (J, 3) centre of mass of link i in DH frame i [m].
+    control_period : controller period [s] (0.002 e-Series, 0.008 CB3).
+    base : (4, 4) pose of the robot base (DH frame 0) in the world frame.
+    tool : (4, 4) pose of the TCP in the flange frame (DH frame J).
+    tool_mass : mass of the tool [kg]; tool_com : (3,) its centre of mass in
+        the flange frame [m].
+    payload : rated payload [kg] (datasheet), or None.
+    reach : nominal reach [m] (datasheet), or None.
+    """
+
+    name: str
+    d: FloatArray
+    a: FloatArray
+    alpha: FloatArray
+    theta_offset: FloatArray
+    lower: FloatArray
+    upper: FloatArray
+    max_velocity: FloatArray
+    max_acceleration: FloatArray
+    max_torque: FloatArray
+    link_mass: FloatArray
+    link_com: FloatArray
+    control_period: float
+    base: FloatArray = field(default_factory=_identity)
+    tool: FloatArray = field(default_factory=_identity)
+    tool_mass: float = 0.0
+    tool_com: FloatArray = field(default_factory=lambda: readonly(np.zeros(3)))
+    payload: float | None = None
+    reach: float | None = None
+
+    # derived, filled in __post_init__
+    _ur: _ik.URGeometry | None = field(init=False, repr=False, default=None)
+    _ur_problem: str = field(init=False, repr=False, default="")
+    _base_inv: FloatArray | None = field(init=False, repr=False, default=None)
+    _tool_inv: FloatArray | None = field(init=False, repr=False, default=None)
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.name, str) or not self.name:
+            raise ValueError(f"name: expected a non-empty string, got {self.name!r}")
+        d = np.asarray(self.d)
+        if d.ndim != 1 or d.shape[0] < 1:
+            raise ValueError(f"d: expected a 1-D DH column with one entry per joint, got {d.shape}")
+        n = d.shape[0]
+        put = object.__setattr__
+        for f in ("d", "a", "alpha", "theta_offset"):
+            put(self, f, readonly(as_joint_vector(getattr(self, f), f, n)))
+        lower = as_joint_vector(self.lower, "lower", n, allow_inf=True)
+        upper = as_joint_vector(self.upper, "upper", n, allow_inf=True)
+        bad = ~(lower < upper)
+        if bad.any():
+            i = int(np.argmax(bad))
+            raise ValueError(f"lower[{i}] = {lower[i]:g} must be below upper[{i}] = {upper[i]:g}")
+        put(self, "lower", readonly(lower))
+        put(self, "upper", readonly(upper))
+        for f, allow_inf in (
+            ("max_velocity", False),
+            ("max_acceleration", False),
+            ("max_torque", True),
+        ):
+            v = as_joint_vector(getattr(self, f), f, n, allow_inf=allow_inf)
+            if np.any(v <= 0.0):
+                raise ValueError(f"{f}[{int(np.argmax(v <= 0.0))}]: must be positive")
+            put(self, f, readonly(v))
+        mass = as_joint_vector(self.link_mass, "link_mass", n)
+        if np.any(mass < 0.0):
+            raise ValueError(f"link_mass[{int(np.argmax(mass < 0.0))}]: must be >= 0")
+        put(self, "link_mass", readonly(mass))
+        com = as_array(self.link_com, "link_com")
+        com = as_array(np.broadcast_to(com, (n, 3)) if com.ndim < 2 else com, "link_com", (3,))
+        if com.shape != (n, 3):
+            raise ValueError(f"link_com: expected shape ({n}, 3), got {com.shape}")
+        put(self, "link_com", readonly(com))
+        period = float(as_array(self.control_period, "control_period"))
+        if not period > 0.0:
+            raise ValueError(f"control_period: must be positive, got {period}")
+        put(self, "control_period", period)
+        put(self, "base", readonly(as_pose_or_vector(self.base, "base")))
+        put(self, "tool", readonly(as_pose_or_vector(self.tool, "tool")))
+        tool_mass = float(as_array(self.tool_mass, "tool_mass"))
+        if tool_mass < 0.0:
+            raise ValueError(f"tool_mass: must be >= 0, got {tool_mass}")
+        put(self, "tool_mass", tool_mass)
+        put(self, "tool_com", readonly(as_array(self.tool_com, "tool_com", (3,)).reshape(3)))
+        for f in ("payload", "reach"):
+            v = getattr(self, f)
+            if v is not None:
+                v = float(as_array(v, f))
+                if v <= 0.0:
+                    raise ValueError(f"{f}: must be positive or None, got {v}")
+                put(self, f, v)
+        ur, problem = _ur_geometry(self.d, self.a, self.alpha)
+        put(self, "_ur", ur)
+        put(self, "_ur_problem", problem)
+        eye = np.eye(4)
+        put(self, "_base_inv", None if np.array_equal(self.base, eye) else _inverse(self.base))
+        put(self, "_tool_inv", None if np.array_equal(self.tool, eye) else _inverse(self.tool))
+
+    # ------------------------------------------------------------------ construction
+
+    @classmethod
+    def from_dh(
+        cls,
+        d: ArrayLike,
+        a: ArrayLike,
+        alpha: ArrayLike,
+        *,
+        name: str = "custom",
+        theta_offset: ArrayLike = 0.0,
+        lower: ArrayLike = -2 * np.pi,
+        upper: ArrayLike = 2 * np.pi,
+        max_velocity: ArrayLike = np.pi,
+        max_acceleration: ArrayLike = DEFAULT_ACCELERATION,
+        max_torque: ArrayLike = np.inf,
+        link_mass: ArrayLike = 0.0,
+        link_com: ArrayLike = (0.0, 0.0, 0.0),
+        control_period: float = 0.002,
+        base: ArrayLike | None = None,
+        tool: ArrayLike | None = None,
+        tool_mass: float = 0.0,
+        tool_com: ArrayLike = (0.0, 0.0, 0.0),
+        payload: float | None = None,
+        reach: float | None = None,
+    ) -> RobotModel:
+        """Build an arm from its standard-DH table (one entry per joint).
+
+        ``d``, ``a`` [m] and ``alpha`` [rad] are the DH columns; per-joint
+        parameters accept a scalar (same for every joint) or a vector.  The
+        defaults for unknown data are: limits +-2 pi, speed pi rad/s,
+        acceleration :data:`DEFAULT_ACCELERATION`, unlimited torque, massless
+        links, a 2 ms control period.  Analytic IK is available when the table
+        has the UR structure (``alpha = [pi/2, 0, 0, pi/2, -pi/2, 0]``,
+        ``a1 = a4 = a5 = a6 = 0``, ``a2, a3 != 0``); FK and the Jacobian work
+        for any table.
+        """
+        n = np.asarray(d).shape[0] if np.ndim(d) == 1 else 0
+        if n == 0:
+            raise ValueError(f"d: expected a 1-D DH column, got shape {np.shape(d)}")
+        return cls(
+            name=name,
+            d=d,
+            a=a,
+            alpha=alpha,
+            theta_offset=theta_offset,
+            lower=lower,
+            upper=upper,
+            max_velocity=max_velocity,
+            max_acceleration=max_acceleration,
+            max_torque=max_torque,
+            link_mass=link_mass,
+            link_com=link_com,
+            control_period=control_period,
+            base=np.eye(4) if base is None else base,
+            tool=np.eye(4) if tool is None else tool,
+            tool_mass=tool_mass,
+            tool_com=tool_com,
+            payload=payload,
+            reach=reach,
+        )
+
+    def with_tool(
+        self, tool: ArrayLike, mass: float | None = None, com: ArrayLike | None = None
+    ) -> RobotModel:
+        """A copy with the TCP at ``tool`` in the flange frame.
+
+        ``tool`` is a 4x4 pose or a UR pose vector ``[x, y, z, rx, ry, rz]`` (the
+        controller's TCP setting).  ``mass`` [kg] and ``com`` (flange frame [m])
+        replace the tool's mass properties when given.
+        """
+        changes: dict = {"tool": as_pose_or_vector(tool, "tool")}
+        if mass is not None:
+            changes["tool_mass"] = mass
+        if com is not None:
+            changes["tool_com"] = com
+        return dataclasses.replace(self, **changes)
+
+    def with_base(self, base: ArrayLike) -> RobotModel:
+        """A copy whose base frame sits at ``base`` (4x4 or UR pose vector) in the world."""
+        return dataclasses.replace(self, base=as_pose_or_vector(base, "base"))
+
+    def with_limits(
+        self,
+        *,
+        lower: ArrayLike | None = None,
+        upper: ArrayLike | None = None,
+        velocity: ArrayLike | None = None,
+        acceleration: ArrayLike | None = None,
+        torque: ArrayLike | None = None,
+    ) -> RobotModel:
+        """A copy with some limits replaced (scalars apply to every joint)."""
+        changes = {
+            k: v
+            for k, v in (
+                ("lower", lower),
+                ("upper", upper),
+                ("max_velocity", velocity),
+                ("max_acceleration", acceleration),
+                ("max_torque", torque),
+            )
+            if v is not None
+        }
+        return dataclasses.replace(self, **changes)
+
+    # ------------------------------------------------------------------ properties
+
+    @property
+    def n_joints(self) -> int:
+        """Number of joints J."""
+        return int(self.d.shape[0])
+
+    @property
+    def has_analytic_ik(self) -> bool:
+        """True when the DH table has the UR structure the closed-form IK needs."""
+        return self._ur is not None
+
+    @property
+    def ur_geometry(self) -> _ik.URGeometry:
+        """``(d1, a2, a3, d4 + d2 + d3, d5, d6)``; ValueError for a non-UR table."""
+        if self._ur is None:
+            raise ValueError(f"model {self.name!r}: no analytic IK: {self._ur_problem}")
+        return self._ur
+
+    def __repr__(self) -> str:
+        extra = ""
+        if self._base_inv is not None:
+            extra += ", base set"
+        if self._tool_inv is not None:
+            extra += f", tool set ({self.tool_mass:g} kg)"
+        return f"RobotModel({self.name!r}, {self.n_joints} joints{extra})"
+
+    # ------------------------------------------------------------------ kinematics
+
+    def _joints(self, q: ArrayLike, name: str = "q") -> FloatArray:
+        return as_array(q, name, (self.n_joints,))
+
+    def fk(self, q: ArrayLike) -> FloatArray:
+        """TCP poses in the world frame: joints (..., J) [rad] -> (..., 4, 4).
+
+        ``base @ A_1(q_1) ... A_J(q_J) @ tool`` (the flange when no tool is set).
+        Vectorised closed form: a loop over the joints, none over poses.
+        """
+        q = self._joints(q)
+        shape = q.shape[:-1]
+        flat = q.reshape(-1, self.n_joints)
+        base = None if self._base_inv is None else self.base
+        tool = None if self._tool_inv is None else self.tool
+        T = dh_fk(flat, self.d, self.a, self.alpha, self.theta_offset, base, tool)
+        return T.reshape(*shape, 4, 4)
+
+    def jacobian(self, q: ArrayLike) -> FloatArray:
+        """Geometric Jacobian (..., 6, J) at the TCP, in the world frame.
+
+        Rows ``[v; omega]``: TCP linear velocity [m/s] then angular velocity
+        [rad/s] (UR speedl order), ``[v; omega] = J(q) @ qdot``.
+        """
+        q = self._joints(q)
+        shape = q.shape[:-1]
+        flat = q.reshape(-1, self.n_joints)
+        base = None if self._base_inv is None else self.base
+        tool = None if self._tool_inv is None else self.tool
+        Jm = dh_jacobian(flat, self.d, self.a, self.alpha, self.theta_offset, base, tool)
+        return Jm.reshape(*shape, 6, self.n_joints)
+
+    def flange_poses(self, T: ArrayLike, check: bool = True) -> FloatArray:
+        """World TCP poses (..., 4, 4) -> flange poses in the robot base frame.
+
+        ``inv(base) @ T @ inv(tool)``: what the closed-form IK solves for.
+        """
+        T = as_poses(T, "poses") if check else np.asarray(T, dtype=np.float64)
+        shape = T.shape[:-2]
+        flat = T.reshape(-1, 4, 4)
+        if self._base_inv is not None:
+            flat = _left_mul(self._base_inv, flat)
+        if self._tool_inv is not None:
+            flat = _right_mul(flat, self._tool_inv)
+        return flat.reshape(*shape, 4, 4)
+
+    @overload
+    def ik(
+        self,
+        T: ArrayLike,
+        *,
+        q6_seed: ArrayLike = ...,
+        return_info: Literal[False] = ...,
+        check: bool = ...,
+    ) -> FloatArray: ...
+
+    @overload
+    def ik(
+        self,
+        T: ArrayLike,
+        *,
+        q6_seed: ArrayLike = ...,
+        return_info: Literal[True],
+        check: bool = ...,
+    ) -> _ik.IKSolutions: ...
+
+    def ik(
+        self,
+        T: ArrayLike,
+        *,
+        q6_seed: ArrayLike = 0.0,
+        return_info: bool = False,
+        check: bool = True,
+    ) -> FloatArray | _ik.IKSolutions:
+        """All 8 analytic IK solutions of TCP poses in the world frame.
+
+        Parameters
+        ----------
+        T : (..., 4, 4) TCP poses in the world frame (m).
+        q6_seed : scalar or (...) value of q6 [rad] used where the wrist is
+            singular (``|sin q5| < 1e-12``: only ``q4 +- q6`` is determined).
+            If the elbow cannot reach with it, the q6 nearest to it with
+            which the elbow reaches is used instead.
+        return_info : also return the singularity factors (:class:`IKSolutions`).
+        check : validate the poses (shape, finite, rigid); ValueError names the
+            first bad pose.  Switch off only for poses known to be valid.
+
+        Returns
+        -------
+        (..., 8, 6) joint positions in (-pi, pi] [rad], branch index
+        ``4 * shoulder + 2 * wrist + elbow`` (``docs/robot.md``), NaN rows
+        where a branch has no solution; or :class:`IKSolutions` with
+        ``return_info=True``.  Each solution reproduces the pose to better than
+        1e-10 (typically 1e-15; the bound is reached only next to singularities).
+        """
+        g = self.ur_geometry
+        Tf = self.flange_poses(T, check=check)
+        shape = Tf.shape[:-2]
+        flat = Tf.reshape(-1, 4, 4)
+        n = flat.shape[0]
+        seed = as_array(q6_seed, "q6_seed")
+        try:
+            seed = np.broadcast_to(seed, shape).reshape(n)
+        except ValueError:
+            raise ValueError(
+                f"q6_seed: expected a scalar or the batch shape {shape}, got {seed.shape}"
+            ) from None
+        seed = seed + self.theta_offset[5]
+        out = np.empty((n, 8, 6))
+        info = np.empty((n, 8, 3)) if return_info else None
+        for lo in range(0, n, _ik._CHUNK):
+            hi = min(lo + _ik._CHUNK, n)
+            _ik.ur_ik_chunk(
+                g, flat[lo:hi], seed[lo:hi], out[lo:hi], None if info is None else info[lo:hi]
+            )
+        if np.any(self.theta_offset != 0.0):
+            ok = ~np.isnan(out[..., 0])
+            out[ok] = _ik.wrap_angle(out[ok] - self.theta_offset)
+        q = out.reshape(*shape, 8, 6)
+        if info is None:
+            return q
+        info = info.reshape(*shape, 8, 3)
+        valid = ~np.isnan(q[..., 0])
+        measure = info[..., 0] * info[..., 1] * info[..., 2] / _measure_scale(g)
+        return _ik.IKSolutions(
+            q=q,
+            valid=valid,
+            wrist=info[..., 0],
+            elbow=info[..., 1],
+            shoulder=info[..., 2],
+            measure=measure,
+        )
+
+    def singularity_factors(self, q: ArrayLike) -> FloatArray:
+        """(..., 3) singularity factors of joint configurations (..., 6).
+
+        ``[|sin q5|, |sin q3|, |a2 c2 + a3 c23 + d5 sin q234|]`` (DH angles):
+        wrist, elbow and shoulder (metres: distance of the wrist point from the
+        plane of the base z axis and the shoulder axis).  Each is 0 at its
+        singularity; ``det J = a2 a3 sin q3 sin q5 s``.
+        """
+        g = self.ur_geometry
+        th = self._joints(q) + self.theta_offset
+        t2, t3, t4 = th[..., 1], th[..., 2], th[..., 3]
+        s = g.a2 * np.cos(t2) + g.a3 * np.cos(t2 + t3) + g.d5 * np.sin(t2 + t3 + t4)
+        return np.stack([np.abs(np.sin(th[..., 4])), np.abs(np.sin(t3)), np.abs(s)], axis=-1)
+
+    def singularity_measure(self, q: ArrayLike) -> FloatArray:
+        """Scaled ``|det J|`` in [0, 1] of configurations (..., 6): 0 at any singularity.
+
+        ``|sin q3 sin q5 s| / (|a2| + |a3| + |d5|)`` = ``|det J| / (|a2 a3| (|a2| + |a3| + |d5|))``.
+        """
+        f = self.singularity_factors(q)
+        return f[..., 0] * f[..., 1] * f[..., 2] / _measure_scale(self.ur_geometry)
+
+    def within_limits(self, q: ArrayLike, tol: float = 0.0) -> np.ndarray:
+        """(...) bool: every joint of ``q`` (..., J) inside ``[lower - tol, upper + tol]``."""
+        q = self._joints(q)
+        return np.all((q >= self.lower - tol) & (q <= self.upper + tol), axis=-1)
+
+    def path_ik(
+        self,
+        poses: ArrayLike,
+        *,
+        q_start: ArrayLike | None = None,
+        jump_threshold: float = 0.5,
+        singular_tol: float = 0.05,
+        weights: ArrayLike | None = None,
+        max_messages: int = 20,
+    ) -> PathIKResult:
+        """One continuous IK solution per TCP pose (N, 4, 4) of a path.
+
+        See :func:`ruledrobot.robot.path_ik` for the parameters and the rules.
+        """
+        from .path import path_ik
+
+        return path_ik(
+            self,
+            poses,
+            q_start=q_start,
+            jump_threshold=jump_threshold,
+            singular_tol=singular_tol,
+            weights=weights,
+            max_messages=max_messages,
+        )
+
+
+def _measure_scale(g: _ik.URGeometry) -> float:
+    return abs(g.a2) + abs(g.a3) + abs(g.d5)
+
+
+def _ur_geometry(
+    d: FloatArray, a: FloatArray, alpha: FloatArray
+) -> tuple[_ik.URGeometry | None, str]:
+    """The closed-form parameters of a UR-type table, or None and the reason it is not one."""
+    if d.shape[0] != 6:
+        return None, f"needs 6 joints, the table has {d.shape[0]}"
+    for i in range(6):
+        if abs(float(alpha[i]) - _UR_ALPHA[i]) > 1e-12:
+            return None, f"alpha[{i}] = {alpha[i]:.12g}, the UR structure needs {_UR_ALPHA[i]:.12g}"
+    for i in (0, 3, 4, 5):
+        if a[i] != 0.0:
+            return None, f"a[{i}] = {a[i]:g}, the UR structure needs 0"
+    for i in (1, 2):
+        if a[i] == 0.0:
+            return None, f"a[{i}] = 0, the UR structure needs a non-zero link length"
+    geom = _ik.URGeometry(
+        d1=float(d[0]),
+        a2=float(a[1]),
+        a3=float(a[2]),
+        d4=float(d[1] + d[2] + d[3]),
+        d5=float(d[4]),
+        d6=float(d[5]),
+    )
+    return geom, ""

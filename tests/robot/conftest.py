@@ -1,0 +1,11 @@
+"""Fixtures of the robot tests (self-contained: no dependency on the shared conftest)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+
+@pytest.fixture
+def rng() -> np.random.Generator:
+    return np.random.default_rng(20261121)
