@@ -25,6 +25,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ._arrays import FloatArray, as_float_array, check_finite, first_index, norm
+from .box import Box
 from .lines import Lines
 from .ruled import RuledSurface
 
@@ -208,38 +209,12 @@ def box_clipped_mesh(
     rulings that both hit.  Returns :class:`ClippedMesh`.
     """
     lines, closed, flip = _topology(lines, "lines")
-    c = as_float_array(box_centre, "box_centre")
-    if c.shape != (3,):
-        raise ValueError(f"box_centre: expected 3 numbers, got shape {c.shape}")
-    size = as_float_array(box_size, "box_size")
-    if size.shape != (3,):
-        raise ValueError(f"box_size: expected 3 edge lengths, got shape {size.shape}")
-    if np.any(size <= 0.0):
-        k = int(np.flatnonzero(size <= 0.0)[0])
-        raise ValueError(f"box_size[{k}]: expected a positive edge length (m), got {size[k]!r}")
-    if box_rotation is None:
-        R = np.eye(3)
-    else:
-        R = as_float_array(box_rotation, "box_rotation")
-        if R.shape != (3, 3):
-            raise ValueError(f"box_rotation: expected a 3x3 rotation matrix, got shape {R.shape}")
-        if not np.allclose(R.T @ R, np.eye(3), atol=1e-9) or np.linalg.det(R) <= 0.0:
-            raise ValueError("box_rotation: expected a rotation matrix (orthonormal, det +1)")
+    box = Box(box_centre, box_size, np.eye(3) if box_rotation is None else box_rotation)
     x = lines.plucker
     l = x[:, :3]
     p0 = np.cross(l, x[:, 3:])
-    foot = p0 + np.einsum("ni,ni->n", c - p0, l)[:, None] * l  # point nearest the box centre
-    p = (foot - c) @ R  # box coordinates (row vectors: R^T (foot - c))
-    d = l @ R
-    half = 0.5 * size
-    parallel = np.abs(d) <= 1e-15
-    safe = np.where(parallel, 1.0, d)
-    t1 = (-half - p) / safe
-    t2 = (half - p) / safe
-    lo = np.where(parallel, np.where(np.abs(p) <= half, -np.inf, np.inf), np.minimum(t1, t2))
-    hi = np.where(parallel, np.where(np.abs(p) <= half, np.inf, -np.inf), np.maximum(t1, t2))
-    tmin, tmax = lo.max(axis=1), hi.min(axis=1)
-    hit = tmax > tmin
+    foot = p0 + np.einsum("ni,ni->n", box.centre - p0, l)[:, None] * l  # nearest the centre
+    tmin, tmax, hit = box.clip_lines(foot, l)
     n = len(lines)
     chords = np.full((n, 2, 3), np.nan)
     chords[hit, 0] = foot[hit] + tmin[hit, None] * l[hit]

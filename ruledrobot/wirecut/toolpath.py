@@ -1,0 +1,137 @@
+"""Geometry of a hot-wire cut: chords, the wire's free degrees of freedom, tool poses.
+
+Frames.  The rulings come with frames ``F`` (M, 4, 4) in the robot base frame:
+origin on the ruling, z along it (the refined DH frames of the ``dh``
+algorithm).  The wire has its own frame ``W`` in the flange frame
+(:func:`wire_frame`): origin at the wire's midpoint, z from ``wire_start`` to
+``wire_end``, x from the flange origin towards the wire (the bow's depth
+direction).
+
+Putting the wire on ruling i fixes 4 of the tool's 6 degrees of freedom; the
+free ones are the **roll** ``psi`` about the ruling and the **slide** ``s``
+along it, plus a discrete choice, whether the wire points along the ruling or
+against it (**reverse**)::
+
+    wire pose   G_i = F_i Rz(psi_i) Tz(s_i) [Rx(pi) if reverse]
+    flange pose P_i = G_i W^-1
+
+The **chord** of ruling i is the part inside the stock, ``c0_i <= z <= c1_i``
+in F_i's z coordinate.  The wire covers it with ``clearance`` beyond each end
+when ``c1 - L/2 + clearance <= s <= c0 + L/2 - clearance`` (L the wire length).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from ..geometry import se3
+from ..geometry._arrays import FloatArray
+from ..geometry.box import Box
+from .job import ToolSpec
+
+__all__ = [
+    "chords",
+    "flange_poses",
+    "slide_bounds",
+    "speed_factor",
+    "wire_frame",
+    "wire_poses",
+]
+
+
+def wire_frame(tool: ToolSpec) -> FloatArray:
+    """The wire frame W (4, 4) in the flange frame (see the module doc).
+
+    x is the component of the wire midpoint normal to the wire (flange -> wire);
+    when the wire passes through the flange axis, the flange z axis is used.
+    """
+    z = tool.wire_end - tool.wire_start
+    z = z / np.linalg.norm(z)
+    mid = 0.5 * (tool.wire_start + tool.wire_end)
+    x = mid - (mid @ z) * z
+    if np.linalg.norm(x) < 1e-9:
+        x = np.array([0.0, 0.0, 1.0]) - z[2] * z
+        if np.linalg.norm(x) < 1e-9:
+            x = np.array([1.0, 0.0, 0.0]) - z[0] * z
+    x = x / np.linalg.norm(x)
+    W = np.eye(4)
+    W[:3, 0], W[:3, 1], W[:3, 2], W[:3, 3] = x, np.cross(z, x), z, mid
+    return W
+
+
+def chords(frames: ArrayLike, stock: Box) -> tuple[FloatArray, FloatArray, np.ndarray]:
+    """Chord parameters ``(c0, c1, hit)`` (M,) of each ruling in the stock, in the
+    z coordinate of its frame (m); NaN where the ruling misses the stock."""
+    F = np.asarray(frames, dtype=np.float64)
+    return stock.clip_lines(F[:, :3, 3], F[:, :3, 2])
+
+
+def slide_bounds(
+    c0: FloatArray, c1: FloatArray, hit: np.ndarray, tool: ToolSpec
+) -> tuple[FloatArray, FloatArray, np.ndarray]:
+    """Slides ``lo <= s <= hi`` (M,) for which the wire covers each chord with the
+    clearance; ``(-inf, inf)`` where the ruling misses the stock.  ``ok`` is False
+    where the chord is longer than the wire allows."""
+    half = 0.5 * tool.wire_length - tool.clearance
+    lo = np.where(hit, c1 - half, -np.inf)
+    hi = np.where(hit, c0 + half, np.inf)
+    return lo, hi, lo <= hi
+
+
+def _rz_tz(psi: FloatArray, s: FloatArray, reverse: FloatArray | bool) -> FloatArray:
+    c, si = np.cos(psi), np.sin(psi)
+    T = np.zeros((*np.shape(psi), 4, 4))
+    T[..., 0, 0], T[..., 0, 1], T[..., 1, 0], T[..., 1, 1] = c, -si, si, c
+    T[..., 2, 2] = T[..., 3, 3] = 1.0
+    T[..., 2, 3] = s
+    rev = np.broadcast_to(np.asarray(reverse, dtype=bool), np.shape(psi))
+    # Rx(pi): y -> -y, z -> -z
+    T[..., :3, 1] = np.where(rev[..., None], -T[..., :3, 1], T[..., :3, 1])
+    T[..., :3, 2] = np.where(rev[..., None], -T[..., :3, 2], T[..., :3, 2])
+    return T
+
+
+def wire_poses(
+    frames: ArrayLike, roll: ArrayLike, slide: ArrayLike, reverse: ArrayLike | bool = False
+) -> FloatArray:
+    """Wire poses ``G = F Rz(roll) Tz(slide) [Rx(pi)]``: frames (M, 4, 4), roll and
+    slide broadcast to (..., M) -> (..., M, 4, 4)."""
+    F = np.asarray(frames, dtype=np.float64)
+    psi, s = np.broadcast_arrays(np.asarray(roll, float), np.asarray(slide, float))
+    return F @ _rz_tz(psi, s, reverse)
+
+
+def flange_poses(wire: ArrayLike, W: ArrayLike) -> FloatArray:
+    """Flange poses ``P = G W^-1`` (..., 4, 4) of wire poses G (..., 4, 4)."""
+    return np.asarray(wire, dtype=np.float64) @ se3.inverse(W)
+
+
+def speed_factor(
+    flange: ArrayLike, path_s: ArrayLike, ends_in_flange: ArrayLike, hit: ArrayLike
+) -> FloatArray:
+    """Metres moved by the fastest wire point inside the stock per unit of path parameter.
+
+    ``flange`` (M, 4, 4) flange poses along the path at parameters ``path_s`` (M,),
+    ``ends_in_flange`` (M, 2, 3) the chord end points as material points of the
+    wire (flange coordinates), ``hit`` (M,) where a chord exists.  The velocity
+    of a rigid body is affine along the wire, so its largest value over the chord
+    is at one of the ends.  Central differences (one-sided at the path ends);
+    0 where there is no chord.
+    """
+    P = np.asarray(flange, dtype=np.float64)
+    s = np.asarray(path_s, dtype=np.float64)
+    e = np.asarray(ends_in_flange, dtype=np.float64)
+    hit = np.asarray(hit, dtype=bool)
+    m = P.shape[0]
+    if m < 2:
+        return np.zeros(m)
+    nxt = np.minimum(np.arange(m) + 1, m - 1)
+    prv = np.maximum(np.arange(m) - 1, 0)
+    e_safe = np.where(hit[:, None, None], e, 0.0)
+    # world position of the same material points under the neighbouring poses
+    ahead = np.einsum("mij,mkj->mki", P[nxt, :3, :3], e_safe) + P[nxt, None, :3, 3]
+    behind = np.einsum("mij,mkj->mki", P[prv, :3, :3], e_safe) + P[prv, None, :3, 3]
+    ds = (s[nxt] - s[prv])[:, None]
+    speed = np.linalg.norm(ahead - behind, axis=-1) / ds
+    return np.where(hit, speed.max(axis=1), 0.0)
