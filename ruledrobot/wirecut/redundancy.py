@@ -1,0 +1,255 @@
+"""Choosing the wire's free degrees of freedom and the IK branch along a cut.
+
+The wire on ruling i leaves the roll ``psi`` about the ruling, the slide ``s``
+along it and the wire direction (``reverse``) free (see
+:mod:`ruledrobot.wirecut.toolpath`).  The default motion, as the issue asks, is
+the refined DH frame motion with a **constant offset**: one roll, one wire
+direction and — where every chord allows it — one slide for the whole cut, so
+the tool inherits the smoothness of the refined SE(3) frame motion.
+
+Search (vectorised over rulings; a Python loop over the small candidate grid):
+
+1. slide: the midpoint of the intersection of all feasible slide intervals; if
+   that intersection is empty, each ruling takes the point of its own interval
+   nearest that midpoint (reported);
+2. every roll of a grid (default 36 values) x both wire directions is scored on
+   a subsample of the rulings: branch-continuous path IK
+   (:func:`ruledrobot.robot.path_ik`), the smallest singularity measure, bow
+   clearance from the stock (arms as segments) and the table, total joint travel;
+3. candidates are verified on all rulings, best first; the first that passes
+   wins.  When none passes, the result is infeasible and says, per reason, how
+   many rulings each candidate lost — the planner reports it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..geometry._arrays import FloatArray
+from ..geometry.box import Box
+from ..robot import path_ik
+from .job import ToolSpec
+from .toolpath import chords, flange_poses, slide_bounds, wire_frame, wire_poses
+
+__all__ = ["RedundancyResult", "bow_segments", "solve_redundancy"]
+
+
+def bow_segments(tool: ToolSpec) -> FloatArray:
+    """The bow as three segments (3, 2, 3) in the flange frame: an arm from each wire
+    end back to the plane through the flange axis normal to the bow's depth direction,
+    and the crossbar between the arms' ends."""
+    W = wire_frame(tool)
+    x = W[:3, 0]
+    a = tool.wire_start - (tool.wire_start @ x) * x
+    b = tool.wire_end - (tool.wire_end @ x) * x
+    return np.array([[tool.wire_start, a], [tool.wire_end, b], [a, b]])
+
+
+@dataclass(frozen=True)
+class RedundancyResult:
+    """The chosen motion of the wire and the robot along the rulings (M of them)."""
+
+    feasible: bool
+    roll: FloatArray  # (M,) rad
+    slide: FloatArray  # (M,) m
+    reverse: bool
+    flange: FloatArray = field(repr=False)  # (M, 4, 4) flange poses
+    q: FloatArray = field(repr=False)  # (M, 6) joint positions
+    chord: FloatArray = field(repr=False)  # (M, 2) chord parameters (NaN: no chord)
+    hit: np.ndarray = field(repr=False)  # (M,) ruling crosses the stock
+    min_measure: float = 0.0
+    max_step: float = 0.0
+    constant_slide: bool = True
+    candidates: int = 0
+    reasons: tuple[str, ...] = ()
+
+
+@dataclass
+class _Score:
+    roll: float
+    reverse: bool
+    ok: bool
+    travel: float
+    min_measure: float
+    lost: dict[str, int]
+
+
+def _evaluate(
+    model,
+    frames,
+    roll,
+    slide,
+    reverse,
+    W,
+    segs,
+    stock,
+    table_z,
+    margin,
+    singular_min,
+    jump_threshold,
+    q_start=None,
+):
+    """Flange poses, path IK and checks for one candidate on the given rulings."""
+    P = flange_poses(wire_poses(frames, roll, slide, reverse), W)
+    ik = path_ik(model, P, q_start=q_start, jump_threshold=jump_threshold)
+    # bow segments in the base frame
+    R, t = P[:, None, None, :3, :3], P[:, None, None, :3, 3]
+    seg = np.einsum("mkeij,kej->mkei", np.broadcast_to(R, (len(P), 3, 2, 3, 3)), segs) + t
+    bow_in_stock = stock.segment_hits(seg[:, :, 0], seg[:, :, 1], margin).any(axis=1)
+    bow_low = (seg[..., 2] < table_z + margin).any(axis=(1, 2))
+    singular = ik.measure < singular_min
+    lost = {
+        "no continuous IK solution": int((~ik.ok).sum()),
+        "near a singularity": int((ik.ok & singular).sum()),
+        "bow hits the stock": int(bow_in_stock.sum()),
+        "bow below the table": int(bow_low.sum()),
+    }
+    ok = all(v == 0 for v in lost.values())
+    return P, ik, ok, lost
+
+
+def solve_redundancy(
+    frames: FloatArray,
+    stock: Box,
+    tool: ToolSpec,
+    model,
+    *,
+    rolls: int = 36,
+    sample: int = 80,
+    singular_min: float = 0.02,
+    jump_threshold: float = 0.5,
+    table_z: float | None = 0.0,
+    margin: float = 0.005,
+) -> RedundancyResult:
+    """Choose roll, slide, wire direction and IK branch for rulings with ``frames`` (M, 4, 4).
+
+    ``model``: a :class:`~ruledrobot.robot.RobotModel` whose ``fk`` gives the flange
+    pose (no tool set).  ``table_z``: height of the table top in the base frame
+    (None: no table check).  ``margin`` (m): clearance of the bow from stock and
+    table.  See the module doc for the search.
+    """
+    F = np.asarray(frames, dtype=np.float64)
+    m = F.shape[0]
+    W = wire_frame(tool)
+    segs = bow_segments(tool)
+    c0, c1, hit = chords(F, stock)
+    if not hit.any():
+        raise ValueError("rulings: none of them crosses the stock; nothing to cut")
+    lo, hi, ok = slide_bounds(c0, c1, hit, tool)
+    reasons: list[str] = []
+    if not ok.all():
+        bad = np.flatnonzero(~ok)
+        longest = float(np.nanmax(c1 - c0))
+        reasons.append(
+            f"{bad.size} chord(s) longer than the wire allows (longest {longest * 1e3:.1f} mm, "
+            f"wire {tool.wire_length * 1e3:.1f} mm less 2 x {tool.clearance * 1e3:.1f} mm "
+            f"clearance), first at ruling {int(bad[0])}"
+        )
+        empty = np.zeros(0)
+        return RedundancyResult(
+            False,
+            empty,
+            empty,
+            False,
+            np.zeros((0, 4, 4)),
+            np.zeros((0, 6)),
+            np.c_[c0, c1],
+            hit,
+            reasons=tuple(reasons),
+        )
+    L, H = lo[hit].max(), hi[hit].min()
+    constant = bool(L <= H)
+    if constant:
+        slide = np.full(m, 0.5 * (L + H))
+    else:
+        centre = 0.5 * (np.median(lo[hit]) + np.median(hi[hit]))
+        slide = np.clip(np.full(m, centre), lo, hi)
+        reasons.append("no single slide covers every chord: the slide varies along the cut")
+    idx = np.unique(np.r_[np.linspace(0, m - 1, min(sample, m)).round().astype(int)])
+    stride = max(1.0, (m - 1) / max(1, idx.size - 1))
+    grid = np.linspace(-np.pi, np.pi, rolls, endpoint=False)
+    scores: list[_Score] = []
+    for reverse in (False, True):
+        for psi in grid:
+            _, ik, ok_c, lost = _evaluate(
+                model,
+                F[idx],
+                np.full(idx.size, psi),
+                slide[idx],
+                reverse,
+                W,
+                segs,
+                stock,
+                table_z,
+                margin,
+                singular_min,
+                jump_threshold * stride,
+            )
+            travel = float(np.abs(np.diff(ik.q, axis=0)).sum()) if ik.q.size else np.inf
+            scores.append(
+                _Score(float(psi), reverse, ok_c, travel, float(np.min(ik.measure)), lost)
+            )
+    # feasible first, then least joint travel, then best conditioned
+    order = sorted(
+        range(len(scores)),
+        key=lambda k: (not scores[k].ok, scores[k].travel, -scores[k].min_measure),
+    )
+    tried = 0
+    for k in order[:12]:
+        sc = scores[k]
+        if not sc.ok and tried > 0:
+            break
+        tried += 1
+        roll = np.full(m, sc.roll)
+        P, ik, ok_c, lost = _evaluate(
+            model,
+            F,
+            roll,
+            slide,
+            sc.reverse,
+            W,
+            segs,
+            stock,
+            table_z,
+            margin,
+            singular_min,
+            jump_threshold,
+        )
+        if ok_c:
+            return RedundancyResult(
+                True,
+                roll,
+                slide,
+                sc.reverse,
+                P,
+                ik.q,
+                np.c_[c0, c1],
+                hit,
+                float(ik.measure.min()),
+                float(ik.max_step),
+                constant,
+                len(scores),
+                tuple(reasons),
+            )
+    best = scores[order[0]]
+    summary = "; ".join(f"{v} ruling(s) {r}" for r, v in best.lost.items() if v)
+    reasons.append(
+        f"no constant roll works: the best candidate (roll {np.degrees(best.roll):.0f} deg, "
+        f"{'reversed' if best.reverse else 'along the ruling'}) fails on the sampled rulings "
+        f"with {summary or 'problems only on the full path'}"
+    )
+    empty = np.zeros(0)
+    return RedundancyResult(
+        False,
+        empty,
+        slide,
+        best.reverse,
+        np.zeros((0, 4, 4)),
+        np.zeros((0, 6)),
+        np.c_[c0, c1],
+        hit,
+        candidates=len(scores),
+        reasons=tuple(reasons),
+    )
