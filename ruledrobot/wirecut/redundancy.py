@@ -17,8 +17,15 @@ Search (vectorised over rulings; a Python loop over the small candidate grid):
    (:func:`ruledrobot.robot.path_ik`), the smallest singularity measure, bow
    clearance from the stock (arms as segments) and the table, total joint travel;
 3. candidates are verified on all rulings, best first; the first that passes
-   wins.  When none passes, the result is infeasible and says, per reason, how
-   many rulings each candidate lost — the planner reports it.
+   wins;
+4. when no constant roll works, the roll varies: a ladder graph over
+   (roll x IK branch) per sampled ruling, nodes removed where IK fails, the
+   configuration is near a singularity or the bow is not clear, edges weighted
+   by the squared (wrapped) joint motion plus a roll-change penalty, solved by
+   dynamic programming (Viterbi) — as semi-constrained Cartesian planners do.
+   The roll sequence is then smoothed and verified on every ruling with path IK.
+   When that fails too, the result is infeasible and says, per reason, how many
+   rulings the best candidate lost — the planner reports it.
 """
 
 from __future__ import annotations
@@ -122,14 +129,18 @@ def solve_redundancy(
     jump_threshold: float = 0.5,
     table_z: float | None = 0.0,
     margin: float = 0.005,
+    strategy: str = "auto",
 ) -> RedundancyResult:
     """Choose roll, slide, wire direction and IK branch for rulings with ``frames`` (M, 4, 4).
 
     ``model``: a :class:`~ruledrobot.robot.RobotModel` whose ``fk`` gives the flange
     pose (no tool set).  ``table_z``: height of the table top in the base frame
     (None: no table check).  ``margin`` (m): clearance of the bow from stock and
-    table.  See the module doc for the search.
+    table.  ``strategy``: "auto" (constant offset first, then a varying roll),
+    "constant" or "varying".  See the module doc for the search.
     """
+    if strategy not in ("auto", "constant", "varying"):
+        raise ValueError(f"strategy: expected auto, constant or varying, got {strategy!r}")
     F = np.asarray(frames, dtype=np.float64)
     m = F.shape[0]
     W = wire_frame(tool)
@@ -197,7 +208,7 @@ def solve_redundancy(
         key=lambda k: (not scores[k].ok, scores[k].travel, -scores[k].min_measure),
     )
     tried = 0
-    for k in order[:12]:
+    for k in order[:12] if strategy != "varying" else []:
         sc = scores[k]
         if not sc.ok and tried > 0:
             break
@@ -233,10 +244,60 @@ def solve_redundancy(
                 len(scores),
                 tuple(reasons),
             )
+    for reverse in (False, True) if strategy != "constant" else ():
+        roll = _ladder_roll(
+            model,
+            F,
+            slide,
+            reverse,
+            W,
+            segs,
+            stock,
+            table_z,
+            margin,
+            singular_min,
+            grid,
+            idx,
+            jump_threshold * stride,
+        )
+        if roll is None:
+            continue
+        P, ik, ok_c, lost = _evaluate(
+            model,
+            F,
+            roll,
+            slide,
+            reverse,
+            W,
+            segs,
+            stock,
+            table_z,
+            margin,
+            singular_min,
+            jump_threshold,
+        )
+        if ok_c:
+            reasons.append("no constant roll works: the roll varies along the cut")
+            return RedundancyResult(
+                True,
+                roll,
+                slide,
+                reverse,
+                P,
+                ik.q,
+                np.c_[c0, c1],
+                hit,
+                float(ik.measure.min()),
+                float(ik.max_step),
+                constant,
+                len(scores),
+                tuple(reasons),
+            )
     best = scores[order[0]]
     summary = "; ".join(f"{v} ruling(s) {r}" for r, v in best.lost.items() if v)
     reasons.append(
-        f"no constant roll works: the best candidate (roll {np.degrees(best.roll):.0f} deg, "
+        "no constant or varying roll works: the best constant candidate "
+        f"(roll {np.degrees(best.roll):.0f} deg, "
         f"{'reversed' if best.reverse else 'along the ruling'}) fails on the sampled rulings "
         f"with {summary or 'problems only on the full path'}"
     )
@@ -253,3 +314,74 @@ def solve_redundancy(
         candidates=len(scores),
         reasons=tuple(reasons),
     )
+
+
+def _wrap(a: FloatArray) -> FloatArray:
+    return (a + np.pi) % (2.0 * np.pi) - np.pi
+
+
+def _ladder_roll(
+    model,
+    F,
+    slide,
+    reverse,
+    W,
+    segs,
+    stock,
+    table_z,
+    margin,
+    singular_min,
+    grid: FloatArray,
+    idx: np.ndarray,
+    jump: float,
+    roll_weight: float = 0.5,
+) -> FloatArray | None:
+    """Roll per ruling (M,) from a Viterbi pass over (roll x branch) nodes at the sampled
+    rulings ``idx``, smoothed and interpolated to every ruling; None when no path exists."""
+    n, k = idx.size, grid.size
+    Fs = F[idx]
+    psi = np.broadcast_to(grid, (n, k))
+    P = flange_poses(
+        wire_poses(Fs[:, None], psi, np.broadcast_to(slide[idx, None], (n, k)), reverse), W
+    )  # (n, k, 4, 4)
+    q = model.ik(P, check=False)  # (n, k, 8, 6)
+    valid = ~np.isnan(q).any(axis=-1)
+    meas = np.where(valid, model.singularity_measure(np.nan_to_num(q)), 0.0)
+    valid &= meas >= singular_min
+    R, t = P[:, :, None, None, :3, :3], P[:, :, None, None, :3, 3]
+    seg = np.einsum("nkseij,sej->nksei", np.broadcast_to(R, (n, k, 3, 2, 3, 3)), segs) + t
+    clear = ~stock.segment_hits(seg[..., 0, :], seg[..., 1, :], margin).any(axis=-1)
+    if table_z is not None:
+        clear &= ~(seg[..., 2] < table_z + margin).any(axis=(-1, -2))
+    valid &= clear[:, :, None]
+    qn = np.nan_to_num(q).reshape(n, k * 8, 6)
+    node_ok = valid.reshape(n, k * 8)
+    roll_of = np.repeat(grid, 8)
+    droll = _wrap(roll_of[:, None] - roll_of[None, :]) ** 2
+    cost = np.where(node_ok[0], 0.0, np.inf)
+    back = np.zeros((n, k * 8), dtype=np.intp)
+    for i in range(1, n):
+        dq = _wrap(qn[i - 1][:, None, :] - qn[i][None, :, :])  # (N, N, 6)
+        step = np.abs(dq).max(axis=-1)
+        c = (dq * dq).sum(-1) + roll_weight * droll
+        c = np.where(step <= jump, c, np.inf)
+        total = cost[:, None] + c
+        back[i] = np.argmin(total, axis=0)
+        cost = total[back[i], np.arange(k * 8)]
+        cost = np.where(node_ok[i], cost, np.inf)
+        if not np.isfinite(cost).any():
+            return None
+    j = int(np.argmin(cost))
+    if not np.isfinite(cost[j]):
+        return None
+    path = np.empty(n, dtype=np.intp)
+    path[-1] = j
+    for i in range(n - 1, 0, -1):
+        path[i - 1] = back[i, path[i]]
+    roll_s = np.unwrap(roll_of[path])
+    # smooth the piecewise-constant grid rolls (moving average over ~3 samples), then
+    # interpolate to every ruling
+    if n >= 3:
+        pad = np.r_[roll_s[0], roll_s, roll_s[-1]]
+        roll_s = (pad[:-2] + pad[1:-1] + pad[2:]) / 3.0
+    return np.interp(np.arange(F.shape[0]), idx, roll_s)

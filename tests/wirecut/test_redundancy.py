@@ -65,9 +65,23 @@ def test_impossible_jobs_are_reported(setup):
     stock_far = Box(job.stock.centre + np.array([3.0, 0.0, 0.0]), job.stock.size)
     r = red.solve_redundancy(far, stock_far, job.tool, model)
     assert not r.feasible
-    assert "no constant roll works" in r.reasons[-1] and "no continuous IK" in r.reasons[-1]
+    assert (
+        "no constant or varying roll works" in r.reasons[-1] and "no continuous IK" in r.reasons[-1]
+    )
     big = Box(job.stock.centre, [0.2, 0.6, 0.6])
     r = red.solve_redundancy(F, big, job.tool, model)
     assert not r.feasible and "longer than the wire allows" in r.reasons[0]
     with pytest.raises(ValueError, match="none of them crosses the stock"):
         red.solve_redundancy(F, Box([5.0, 5.0, 5.0], [0.1, 0.1, 0.1]), job.tool, model)
+
+
+def test_varying_roll_by_dynamic_programming(setup):
+    job, F, model = setup
+    r = red.solve_redundancy(F, job.stock, job.tool, model, strategy="varying")
+    assert r.feasible
+    np.testing.assert_allclose(model.fk(r.q), r.flange, atol=1e-9)
+    assert r.max_step < 0.05 and r.min_measure >= 0.02
+    # the roll is smooth: no jumps between consecutive rulings
+    assert np.abs(np.diff(np.unwrap(r.roll))).max() < 0.02
+    with pytest.raises(ValueError, match="strategy"):
+        red.solve_redundancy(F, job.stock, job.tool, model, strategy="greedy")
