@@ -1,0 +1,133 @@
+"""From a job to the geometric cut path: refined rulings, lead-in/out, wire motion.
+
+1. The input rulings are refined (``job.surface``: algorithm, scheme, and either
+   a number of steps or a target ``spacing`` — the largest gap between
+   consecutive chord midpoints — for which steps are added until it holds).
+2. The frame motion (the refined DH frames of ``dh``; sign-continuous DH frames
+   of the refined rulings otherwise) is kept between the first and the last
+   ruling that meets the stock grown by the lead distance on every side, and
+   extended at either end by screw-geodesic extrapolation of the frame motion
+   when the surface stops before the wire is clear of the stock by the lead
+   distance.
+3. The redundancy search (:mod:`.redundancy`) chooses roll, slide, wire
+   direction and IK branch.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..algorithms import refine
+from ..geometry import se3
+from ..geometry._arrays import FloatArray
+from ..geometry.box import Box
+from ..geometry.ruled import RuledSurface
+from .job import Job
+from .redundancy import RedundancyResult, solve_redundancy
+from .toolpath import chords
+
+__all__ = ["CutPath", "chord_ends_in_flange", "cut_path", "refine_for_job"]
+
+MAX_STEPS = 10
+
+
+@dataclass(frozen=True)
+class CutPath:
+    """The geometric cut: frames (M, 4, 4) on the rulings and the chosen robot motion."""
+
+    frames: FloatArray = field(repr=False)
+    motion: RedundancyResult
+    steps: int
+    extended: tuple[int, int]  # frames added before / after by extrapolation
+    input_rulings: int
+
+    @property
+    def feasible(self) -> bool:
+        return self.motion.feasible
+
+
+def _gaps(frames: FloatArray, stock: Box) -> float:
+    c0, c1, hit = chords(frames, stock)
+    mid = frames[:, :3, 3] + (0.5 * (c0 + c1))[:, None] * frames[:, :3, 2]
+    both = hit[:-1] & hit[1:]
+    if not both.any():
+        return np.inf
+    return float(np.linalg.norm(np.diff(mid, axis=0), axis=1)[both].max())
+
+
+def _frames(job: Job, steps: int) -> FloatArray:
+    s = job.surface
+    lines = job.input_lines()
+    res = refine(lines, s.algorithm, s.scheme, steps)
+    if res.frames is not None:
+        return res.frames
+    return RuledSurface(res.lines).dh_frames("continuous")
+
+
+def refine_for_job(job: Job) -> tuple[FloatArray, int]:
+    """Refined frames (M, 4, 4) and the number of steps used (see the module doc)."""
+    if job.surface.steps is not None:
+        return _frames(job, job.surface.steps), job.surface.steps
+    for steps in range(MAX_STEPS + 1):
+        F = _frames(job, steps)
+        if _gaps(F, job.stock) <= job.surface.spacing:
+            return F, steps
+    raise ValueError(
+        f"[surface] spacing: {job.surface.spacing} m not reached after {MAX_STEPS} steps "
+        f"({len(F)} rulings, largest gap {_gaps(F, job.stock):.3g} m)"
+    )
+
+
+def _extend(F: FloatArray, grown: Box, limit: int = 400) -> tuple[FloatArray, int, int]:
+    """Extrapolate the frame motion at each end until the end frames clear ``grown``."""
+    added = [0, 0]
+    parts = [F]
+    for side in (0, 1):
+        a, b = (F[1], F[0]) if side == 0 else (F[-2], F[-1])
+        new = []
+        k = 1
+        last = b
+        while grown.clip_lines(last[None, :3, 3], last[None, :3, 2])[2][0]:
+            if k > limit:
+                raise ValueError(
+                    "lead-in/out: the frame motion does not leave the stock within "
+                    f"{limit} extrapolated rulings; extend the surface past the stock"
+                )
+            last = se3.geodesic(a, b, 1.0 + k)
+            new.append(last)
+            k += 1
+        added[side] = len(new)
+        if new:
+            ext = np.array(new)
+            parts.insert(0, ext[::-1]) if side == 0 else parts.append(ext)
+    return np.concatenate(parts), added[0], added[1]
+
+
+def cut_path(job: Job, model=None, **search: float) -> CutPath:
+    """The geometric cut of ``job`` (see the module doc); ``search`` goes to the
+    redundancy search.  ``model`` defaults to the job's robot (flange, no tool)."""
+    from ..robot import load
+
+    if model is None:
+        model = load(job.robot.model).with_base(job.robot.base)
+    F, steps = refine_for_job(job)
+    lead = max(job.cut.lead_in, job.cut.lead_out)
+    grown = Box(job.stock.centre, job.stock.size + 2.0 * lead, job.stock.rotation)
+    _, _, near = chords(F, grown)
+    if not near.any():
+        raise ValueError("surface: no refined ruling comes near the stock; check [surface] pose")
+    first, last = np.flatnonzero(near)[[0, -1]]
+    F = F[max(first - 1, 0) : last + 2]
+    F, before, after = _extend(F, grown)
+    motion = solve_redundancy(F, job.stock, job.tool, model, **search)
+    return CutPath(F, motion, steps, (before, after), len(job.input_lines()))
+
+
+def chord_ends_in_flange(path: CutPath) -> FloatArray:
+    """Chord end points (M, 2, 3) as points of the wire in the flange frame (NaN: no chord)."""
+    F, m = path.frames, path.motion
+    ends_world = F[:, None, :3, 3] + m.chord[:, :, None] * F[:, None, :3, 2]
+    P_inv = se3.inverse(m.flange)
+    return np.einsum("mij,mkj->mki", P_inv[:, :3, :3], ends_world) + P_inv[:, None, :3, 3]
