@@ -22,6 +22,7 @@ A job describes, in the robot base frame (metres, radians, seconds)::
     base = [0.0, 0.0, 0.0, 0.0, 0.0, 0.0]
     speed_scale = 1.0          # fraction of the catalogue joint speed limits
     acceleration = 1.4         # rad/s^2, one value or six
+    # home = [3.14, -1.57, 1.57, -1.57, -1.57, 0.0]   # optional (rad): start and end here
 
     [tool]                     # the hot-wire bow, in the flange frame
     wire_start = [-0.2, 0.0, 0.25]
@@ -87,6 +88,7 @@ class RobotSpec:
     base: np.ndarray = field(default_factory=lambda: np.eye(4), repr=False)
     speed_scale: float = 1.0
     acceleration: np.ndarray | None = None
+    home: np.ndarray | None = field(default=None, repr=False)
 
 
 @dataclass(frozen=True)

@@ -121,6 +121,8 @@ def cut_path(job: Job, model=None, **search: float) -> CutPath:
     first, last = np.flatnonzero(near)[[0, -1]]
     F = F[max(first - 1, 0) : last + 2]
     F, before, after = _extend(F, grown)
+    if job.robot.home is not None:
+        search.setdefault("q_start", job.robot.home)
     motion = solve_redundancy(F, job.stock, job.tool, model, **search)
     return CutPath(F, motion, steps, (before, after), len(job.input_lines()))
 

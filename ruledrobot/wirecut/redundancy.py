@@ -130,6 +130,7 @@ def solve_redundancy(
     table_z: float | None = 0.0,
     margin: float = 0.005,
     strategy: str = "auto",
+    q_start: FloatArray | None = None,
 ) -> RedundancyResult:
     """Choose roll, slide, wire direction and IK branch for rulings with ``frames`` (M, 4, 4).
 
@@ -137,7 +138,9 @@ def solve_redundancy(
     pose (no tool set).  ``table_z``: height of the table top in the base frame
     (None: no table check).  ``margin`` (m): clearance of the bow from stock and
     table.  ``strategy``: "auto" (constant offset first, then a varying roll),
-    "constant" or "varying".  See the module doc for the search.
+    "constant" or "varying".  ``q_start`` (6,): joints the motion starts near (the
+    approach comes from there; path IK picks the branch and 2 pi representatives
+    nearest it).  See the module doc for the search.
     """
     if strategy not in ("auto", "constant", "varying"):
         raise ValueError(f"strategy: expected auto, constant or varying, got {strategy!r}")
@@ -197,6 +200,7 @@ def solve_redundancy(
                 margin,
                 singular_min,
                 jump_threshold * stride,
+                q_start,
             )
             travel = float(np.abs(np.diff(ik.q, axis=0)).sum()) if ik.q.size else np.inf
             scores.append(
@@ -227,6 +231,7 @@ def solve_redundancy(
             margin,
             singular_min,
             jump_threshold,
+            q_start,
         )
         if ok_c:
             return RedundancyResult(
@@ -275,6 +280,7 @@ def solve_redundancy(
             margin,
             singular_min,
             jump_threshold,
+            q_start,
         )
         if ok_c:
             reasons.append("no constant roll works: the roll varies along the cut")
