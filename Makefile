@@ -14,9 +14,9 @@ $(STAMP): pyproject.toml
 
 setup: $(STAMP)
 
-## Run the main job on the built-in examples (the paper's gallery, until the robot chain lands).
+## Run the main job: the whole chain on the built-in example.
 demo: $(STAMP)
-	$(BIN)/ruledrobot gallery --out out/gallery
+	$(BIN)/ruledrobot demo --out out/demo
 
 ## Run the whole test suite (what CI runs).
 test: $(STAMP)

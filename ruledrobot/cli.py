@@ -133,6 +133,78 @@ def gallery(
         raise typer.Exit(code=1)
 
 
+def _print_report(report: dict) -> None:
+    keys = [
+        ("duration_s", "duration", "s"),
+        ("cut_duration_s", "cut", "s"),
+        ("path_rulings", "rulings on the path", ""),
+        ("max_feed_speed_mm_s", "max feed speed", "mm/s"),
+        ("feed_within_1pct_fraction", "feed within 1% (fraction of the cut)", ""),
+        ("max_joint_speed_ratio", "max joint speed / limit", ""),
+        ("max_joint_accel_ratio", "max joint accel / limit", ""),
+        ("min_singularity_measure", "min singularity measure", ""),
+        ("max_planned_wire_deviation_mm", "planned wire deviation", "mm"),
+        ("max_wire_deviation_mm", "simulated wire deviation", "mm"),
+        ("max_tcp_tracking_error_mm", "simulated TCP tracking error", "mm"),
+    ]
+    for key, label, unit in keys:
+        v = report.get(key)
+        if v is not None:
+            console.print(f"  {label}: {v:.4g} {unit}".rstrip(), highlight=False)
+    for c in report.get("collisions", []):
+        console.print(f"  [yellow]collision:[/] {c}", highlight=False)
+
+
+def _run_plan(job_path: Path | None, out: Path, job_text: str | None = None) -> dict:
+    from .wirecut.job import load_job
+    from .wirecut.planner import plan as do_plan
+
+    if job_text is not None:
+        from .io.atomic import atomic_write_text
+
+        job_path = atomic_write_text(out / "job.toml", job_text)
+    try:
+        job = load_job(job_path)
+        with console.status("planning") as status:
+            result = do_plan(job, out, progress=lambda msg: status.update(f"planning: {msg}"))
+    except ValueError as exc:
+        raise _fail(str(exc)) from None
+    if not result.feasible:
+        err.print("[bold red]infeasible job:[/]")
+        for r in result.report.get("reasons", []):
+            err.print(f"  - {r}", highlight=False)
+        err.print(f"wrote {out / 'report.json'}")
+        raise typer.Exit(code=1)
+    _print_report(result.report)
+    for name, path in result.files.items():
+        console.print(f"wrote {path}  ({name})", highlight=False)
+    return result.report
+
+
+@app.command(epilog="Example:  ruledrobot plan job.toml --out out/cut   (job format: README)")
+def plan(
+    job: Path = typer.Argument(..., help="Cut job file (.toml)."),
+    out: Path = typer.Option(Path("out/plan"), "--out", "-o", help="Output folder."),
+) -> None:
+    """Plan a hot-wire cut: refine, choose the wire motion, time it, write the trajectory.
+
+    Exits with status 1 (and the reasons) when the job is infeasible.
+    """
+    _run_plan(job, out)
+
+
+@app.command(epilog="Example:  ruledrobot demo --out out/demo")
+def demo(
+    out: Path = typer.Option(Path("out/demo"), "--out", "-o", help="Output folder."),
+) -> None:
+    """Run the whole chain on the built-in example (a hyperbolic paraboloid cut in foam)."""
+    from .wirecut.demo import DEMO_JOB
+
+    console.print("[bold]ruledrobot demo[/]: hyperbolic paraboloid through a foam block, UR5e")
+    _run_plan(None, out, job_text=DEMO_JOB)
+    console.print(f"job file: {out / 'job.toml'} (edit it and run: ruledrobot plan)")
+
+
 def main() -> None:
     """Console-script entry point."""
     app()
