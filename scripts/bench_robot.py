@@ -1,6 +1,7 @@
-"""Benchmark of the robot layer: analytic IK, FK, Jacobian, path IK.
+"""Benchmark of the robot layer: analytic IK, FK, Jacobian, path IK; MuJoCo playback.
 
 Run:  .venv/bin/python scripts/bench_robot.py [--model ur5e] [--n 100000] [--repeat 5]
+      [--sim-duration 60] [--no-sim] [--no-render]
 
 Prints plain numbers (best of ``--repeat`` runs); no assertions on time.
 The comparison uses ``ur_analytic_ik`` (C++/Eigen, one pose per call) when
@@ -46,6 +47,10 @@ def main() -> None:
     parser.add_argument("--oracle-n", type=int, default=5_000, help="poses for ur_analytic_ik")
     parser.add_argument("--path-n", type=int, default=2_000, help="poses for path IK")
     parser.add_argument("--repeat", type=int, default=5)
+    parser.add_argument("--sim-duration", type=float, default=60.0, help="s of playback")
+    parser.add_argument("--render-frames", type=int, default=200)
+    parser.add_argument("--no-sim", action="store_true", help="skip MuJoCo playback/render")
+    parser.add_argument("--no-render", action="store_true", help="skip rendering")
     args = parser.parse_args()
 
     robot = load(args.model)
@@ -119,7 +124,94 @@ def main() -> None:
         f"max step {res.max_step:.2e} rad, max |q - q_ref| {np.abs(res.q - qp).max():.1e})"
     )
 
-    # --- MuJoCo playback / rendering: to be added with ruledrobot.sim --------------
+    # --- MuJoCo playback and rendering (ruledrobot.sim) -----------------------------
+    if not args.no_sim:
+        bench_sim(args)
+
+
+def cell_trajectory(
+    duration: float, dt: float = 0.002
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A smooth 6-joint trajectory of the example hot-wire cell, clear of table and stock.
+
+    Sinusoids about ``[0, -1.9, 1.4, -1.3, -pi/2, 0]``, amplitudes
+    ``[0.8, 0.3, 0.4, 0.3, 0.25, 0.5]`` rad, periods 5.3-10 s: peak speeds
+    0.23-0.50 rad/s (<= 0.16 of the UR5e limits), accelerations <= 0.44 rad/s^2.
+    """
+    t = np.arange(round(duration / dt) + 1) * dt
+    q0 = np.array([0.0, -1.9, 1.4, -1.3, -1.57, 0.0])
+    amp = np.array([0.8, 0.3, 0.4, 0.3, 0.25, 0.5])
+    w = 2 * np.pi / np.array([10.0, 7.7, 6.1, 8.3, 5.3, 6.7])
+    return t, q0 + amp * np.sin(np.outer(t, w)), amp * w * np.cos(np.outer(t, w))
+
+
+def bench_sim(args: argparse.Namespace) -> None:
+    """Playback real-time factor and tracking error on a 60 s trajectory; render fps."""
+    import dataclasses
+    import os
+    import tempfile
+
+    from ruledrobot import sim
+    from ruledrobot.sim.scene import example_scene
+
+    cell = example_scene()  # UR5e, 400 mm bow, 200 mm stock, table
+    cell = dataclasses.replace(cell, robot=cell.robot.with_tool([0, 0, 0.25, 0, 0, 0]))
+    t, q, qd = cell_trajectory(args.sim_duration)
+    print(
+        f"\nMuJoCo playback: {cell.robot.name} hot-wire cell, {args.sim_duration:g} s smooth "
+        f"trajectory ({t.size} samples at 500 Hz), best of {args.repeat}"
+    )
+    for ff in ("velocity", "torque"):
+        for label, kw in (("with collision checks", {}), ("dynamics only", {"collisions": False})):
+            best = None
+            for _ in range(max(1, args.repeat)):
+                res = sim.play(cell, t, q, qd, feedforward=ff, **kw)
+                if best is None or res.wall_time < best.wall_time:
+                    best = res
+            assert best is not None
+            rep = best.report()
+            rtf, phys = rep["realtime_factor"], rep["physics_realtime_factor"]
+            print(
+                f"  {ff:8s} feed-forward, {label:21s}: {best.wall_time * 1e3:7.1f} ms  "
+                f"{rtf:6.0f}x real time (physics {phys:4.0f}x)"
+            )
+        pos, rot = rep["tcp_position_error_mm"], rep["tcp_orientation_error_deg"]
+        print(
+            f"    TCP error max {pos['max']:.3f} mm, rms {pos['rms']:.3f} mm; orientation max "
+            f"{rot['max']:.4f} deg; joint max {rep['joint_error_rad']['max']:.2e} rad; "
+            f"torque/limit {rep['joint_torque']['max_ratio']:.2f}, "
+            f"speed/limit {rep['joint_speed']['max_ratio']:.2f}; "
+            f"collisions {rep['collision_count']}"
+        )
+    if args.no_render:
+        return
+    try:
+        renderer = sim.Renderer(cell, width=640, height=480)
+    except sim.RenderUnavailable as exc:
+        print(f"rendering               skipped: {exc}")
+        return
+    with renderer as r:
+        qs = q[:: max(1, q.shape[0] // args.render_frames)][: args.render_frames]
+        r.frame(qs[0])
+        t0 = time.perf_counter()
+        for qk in qs:
+            r.frame(qk)
+        el = time.perf_counter() - t0
+    print(
+        f"render 640x480 (EGL/OSMesa, fast settings): {len(qs) / el:6.1f} frames/s "
+        f"(MUJOCO_GL={os.environ.get('MUJOCO_GL')})"
+    )
+    res = sim.play(cell, t[:5001], q[:5001], qd[:5001], collisions=False)
+    with tempfile.TemporaryDirectory() as tmp:
+        t0 = time.perf_counter()
+        path = sim.render_video(res, f"{tmp}/cell.mp4", fps=25)
+        el = time.perf_counter() - t0
+        size = path.stat().st_size
+    n = int(res.duration * 25) + 1
+    print(
+        f"video 10 s, 25 fps, 640x480, H.264 (render + encode): {el:5.2f} s, "
+        f"{n / el:5.1f} frames/s, {size / 1e6:.2f} MB"
+    )
 
 
 if __name__ == "__main__":

@@ -37,6 +37,7 @@ import numpy as np
 from ..geometry._arrays import FloatArray
 from ..geometry.box import Box
 from ..robot import path_ik
+from ..sim.scene import BowTool
 from .job import ToolSpec
 from .toolpath import chords, flange_poses, slide_bounds, wire_frame, wire_poses
 
@@ -44,14 +45,10 @@ __all__ = ["RedundancyResult", "bow_segments", "solve_redundancy"]
 
 
 def bow_segments(tool: ToolSpec) -> FloatArray:
-    """The bow as three segments (3, 2, 3) in the flange frame: an arm from each wire
-    end back to the plane through the flange axis normal to the bow's depth direction,
-    and the crossbar between the arms' ends."""
-    W = wire_frame(tool)
-    x = W[:3, 0]
-    a = tool.wire_start - (tool.wire_start @ x) * x
-    b = tool.wire_end - (tool.wire_end @ x) * x
-    return np.array([[tool.wire_start, a], [tool.wire_end, b], [a, b]])
+    """The bow's rods (3, 2, 3) in the flange frame (:meth:`ruledrobot.sim.BowTool.segments`):
+    an arm from each wire end back to the plane through the flange axis normal to the
+    bow's depth direction, and the crossbar between the arms' ends."""
+    return BowTool.from_spec(tool).segments()
 
 
 @dataclass(frozen=True)

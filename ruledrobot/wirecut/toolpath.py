@@ -28,6 +28,7 @@ from numpy.typing import ArrayLike
 from ..geometry import se3
 from ..geometry._arrays import FloatArray
 from ..geometry.box import Box
+from ..sim.scene import BowTool
 from .job import ToolSpec
 
 __all__ = [
@@ -41,22 +42,15 @@ __all__ = [
 
 
 def wire_frame(tool: ToolSpec) -> FloatArray:
-    """The wire frame W (4, 4) in the flange frame (see the module doc).
-
-    x is the component of the wire midpoint normal to the wire (flange -> wire);
-    when the wire passes through the flange axis, the flange z axis is used.
-    """
-    z = tool.wire_end - tool.wire_start
-    z = z / np.linalg.norm(z)
-    mid = 0.5 * (tool.wire_start + tool.wire_end)
-    x = mid - (mid @ z) * z
-    if np.linalg.norm(x) < 1e-9:
-        x = np.array([0.0, 0.0, 1.0]) - z[2] * z
-        if np.linalg.norm(x) < 1e-9:
-            x = np.array([1.0, 0.0, 0.0]) - z[0] * z
-    x = x / np.linalg.norm(x)
+    """The wire frame W (4, 4) in the flange frame (see the module doc): origin at the
+    wire midpoint, z along the wire, x the bow's depth direction
+    (:meth:`ruledrobot.sim.BowTool.depth_direction`)."""
+    bow = BowTool.from_spec(tool)
+    z = (bow.wire_end - bow.wire_start) / bow.wire_length
+    x = bow.depth_direction()
     W = np.eye(4)
-    W[:3, 0], W[:3, 1], W[:3, 2], W[:3, 3] = x, np.cross(z, x), z, mid
+    W[:3, 0], W[:3, 1], W[:3, 2] = x, np.cross(z, x), z
+    W[:3, 3] = 0.5 * (bow.wire_start + bow.wire_end)
     return W
 
 

@@ -1,0 +1,695 @@
+"""MJCF generation: robot arms from their DH tables, and the chain of a line sequence.
+
+:func:`robot_mjcf` writes a MuJoCo model of any :class:`~ruledrobot.robot.RobotModel`
+(the UR catalogue or a custom DH arm) from its DH table and inertial data,
+with primitive geometry only (cylinders and capsules, no meshes).
+:func:`chain_mjcf` writes the serial chain whose joint axes are a given
+sequence of lines (the paper's view of a discrete ruled surface as a robot).
+
+Frames and names of the robot model (see ``docs/sim.md``):
+
+* body ``base`` sits at ``model.base`` in the world; its frame is DH frame 0;
+* body ``link{i}`` (i = 1..J) carries hinge ``joint{i}`` about its local z
+  axis through its origin; at ``q = 0`` its frame is DH frame i-1 turned by
+  ``theta_offset_i`` about z, so it moves with ``Rz(q_i)`` exactly as the DH
+  link ``A_i = Rz(q_i + theta_offset_i) Tz(d_i) Tx(a_i) Rx(alpha_i)``;
+* site ``flange`` = DH frame J (UR ``tool0``), site ``tcp`` = flange @ ``model.tool``;
+* actuators ``pos{i}``, ``vel{i}``, ``ff{i}`` (control vector
+  ``[q_ref (J), qd_ref (J), tau_ff (J)]``): a position servo, a velocity servo
+  and a torque feed-forward on each joint, summed and clamped to the torque
+  limit by the joint's ``actuatorfrcrange``; gravity is compensated by the
+  actuators (``gravcomp`` on every moving body, ``actuatorgravcomp`` on every
+  joint), so it counts against the torque limit too;
+* sensors ``torque{i}`` (``jointactuatorfrc``: servo + feed-forward + gravity
+  compensation, the joint torque), ``tcp_pos``, ``tcp_quat``.
+
+The compiled model's kinematics equal ``model.fk`` to rounding (tested to 1e-9).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from ..geometry._arrays import FloatArray
+from ..io.atomic import atomic_write_text
+from ..robot.model import RobotModel
+from ._xml import placed, sub, to_string
+
+__all__ = [
+    "COMMITTED_MODELS",
+    "EXAMPLE_SCENE_FILE",
+    "MODELS_DIR",
+    "ServoGains",
+    "chain_mjcf",
+    "default_armature",
+    "default_damping",
+    "link_radii",
+    "physics_timestep",
+    "robot_mjcf",
+    "write_chain",
+    "write_models",
+]
+
+#: Folder of the committed, generated models (``models/`` at the repository root).
+MODELS_DIR = Path(__file__).resolve().parents[2] / "models"
+#: Catalogue models written by :func:`write_models`.
+COMMITTED_MODELS: tuple[str, ...] = ("ur5e", "ur10e")
+#: File name of the committed example work cell.
+EXAMPLE_SCENE_FILE = "ur5e_hotwire_cell.xml"
+
+#: Largest physics step [s]: the e-Series servo period.  Slower controllers
+#: (CB3, 8 ms) are simulated with substeps of at most this size.
+MAX_TIMESTEP = 0.002
+
+# colours (UR-like: light grey links, blue joint caps, dark base)
+_RGBA = {
+    "link": "0.78 0.80 0.82 1",
+    "joint": "0.25 0.50 0.72 1",
+    "base": "0.22 0.23 0.25 1",
+    "flange": "0.45 0.47 0.50 1",
+}
+
+
+# ---------------------------------------------------------------------------------------
+# parameters shared by the MJCF writer, the playback and the inverse dynamics
+# ---------------------------------------------------------------------------------------
+
+
+def physics_timestep(control_period: float) -> float:
+    """MuJoCo timestep [s] for a controller period [s].
+
+    The control period itself when it is at most 2 ms (e-Series: the physics
+    steps at the 500 Hz servo rate, one reference sample per step); otherwise
+    the period divided into the fewest equal substeps of at most 2 ms (CB3:
+    8 ms -> 4 x 2 ms), because the stiff joint servos need a 2 ms step to be
+    integrated accurately.
+    """
+    period = float(control_period)
+    if not period > 0.0:
+        raise ValueError(f"control_period: must be positive, got {period}")
+    n = max(1, math.ceil(period / MAX_TIMESTEP - 1e-9))
+    return period / n
+
+
+def link_radii(model: RobotModel) -> FloatArray:
+    """Joint-housing radius per joint [m] (J,), from the torque limits (UR-like proportions).
+
+    ``r = 0.0185 m * (tau_max / 1 N m)^(1/4)``, clipped to [0.015, 0.12] m
+    (UR5e: 0.065 m shoulder, 0.043 m wrists; UR10e: 0.079 / 0.050 m).  Arms
+    without torque limits get 4.5 % of the summed DH lengths on every joint.
+    """
+    tau = model.max_torque
+    if np.all(np.isfinite(tau)):
+        return np.clip(0.0185 * tau**0.25, 0.015, 0.12)
+    length = float(np.sum(np.abs(model.a)) + np.sum(np.abs(model.d)))
+    return np.full(model.n_joints, float(np.clip(0.045 * length, 0.01, 0.12)))
+
+
+def default_armature(model: RobotModel) -> FloatArray:
+    """Reflected rotor inertia per joint [kg m^2] (J,): ``1e-3 s^2 * tau_max``.
+
+    UR do not publish rotor inertias.  Rotor inertia times the squared gear
+    ratio grows with the drive size, i.e. with the torque limit; this rule
+    gives 0.15 kg m^2 (UR5e shoulder) and 0.028 kg m^2 (UR5e wrists), close
+    to MuJoCo Menagerie's 0.1 kg m^2.  Unlimited torque: 0.1 kg m^2.
+    """
+    tau = model.max_torque
+    return np.where(np.isfinite(tau), 1e-3 * np.where(np.isfinite(tau), tau, 0.0), 0.1)
+
+
+def default_damping(model: RobotModel) -> FloatArray:
+    """Viscous joint friction [N m s/rad] (J,): ``0.02 s * tau_max`` (UR5e 3 / 0.56).
+
+    Unknown for real UR drives; of the order of Menagerie's UR10e values
+    (10 / 5 / 2).  The inverse-dynamics feed-forward compensates it.
+    Unlimited torque: 1 N m s/rad.
+    """
+    tau = model.max_torque
+    return np.where(np.isfinite(tau), 0.02 * np.where(np.isfinite(tau), tau, 0.0), 1.0)
+
+
+@dataclass(frozen=True)
+class ServoGains:
+    """Joint servo gains: ``tau = kp (q_ref - q) + kv (qd_ref - qd) + tau_ff`` (+ gravity).
+
+    ``kp`` (J,) [N m/rad], ``kv`` (J,) [N m s/rad].  :meth:`default` scales
+    them with the drive size (the torque limit).
+    """
+
+    kp: FloatArray
+    kv: FloatArray
+
+    def __post_init__(self) -> None:
+        for name in ("kp", "kv"):
+            v = np.array(getattr(self, name), dtype=np.float64).reshape(-1)
+            if not np.all(np.isfinite(v)) or np.any(v < 0.0):
+                k = int(np.flatnonzero(~(np.isfinite(v) & (v >= 0.0)))[0])
+                raise ValueError(f"servo gains {name}[{k}]: expected a finite value >= 0")
+            v.setflags(write=False)
+            object.__setattr__(self, name, v)
+        if self.kp.shape != self.kv.shape:
+            raise ValueError(f"servo gains: kp {self.kp.shape} and kv {self.kv.shape} differ")
+
+    @classmethod
+    def default(cls, model: RobotModel) -> ServoGains:
+        """``kp = 100 /rad * tau_max``, ``kv = 4 s/rad * tau_max`` (UR5e: 15000 / 600 on the
+        big joints, 2800 / 112 on the wrists); unlimited torque: as for 150 N m.
+
+        With the armature of :func:`default_armature` the wrist servo has a
+        natural frequency ``sqrt(kp / armature) = 316 rad/s`` and is
+        overdamped; the physics step of 2 ms resolves it (``omega dt = 0.63``)
+        and ``implicitfast`` integrates the velocity gain implicitly.
+        """
+        tau = np.where(np.isfinite(model.max_torque), model.max_torque, 150.0)
+        return cls(kp=100.0 * tau, kv=4.0 * tau)
+
+    def for_joints(self, n: int) -> ServoGains:
+        """Broadcast scalar gains to n joints (ValueError on a length mismatch)."""
+        try:
+            kp = np.broadcast_to(self.kp, (n,)).copy()
+            kv = np.broadcast_to(self.kv, (n,)).copy()
+        except ValueError:
+            raise ValueError(
+                f"servo gains: expected 1 or {n} values, "
+                f"got {self.kp.size} (kp), {self.kv.size} (kv)"
+            ) from None
+        return ServoGains(kp, kv)
+
+
+def _per_joint(value: ArrayLike | None, default: FloatArray, name: str) -> FloatArray:
+    if value is None:
+        return default
+    try:
+        v = np.broadcast_to(np.asarray(value, dtype=np.float64), default.shape).copy()
+    except ValueError:
+        raise ValueError(f"{name}: expected a scalar or {default.shape[0]} values") from None
+    if not np.all(np.isfinite(v)) or np.any(v < 0.0):
+        k = int(np.flatnonzero(~(np.isfinite(v) & (v >= 0.0)))[0])
+        raise ValueError(f"{name}[{k}]: expected a finite value >= 0, got {v[k]!r}")
+    return v
+
+
+# ---------------------------------------------------------------------------------------
+# robot geometry
+# ---------------------------------------------------------------------------------------
+
+
+def _rz(angle: float) -> FloatArray:
+    c, s = math.cos(angle), math.sin(angle)
+    T = np.eye(4)
+    T[0, 0], T[0, 1], T[1, 0], T[1, 1] = c, -s, s, c
+    return T
+
+
+def _dh_tail(d: float, a: float, alpha: float) -> FloatArray:
+    """``Tz(d) Tx(a) Rx(alpha)`` (4, 4): from the body frame of link i to DH frame i."""
+    c, s = math.cos(alpha), math.sin(alpha)
+    # exact values at multiples of pi/2 (the UR twists), like the robot layer's FK
+    c = 0.0 if abs(c) < 1e-15 else c
+    s = 0.0 if abs(s) < 1e-15 else s
+    T = np.eye(4)
+    T[1, 1], T[1, 2], T[2, 1], T[2, 2] = c, -s, s, c
+    T[0, 3], T[2, 3] = a, d
+    return T
+
+
+def _cylinder_inertia(mass: float, radius: float, length: float, axis: int) -> FloatArray:
+    """Diagonal inertia (3,) of a solid cylinder about its centre, axis along ``axis``."""
+    axial = 0.5 * mass * radius**2
+    trans = mass * (3.0 * radius**2 + length**2) / 12.0
+    out = np.full(3, trans)
+    out[axis] = axial
+    return out
+
+
+@dataclass(frozen=True)
+class _Segment:
+    kind: str  # "capsule" | "cylinder"
+    a: FloatArray
+    b: FloatArray
+    radius: float
+    rgba: str
+
+
+def _link_geometry(model: RobotModel, radii: FloatArray) -> tuple[list[list[_Segment]], float]:
+    """Primitive geometry per link body (in the body frame) and the base height [m].
+
+    Each body gets a joint housing (cylinder along its z axis) and tubes
+    along its DH path ``origin -> Tz(d) -> Tx(a)``.  UR-structure arms get
+    the real arm's side offset: the upper arm runs at ``z = d2 + d3 + d4`` along
+    the shoulder axis (as on the real UR, where the DH plane holds the
+    forearm), and the shoulder and elbow housings span that offset.
+    """
+    n = model.n_joints
+    ur = model.has_analytic_ik
+    shoulder = float(model.d[1] + model.d[2] + model.d[3]) if ur else 0.0
+    d1 = float(model.d[0])
+    base_h = max(0.02, 0.5 * abs(d1))
+    out: list[list[_Segment]] = []
+    for k in range(n):
+        r = float(radii[k])
+        tube = 0.8 * r
+        d, a = float(model.d[k]), float(model.a[k])
+        segs: list[_Segment] = []
+        z0, z1 = -0.9 * r, 0.9 * r
+        if ur and k in (1, 2):
+            z0, z1 = min(0.0, shoulder) - 0.9 * r, max(0.0, shoulder) + 0.9 * r
+        if k == 0:
+            # the column above the base; its housing is the base's top
+            top = math.copysign(base_h + 0.002, d1) if d1 != 0.0 else 0.0
+            if abs(d1) > abs(top) + 0.004:
+                segs.append(
+                    _Segment(
+                        "cylinder", np.array([0, 0, top]), np.array([0, 0, d1]), r, _RGBA["link"]
+                    )
+                )
+        else:
+            segs.append(
+                _Segment("cylinder", np.array([0, 0, z0]), np.array([0, 0, z1]), r, _RGBA["joint"])
+            )
+            if abs(d) > 1e-9:
+                kind = "cylinder" if k == n - 1 else "capsule"
+                segs.append(
+                    _Segment(
+                        kind,
+                        np.zeros(3),
+                        np.array([0, 0, d]),
+                        r if k == n - 1 else tube,
+                        _RGBA["link"],
+                    )
+                )
+        if abs(a) > 1e-9:
+            z = shoulder if (ur and k == 1) else d
+            segs.append(
+                _Segment("capsule", np.array([0, 0, z]), np.array([a, 0, z]), tube, _RGBA["link"])
+            )
+        out.append(segs)
+    return out, base_h
+
+
+def _link_inertial(model: RobotModel, k: int, radius: float) -> tuple[FloatArray, FloatArray]:
+    """COM (3,) in the body frame and diagonal inertia (3,) of link k (0-based).
+
+    UR publish masses and COMs but (except UR20/UR30) no inertia tensors; the
+    inertia is that of a solid cylinder of the link's mass, with the tube's
+    radius (0.8 x housing radius), along the link's longer DH offset
+    (``a`` along x, else ``d`` along z) and at least 2 radii long, taken
+    about the published COM with its axes along the body frame -- the same
+    approximation as the cylinders of UR's ROS description.
+    """
+    d, a, alpha = float(model.d[k]), float(model.a[k]), float(model.alpha[k])
+    tail = _dh_tail(d, a, alpha)
+    com = tail[:3, :3] @ model.link_com[k] + tail[:3, 3]
+    tube = 0.8 * radius
+    if abs(a) >= abs(d) and abs(a) > 0.0:
+        axis, length = 0, abs(a)
+    else:
+        axis, length = 2, abs(d)
+    length = max(length, 2.0 * tube)
+    return com, _cylinder_inertia(float(model.link_mass[k]), tube, length, axis)
+
+
+def _add_segment(body: ET.Element, name: str, seg: _Segment, **attrs: object) -> None:
+    sub(
+        body,
+        "geom",
+        name=name,
+        type=seg.kind,
+        size=seg.radius,
+        fromto=np.concatenate([seg.a, seg.b]),
+        rgba=seg.rgba,
+        **attrs,
+    )  # type: ignore[arg-type]
+
+
+# ---------------------------------------------------------------------------------------
+# the robot writer (shared with the scene builder)
+# ---------------------------------------------------------------------------------------
+
+
+@dataclass
+class _RobotTree:
+    root: ET.Element
+    worldbody: ET.Element
+    last_body: ET.Element
+    contact: ET.Element
+    actuator: ET.Element
+    sensor: ET.Element
+    link_names: list[str]
+    flange: FloatArray  # DH frame J in the last link body's frame
+
+
+def _build_robot(
+    model: RobotModel,
+    *,
+    gains: ServoGains | None,
+    armature: ArrayLike | None,
+    damping: ArrayLike | None,
+    timestep: float | None,
+    collisions: bool,
+    payload: bool,
+    keyframe: bool,
+    comment_model: str,
+    conaffinity: int = 1,
+) -> _RobotTree:
+    n = model.n_joints
+    g = (gains or ServoGains.default(model)).for_joints(n)
+    arm = _per_joint(armature, default_armature(model), "armature")
+    damp = _per_joint(damping, default_damping(model), "damping")
+    dt = physics_timestep(model.control_period) if timestep is None else float(timestep)
+    if not dt > 0.0:
+        raise ValueError(f"timestep: must be positive, got {dt}")
+    radii = link_radii(model)
+    geometry, base_h = _link_geometry(model, radii)
+
+    root = ET.Element("mujoco", model=comment_model)
+    sub(root, "compiler", angle="radian", autolimits="true", inertiafromgeom="auto")
+    sub(root, "option", timestep=dt, integrator="implicitfast")
+    visual = sub(root, "visual")
+    sub(visual, "quality", offsamples=0)
+    sub(visual, "map", znear=0.01)
+    default = sub(root, "default")
+    geom_default = (
+        {"contype": 1, "conaffinity": conaffinity}
+        if collisions
+        else {"contype": 0, "conaffinity": 0}
+    )
+    sub(default, "geom", condim=3, **geom_default)  # type: ignore[arg-type]
+    worldbody = sub(root, "worldbody")
+    base = placed(worldbody, "body", model.base, name="base")
+    z_base = (0.0, base_h) if model.d[0] >= 0.0 else (-base_h, 0.0)
+    sub(
+        base,
+        "geom",
+        name="base",
+        type="cylinder",
+        size=1.15 * float(radii[0]),
+        fromto=[0.0, 0.0, z_base[0], 0.0, 0.0, z_base[1]],
+        rgba=_RGBA["base"],
+    )
+
+    parent = base
+    parent_tail = np.eye(4)  # pose of DH frame i-1 in the parent body's frame
+    names = ["base"]
+    for k in range(n):
+        name = f"link{k + 1}"
+        body = placed(
+            parent, "body", parent_tail @ _rz(float(model.theta_offset[k])), name=name, gravcomp=1
+        )
+        com, inertia = _link_inertial(model, k, float(radii[k]))
+        if model.link_mass[k] > 0.0:
+            sub(body, "inertial", pos=com, mass=float(model.link_mass[k]), diaginertia=inertia)
+        lo, hi = float(model.lower[k]), float(model.upper[k])
+        limited = bool(np.isfinite(lo) and np.isfinite(hi))
+        tau = float(model.max_torque[k])
+        sub(
+            body,
+            "joint",
+            name=f"joint{k + 1}",
+            type="hinge",
+            axis="0 0 1",
+            limited=limited,
+            range=[lo, hi] if limited else None,
+            armature=float(arm[k]),
+            damping=float(damp[k]),
+            actuatorgravcomp=True,
+            actuatorfrclimited=bool(np.isfinite(tau)),
+            actuatorfrcrange=[-tau, tau] if np.isfinite(tau) else None,
+        )
+        for j, seg in enumerate(geometry[k]):
+            _add_segment(body, f"{name}_g{j}", seg)
+        names.append(name)
+        parent = body
+        parent_tail = _dh_tail(float(model.d[k]), float(model.a[k]), float(model.alpha[k]))
+
+    flange = parent_tail
+    placed(parent, "site", flange, name="flange", size=0.01, rgba="0.1 0.1 0.1 0.3")
+    placed(parent, "site", flange @ model.tool, name="tcp", size=0.008, rgba="0.9 0.1 0.1 0.5")
+    if payload and model.tool_mass > 0.0:
+        tool = placed(parent, "body", flange, name="payload", gravcomp=1)
+        r = 0.05  # the payload as a 5 cm sphere about its COM
+        sub(
+            tool,
+            "inertial",
+            pos=model.tool_com,
+            mass=model.tool_mass,
+            diaginertia=np.full(3, 0.4 * model.tool_mass * r * r),
+        )
+
+    contact = sub(root, "contact")
+    ur = model.has_analytic_ik
+    # base-link1: the base is welded to the world, so MuJoCo's parent filter skips it
+    pairs = (
+        [(0, 1), (0, 2), (3, 5), (4, 6)] if ur else [(0, 1)] + [(i, i + 2) for i in range(n - 1)]
+    )
+    for i, j in pairs:
+        if j <= n:
+            sub(contact, "exclude", body1=names[i], body2=names[j])
+
+    actuator = sub(root, "actuator")
+    for k in range(n):
+        sub(actuator, "position", name=f"pos{k + 1}", joint=f"joint{k + 1}", kp=float(g.kp[k]))
+    for k in range(n):
+        sub(actuator, "velocity", name=f"vel{k + 1}", joint=f"joint{k + 1}", kv=float(g.kv[k]))
+    for k in range(n):
+        sub(actuator, "motor", name=f"ff{k + 1}", joint=f"joint{k + 1}")
+    sensor = sub(root, "sensor")
+    for k in range(n):
+        sub(sensor, "jointactuatorfrc", name=f"torque{k + 1}", joint=f"joint{k + 1}")
+    sub(sensor, "framepos", name="tcp_pos", objtype="site", objname="tcp")
+    sub(sensor, "framequat", name="tcp_quat", objtype="site", objname="tcp")
+    if keyframe:
+        home = _home(model)
+        keyf = sub(root, "keyframe")
+        sub(keyf, "key", name="home", qpos=home, ctrl=np.concatenate([home, np.zeros(2 * n)]))
+    return _RobotTree(root, worldbody, parent, contact, actuator, sensor, names, flange)
+
+
+def _home(model: RobotModel) -> FloatArray:
+    """A keyframe posture: the UR "home" (elbow up, wrist down) within limits, else zeros."""
+    n = model.n_joints
+    if model.has_analytic_ik:
+        q = np.array([0.0, -np.pi / 2, np.pi / 2, -np.pi / 2, -np.pi / 2, 0.0])
+    else:
+        q = np.zeros(n)
+    return np.clip(q, model.lower, model.upper)
+
+
+def robot_mjcf(
+    model: RobotModel,
+    *,
+    gains: ServoGains | None = None,
+    armature: ArrayLike | None = None,
+    damping: ArrayLike | None = None,
+    timestep: float | None = None,
+    collisions: bool = True,
+    keyframe: bool = True,
+) -> str:
+    """MJCF text of a robot arm built from its DH table and inertial data.
+
+    Parameters
+    ----------
+    model : any :class:`~ruledrobot.robot.RobotModel` (catalogue or ``from_dh``).
+        ``model.base`` places the base body in the world; ``model.tool`` is
+        the ``tcp`` site in the flange frame; a ``tool_mass`` > 0 adds a
+        ``payload`` body (mass at ``tool_com``, flange frame).
+    gains : joint servo gains; default :meth:`ServoGains.default`.
+    armature, damping : (J,) or scalar, kg m^2 and N m s/rad; defaults
+        :func:`default_armature`, :func:`default_damping`.
+    timestep : physics step [s]; default :func:`physics_timestep` of the
+        model's control period (2 ms on every catalogue arm).
+    collisions : geoms collide (``contype = conaffinity = 1``; the joint
+        neighbours, base-link1 and, on UR arms, the pairs base-link2,
+        link3-link5, link4-link6 that the real arm cannot bring together are
+        excluded; other arms exclude every link i, i+2 pair);
+        ``False`` makes every geom visual only.
+    keyframe : add the keyframe ``home`` (UR: ``[0, -pi/2, pi/2, -pi/2, -pi/2, 0]``).
+
+    Joint limits are the model's (an infinite limit, UR3/UR3e wrist 3, makes
+    the joint unlimited); joint torque limits are ``actuatorfrcrange``.  Angles
+    are radians (``<compiler angle="radian">``), integrator ``implicitfast``.
+    """
+    if not isinstance(model, RobotModel):
+        raise ValueError(f"model: expected a RobotModel, got {type(model).__name__}")
+    tree = _build_robot(
+        model,
+        gains=gains,
+        armature=armature,
+        damping=damping,
+        timestep=timestep,
+        collisions=collisions,
+        payload=True,
+        keyframe=keyframe,
+        comment_model=model.name,
+    )
+    comment = (
+        f"{model.name}: generated by ruledrobot.sim.mjcf.robot_mjcf from the DH table "
+        "and inertial data of the robot catalogue; do not edit, regenerate with "
+        "ruledrobot.sim.write_models()"
+    )
+    return to_string(tree.root, comment)
+
+
+def write_models(
+    folder: str | os.PathLike[str] | None = None, names: tuple[str, ...] = COMMITTED_MODELS
+) -> list[Path]:
+    """Write the generated models into ``folder`` (default the repository's ``models/``).
+
+    ``<name>.xml`` for each catalogue model in ``names`` (default UR5e and
+    UR10e) and the example work cell ``ur5e_hotwire_cell.xml``
+    (:func:`ruledrobot.sim.scene.example_scene`), atomically; returns the
+    paths.  The test suite checks that the committed files equal this output.
+    """
+    from ..robot import load
+    from .scene import example_scene
+
+    out = Path(folder) if folder is not None else MODELS_DIR
+    paths = [atomic_write_text(out / f"{name}.xml", robot_mjcf(load(name))) for name in names]
+    paths.append(atomic_write_text(out / EXAMPLE_SCENE_FILE, example_scene().mjcf()))
+    return paths
+
+
+# ---------------------------------------------------------------------------------------
+# the line chain
+# ---------------------------------------------------------------------------------------
+
+
+def chain_mjcf(
+    lines_or_surface: object,
+    *,
+    closed: bool | None = None,
+    radius: float | None = None,
+    axis_length: float | None = None,
+    actuators: bool = True,
+) -> str:
+    """MJCF text of the serial chain whose joint axes are the given lines.
+
+    ``lines_or_surface`` is a :class:`~ruledrobot.geometry.ruled.RuledSurface`,
+    a :class:`~ruledrobot.Lines` or Plücker rows (N, 6) (``closed`` applies
+    to the last two).  Body ``axis{i}`` (i = 0..N-1) sits at DH frame i of
+    ``RuledSurface.dh_frames()`` and carries hinge ``joint{i}`` about its z
+    axis, the line i; the child body is placed by DH row i of
+    ``dh_parameters()``, ``Trans_x(a) Rot_x(alpha) Rot_z(theta) Trans_z(d)``
+    (Craig's ordering).  So at ``q = 0`` the joint axes (``mjData.xaxis``,
+    ``xanchor``) are the input lines, oriented as they are.  A closed surface
+    ends in a site ``end`` at its closing frame (frame 0, turned by pi about x
+    after a flip); an open one in a site ``end`` at the last frame.
+
+    Geometry: a cylinder along each joint axis (``axis_length``, default 1.5 x
+    the median spacing, at least 4 radii) and capsules along the common
+    normals and joint offsets; ``radius`` defaults to 1.5 % of the chain's
+    size.  No gravity; ``actuators`` adds a position servo per joint, so the
+    chain can be posed from a viewer.  Masses come from the geoms (density
+    1000 kg/m^3).
+    """
+    from ..geometry.lines import Lines
+    from ..geometry.ruled import RuledSurface, dh_transform
+
+    if isinstance(lines_or_surface, RuledSurface):
+        surf = lines_or_surface
+        if closed is not None and bool(closed) != surf.closed:
+            raise ValueError(f"closed={closed} contradicts the surface (closed={surf.closed})")
+    else:
+        lines = (
+            lines_or_surface
+            if isinstance(lines_or_surface, Lines)
+            else Lines.from_plucker(np.asarray(lines_or_surface, dtype=np.float64))
+        )
+        surf = RuledSurface(lines, closed=bool(closed))
+    T = surf.dh_frames()
+    rows = surf.dh_parameters()
+    n = T.shape[0]
+    rel = dh_transform(rows[:, 0], rows[:, 1], rows[:, 2], rows[:, 3])  # (P, 4, 4)
+    origins = T[:, :3, 3]
+    size = float(np.linalg.norm(np.ptp(origins, axis=0))) if n > 1 else 1.0
+    spacing = np.concatenate([rows[:, 2], np.abs(rows[:, 1])])
+    step = float(np.median(spacing[spacing > 1e-9])) if np.any(spacing > 1e-9) else size / n
+    r = float(radius) if radius is not None else max(0.015 * max(size, step), 1e-4)
+    if not r > 0.0:
+        raise ValueError(f"radius: must be positive, got {radius}")
+    half = 0.5 * (float(axis_length) if axis_length is not None else max(1.5 * step, 4 * r))
+    if not half > 0.0:
+        raise ValueError(f"axis_length: must be positive, got {axis_length}")
+
+    root = ET.Element("mujoco", model="line_chain")
+    sub(root, "compiler", angle="radian", autolimits="true", inertiafromgeom="true")
+    sub(root, "option", timestep=0.002, integrator="implicitfast", gravity="0 0 0")
+    visual = sub(root, "visual")
+    sub(visual, "quality", offsamples=0)
+    sub(visual, "map", znear=0.001)
+    default = sub(root, "default")
+    sub(default, "geom", contype=0, conaffinity=0, density=1000)
+    sub(
+        default, "joint", type="hinge", axis="0 0 1", limited=False, damping=0.01 * r, armature=1e-4
+    )
+    worldbody = sub(root, "worldbody")
+    top = [*origins.mean(axis=0)[:2], origins[:, 2].max() + 3 * size + 1]
+    sub(worldbody, "light", name="top", pos=top, dir="0 0 -1", directional=True, castshadow=False)
+    parent = worldbody
+    pose = T[0]
+    for i in range(n):
+        body = placed(parent, "body", pose, name=f"axis{i}")
+        sub(body, "joint", name=f"joint{i}")
+        sub(body, "geom", name=f"axis{i}", type="cylinder", size=[r, half], rgba="0.25 0.50 0.72 1")
+        if i < rel.shape[0]:
+            nxt = rel[i]
+            foot = np.array([float(rows[i, 2]), 0.0, 0.0])
+            if rows[i, 2] > 1e-9:
+                sub(
+                    body,
+                    "geom",
+                    name=f"normal{i}",
+                    type="capsule",
+                    size=0.5 * r,
+                    fromto=np.concatenate([np.zeros(3), foot]),
+                    rgba="0.78 0.80 0.82 1",
+                )
+            if abs(rows[i, 1]) > 1e-9:
+                sub(
+                    body,
+                    "geom",
+                    name=f"offset{i}",
+                    type="capsule",
+                    size=0.5 * r,
+                    fromto=np.concatenate([foot, nxt[:3, 3]]),
+                    rgba="0.78 0.80 0.82 1",
+                )
+        if i == n - 1:
+            # closed: the closing row leads to frame 0 (turned by pi about x after a flip)
+            end = rel[i] if surf.closed else np.eye(4)
+            placed(body, "site", end, name="end", size=1.5 * r, rgba="0.9 0.1 0.1 1")
+        parent = body
+        if i < n - 1:
+            pose = rel[i]
+    if actuators:
+        act = sub(root, "actuator")
+        for i in range(n):
+            sub(act, "position", name=f"pos{i}", joint=f"joint{i}", kp=1.0, kv=0.1)
+    return to_string(root, f"serial chain of {n} lines (ruledrobot.sim.mjcf.chain_mjcf)")
+
+
+def write_chain(
+    lines_path: str | os.PathLike[str], out_path: str | os.PathLike[str], **options: object
+) -> Path:
+    """Read a lines file (``.json``/``.csv``) and write its chain MJCF to ``out_path``.
+
+    The file's ``closed`` flag is used; ``options`` go to :func:`chain_mjcf`.
+    Returns the written path.  ValueError names the file on bad input.
+    """
+    from ..geometry.ruled import RuledSurface
+    from ..io.lines import read_lines_document
+
+    doc = read_lines_document(lines_path)
+    try:
+        surf = RuledSurface(doc.lines, closed=doc.closed)
+        text = chain_mjcf(surf, **options)  # type: ignore[arg-type]
+    except ValueError as exc:
+        raise ValueError(f"{lines_path}: {exc}") from None
+    return atomic_write_text(out_path, text)
