@@ -9,8 +9,8 @@
 * ``report.json`` — the numbers below; ``plots.png`` — surface and wire
   positions, joint trajectories against limits, feed speed.
 
-Time law: approach (a joint move down to the lead-in pose from 0.1 m above it,
-or from ``[robot] home``), the cut at the feed speed (lead-in, chords,
+Time law: approach (a joint move to the lead-in pose from 0.1 m further out —
+away from the stock centre — or from ``[robot] home``), the cut at the feed speed (lead-in, chords,
 lead-out; :func:`ruledrobot.wirecut.timing.time_path`), retract.  Every number
 in the report is measured on the *sampled* joints through forward kinematics.
 """
@@ -40,7 +40,7 @@ from .toolpath import speed_factor, wire_frame
 
 __all__ = ["LIFT", "PlanResult", "plan"]
 
-LIFT = 0.1  # m: approach from / retract to this far above the lead-in/out pose
+LIFT = 0.1  # m: approach from / retract to this far beyond the lead-in/out pose
 
 
 @dataclass(frozen=True)
@@ -58,10 +58,11 @@ def _wrap_near(q: FloatArray, ref: FloatArray) -> FloatArray:
     return ref + (q - ref + np.pi) % (2.0 * np.pi) - np.pi
 
 
-def _lifted(model, q: FloatArray, dz: float) -> FloatArray | None:
-    """Joints nearest ``q`` whose flange is ``dz`` higher (base z); None if unreachable."""
+def _backed_off(model, q: FloatArray, away: FloatArray, dist: float) -> FloatArray | None:
+    """Joints nearest ``q`` whose flange is ``dist`` further along ``away`` (unit, base
+    frame); None if unreachable or out of limits."""
     P = model.fk(q)
-    P[2, 3] += dz
+    P[:3, 3] += dist * away
     sols = model.ik(P)
     sols = sols[~np.isnan(sols).any(axis=1)]
     if not len(sols):
@@ -92,8 +93,16 @@ def plan(
     job: Job,
     out_dir: str | Path,
     progress: Callable[[str], None] | None = None,
+    simulate: bool = True,
+    video: bool = False,
 ) -> PlanResult:
     """Plan ``job`` and write its files into ``out_dir`` (see the module doc).
+
+    ``simulate``: play the trajectory in MuJoCo (the job's cell: arm, bow, stock,
+    table) and report, from the *simulated* joints, the wire's deviation from the
+    target rulings inside the stock, the TCP tracking error and the collisions
+    (the playback report goes to ``simulation/``).  ``video``: also render
+    ``video.mp4`` (needs an OpenGL backend: EGL or OSMesa).
 
     An infeasible job still gets ``report.json`` (``feasible: false`` and the
     reasons) and returns ``PlanResult(feasible=False)``; nothing else is written.
@@ -133,8 +142,11 @@ def plan(
     cut = time_path(s, m.q, sf, job.cut.feed_speed, vel, acc, dt)
     parts: list[TimedPath] = []
     start, end = m.q[0], m.q[-1]
-    above_start = _lifted(model, start, LIFT)
-    above_end = _lifted(model, end, LIFT)
+    mids = (m.flange @ wire_frame(job.tool))[[0, -1], :3, 3]
+    away = mids - job.stock.centre
+    away /= np.linalg.norm(away, axis=1, keepdims=True)
+    above_start = _backed_off(model, start, away[0], LIFT)
+    above_end = _backed_off(model, end, away[1], LIFT)
     slow = job.cut.approach_speed
     if job.robot.home is not None:
         home = _wrap_near(job.robot.home, start)
@@ -186,8 +198,32 @@ def plan(
     ends_w = wire_points(flange, ends_t)
     off = ends_w - target[:, None, :3, 3]
     dev = np.linalg.norm(np.cross(off, target[:, None, :3, 2]), axis=-1).max(axis=1)
+    sim_files: dict[str, Path] = {}
+    if simulate:
+        say("verifying in MuJoCo")
+        t3 = time.perf_counter()
+        from ..sim import Scene, play
+
+        scene = Scene.from_job(job, robot=model)
+        pb = play(scene, traj.t, traj.q, traj.qd)
+        sim = pb.report()
+        w_sim = wire_points(model.fk(pb.q), ends_t)
+        off_sim = w_sim - target[:, None, :3, 3]
+        dev_sim = np.linalg.norm(np.cross(off_sim, target[:, None, :3, 2]), axis=-1).max(axis=1)
+        report["max_wire_deviation_mm"] = float(dev_sim[hit_t].max() * 1e3) if hit_t.any() else 0.0
+        report["max_tcp_tracking_error_mm"] = sim["tcp_position_error_mm"]["max"]
+        report["simulation_realtime_factor"] = sim.get("realtime_factor")
+        collisions.extend(c.as_dict() for c in pb.collisions)
+        sim_files = {f"simulation_{k}": v for k, v in pb.write(out / "simulation").items()}
+        if video:
+            from ..sim import render_video
+
+            sim_files["video"] = render_video(scene, out / "video.mp4", traj.t, pb.q)
+        timings["simulation_s"] = time.perf_counter() - t3
     cut_feed = feed[hit_t]
     interior = hit_t & ~traj.feed_limited if hasattr(traj, "feed_limited") else hit_t
+    report.setdefault("max_wire_deviation_mm", None)
+    report.setdefault("max_tcp_tracking_error_mm", None)
     report.update(
         {
             "duration_s": float(traj.t[-1]),
@@ -205,8 +241,6 @@ def plan(
             "max_joint_accel_ratio": ratios["max_joint_accel_ratio"],
             "min_singularity_measure": float(model.singularity_measure(traj.q[in_cut]).min()),
             "max_planned_wire_deviation_mm": float(dev[hit_t].max() * 1e3) if hit_t.any() else 0.0,
-            "max_wire_deviation_mm": None,
-            "max_tcp_tracking_error_mm": None,
             "collisions": collisions,
             "roll_deg": float(np.degrees(m.roll[0])),
             "constant_roll": bool(np.ptp(m.roll) < 1e-12),
@@ -238,7 +272,8 @@ def plan(
     if len(mesh.faces):
         files["surface"] = write_stl(out / "surface.stl", mesh.vertices, mesh.faces)
     files["plots"] = _plots(out / "plots.png", job, cp, traj, feed, hit_t, model, flange, W)
-    timings["write_s"] = time.perf_counter() - t2
+    files.update(sim_files)
+    timings["write_s"] = time.perf_counter() - t2 - timings.get("simulation_s", 0.0)
     timings["total_s"] = time.perf_counter() - t0
     report["timings"] = timings
     files["report"] = atomic_write_text(out / "report.json", json.dumps(report, indent=1) + "\n")

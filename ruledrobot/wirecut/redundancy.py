@@ -36,6 +36,7 @@ import numpy as np
 
 from ..geometry._arrays import FloatArray
 from ..geometry.box import Box
+from ..geometry.segments import segment_distance
 from ..robot import path_ik
 from ..sim.scene import BowTool
 from .job import ToolSpec
@@ -80,6 +81,54 @@ class _Score:
     lost: dict[str, int]
 
 
+#: DH skeleton segments checked against the bow and the wire: the legs of joints 2-4
+#: (upper arm, forearm, wrist 1); the wrist 2/3 legs carry the bow's hub.
+_ARM_NEAR_BOW = slice(2, 8)
+
+
+def _clearance(model, q, P, segs, wire, stock, table_z, margin):
+    """Per configuration (...): which clearance rule it breaks (dict of bool arrays).
+
+    ``q`` (..., 6) joints, ``P`` (..., 4, 4) their flange poses, ``segs`` (3, 2, 3) the
+    bow rods and ``wire`` (2, 3) the wire in the flange frame.  Link capsules sit on
+    the DH skeleton with the MuJoCo model's housing radii (so planner and simulation
+    agree); the bow rods have the bow's arm radius.
+    """
+    from ..sim.mjcf import link_radii
+
+    shape = q.shape[:-1]
+    qf = np.nan_to_num(q.reshape(-1, q.shape[-1]))
+    Pf = P.reshape(-1, 4, 4)
+    rods = np.concatenate([segs, wire[None]], axis=0)  # (4, 2, 3)
+    w = np.einsum("nij,kej->nkei", Pf[:, :3, :3], rods) + Pf[:, None, None, :3, 3]
+    pts = model.link_points(qf)  # (n, 13, 3)
+    legs_a, legs_b = pts[:, :-1], pts[:, 1:]  # (n, 12, 3): two legs per joint
+    radius = np.repeat(link_radii(model), 2)  # (12,)
+    bow_r = BowTool.arm_radius  # the default rod radius of the simulated bow
+    out = {
+        "bow hits the stock": stock.segment_hits(w[:, :3, 0], w[:, :3, 1], margin).any(axis=1),
+        "arm hits the stock": np.zeros(len(qf), bool),
+        "bow or wire hits the arm": np.zeros(len(qf), bool),
+        "bow below the table": np.zeros(len(qf), bool),
+        "arm below the table": np.zeros(len(qf), bool),
+    }
+    for k in range(legs_a.shape[1]):
+        out["arm hits the stock"] |= stock.segment_hits(
+            legs_a[:, k], legs_b[:, k], margin + radius[k]
+        )
+    near = range(12)[_ARM_NEAR_BOW]
+    for k in near:
+        dist = segment_distance(legs_a[:, k, None], legs_b[:, k, None], w[:, :, 0], w[:, :, 1])
+        out["bow or wire hits the arm"] |= (dist < radius[k] + bow_r + margin).any(axis=1)
+    if table_z is not None:
+        out["bow below the table"] = (w[:, :3, :, 2] < table_z + margin).any(axis=(1, 2))
+        # skeleton points from the shoulder on (the base stands on the table); a
+        # straight leg is lowest at an end point
+        r_pt = np.r_[0.0, radius][2:]
+        out["arm below the table"] = (pts[:, 2:, 2] - r_pt < table_z + margin).any(axis=1)
+    return {key: v.reshape(shape) for key, v in out.items()}
+
+
 def _evaluate(
     model,
     frames,
@@ -94,21 +143,20 @@ def _evaluate(
     singular_min,
     jump_threshold,
     q_start=None,
+    wire=None,
 ):
     """Flange poses, path IK and checks for one candidate on the given rulings."""
     P = flange_poses(wire_poses(frames, roll, slide, reverse), W)
     ik = path_ik(model, P, q_start=q_start, jump_threshold=jump_threshold)
-    # bow segments in the base frame
-    R, t = P[:, None, None, :3, :3], P[:, None, None, :3, 3]
-    seg = np.einsum("mkeij,kej->mkei", np.broadcast_to(R, (len(P), 3, 2, 3, 3)), segs) + t
-    bow_in_stock = stock.segment_hits(seg[:, :, 0], seg[:, :, 1], margin).any(axis=1)
-    bow_low = (seg[..., 2] < table_z + margin).any(axis=(1, 2))
+    if wire is None:
+        half = 0.5 * np.linalg.norm(segs[1, 0] - segs[0, 0])
+        wire = np.array([W[:3, 3] - half * W[:3, 2], W[:3, 3] + half * W[:3, 2]])
+    checks = _clearance(model, ik.q, P, segs, wire, stock, table_z, margin)
     singular = ik.measure < singular_min
     lost = {
         "no continuous IK solution": int((~ik.ok).sum()),
         "near a singularity": int((ik.ok & singular).sum()),
-        "bow hits the stock": int(bow_in_stock.sum()),
-        "bow below the table": int(bow_low.sum()),
+        **{key: int((ik.ok & v).sum()) for key, v in checks.items()},
     }
     ok = all(v == 0 for v in lost.values())
     return P, ik, ok, lost
@@ -181,32 +229,43 @@ def solve_redundancy(
     idx = np.unique(np.r_[np.linspace(0, m - 1, min(sample, m)).round().astype(int)])
     stride = max(1.0, (m - 1) / max(1, idx.size - 1))
     grid = np.linspace(-np.pi, np.pi, rolls, endpoint=False)
-    scores: list[_Score] = []
-    for reverse in (False, True):
-        for psi in grid:
-            _, ik, ok_c, lost = _evaluate(
-                model,
-                F[idx],
-                np.full(idx.size, psi),
-                slide[idx],
-                reverse,
-                W,
-                segs,
-                stock,
-                table_z,
-                margin,
-                singular_min,
-                jump_threshold * stride,
-                q_start,
-            )
-            travel = float(np.abs(np.diff(ik.q, axis=0)).sum()) if ik.q.size else np.inf
-            scores.append(
-                _Score(float(psi), reverse, ok_c, travel, float(np.min(ik.measure)), lost)
-            )
-    # feasible first, then least joint travel, then best conditioned
+
+    def score(psi: float, reverse: bool) -> _Score:
+        _, ik, ok_c, lost = _evaluate(
+            model,
+            F[idx],
+            np.full(idx.size, psi),
+            slide[idx],
+            reverse,
+            W,
+            segs,
+            stock,
+            table_z,
+            margin,
+            singular_min,
+            jump_threshold * stride,
+            q_start,
+        )
+        travel = float(np.abs(np.diff(ik.q, axis=0)).sum()) if ik.q.size else np.inf
+        return _Score(float(psi), reverse, ok_c, travel, float(np.min(ik.measure)), lost)
+
+    scores = [score(psi, rev) for rev in (False, True) for psi in grid]
+    # refine the roll around the candidates that lose the fewest rulings
+    step = 2.0 * np.pi / rolls
+    if not any(sc.ok for sc in scores):
+        best = sorted(scores, key=lambda sc: sum(sc.lost.values()))[:3]
+        for sc in best:
+            for frac in (-0.75, -0.5, -0.25, 0.25, 0.5, 0.75):
+                scores.append(score(sc.roll + frac * step, sc.reverse))
+    # feasible first, then fewest lost rulings, least joint travel, best conditioned
     order = sorted(
         range(len(scores)),
-        key=lambda k: (not scores[k].ok, scores[k].travel, -scores[k].min_measure),
+        key=lambda k: (
+            not scores[k].ok,
+            sum(scores[k].lost.values()),
+            scores[k].travel,
+            -scores[k].min_measure,
+        ),
     )
     tried = 0
     for k in order[:12] if strategy != "varying" else []:
@@ -215,7 +274,7 @@ def solve_redundancy(
             break
         tried += 1
         roll = np.full(m, sc.roll)
-        P, ik, ok_c, lost = _evaluate(
+        P, ik, ok_c, _ = _evaluate(
             model,
             F,
             roll,
@@ -247,7 +306,7 @@ def solve_redundancy(
                 tuple(reasons),
             )
     for reverse in (False, True) if strategy != "constant" else ():
-        roll = _ladder_roll(
+        found = _ladder_roll(
             model,
             F,
             slide,
@@ -258,28 +317,27 @@ def solve_redundancy(
             table_z,
             margin,
             singular_min,
-            grid,
+            np.linspace(-np.pi, np.pi, 2 * rolls, endpoint=False),
             idx,
             jump_threshold * stride,
         )
-        if roll is None:
+        if found is None:
             continue
-        P, ik, ok_c, lost = _evaluate(
-            model,
-            F,
-            roll,
-            slide,
-            reverse,
-            W,
-            segs,
-            stock,
-            table_z,
-            margin,
-            singular_min,
-            jump_threshold,
-            q_start,
-        )
-        if ok_c:
+        roll, branch = found
+        P = flange_poses(wire_poses(F, roll, slide, reverse), W)
+        q = _follow_branch(model, P, branch, q_start)
+        if q is None:
+            continue
+        half = 0.5 * np.linalg.norm(segs[1, 0] - segs[0, 0])
+        wire = np.array([W[:3, 3] - half * W[:3, 2], W[:3, 3] + half * W[:3, 2]])
+        checks = _clearance(model, q, P, segs, wire, stock, table_z, margin)
+        measure = model.singularity_measure(q)
+        step = float(np.abs(np.diff(q, axis=0)).max()) if m > 1 else 0.0
+        if (
+            step <= jump_threshold
+            and measure.min() >= singular_min
+            and not any(v.any() for v in checks.values())
+        ):
             reasons.append("no constant roll works: the roll varies along the cut")
             return RedundancyResult(
                 True,
@@ -287,11 +345,11 @@ def solve_redundancy(
                 slide,
                 reverse,
                 P,
-                ik.q,
+                q,
                 np.c_[c0, c1],
                 hit,
-                float(ik.measure.min()),
-                float(ik.max_step),
+                float(measure.min()),
+                step,
                 constant,
                 len(scores),
                 tuple(reasons),
@@ -338,9 +396,10 @@ def _ladder_roll(
     idx: np.ndarray,
     jump: float,
     roll_weight: float = 0.5,
-) -> FloatArray | None:
-    """Roll per ruling (M,) from a Viterbi pass over (roll x branch) nodes at the sampled
-    rulings ``idx``, smoothed and interpolated to every ruling; None when no path exists."""
+) -> tuple[FloatArray, np.ndarray] | None:
+    """Roll (M,) and IK branch (M,) per ruling from a Viterbi pass over (roll x branch)
+    nodes at the sampled rulings ``idx`` (roll smoothed and interpolated, branch of the
+    nearest sample); None when no path exists."""
     n, k = idx.size, grid.size
     Fs = F[idx]
     psi = np.broadcast_to(grid, (n, k))
@@ -351,12 +410,11 @@ def _ladder_roll(
     valid = ~np.isnan(q).any(axis=-1)
     meas = np.where(valid, model.singularity_measure(np.nan_to_num(q)), 0.0)
     valid &= meas >= singular_min
-    R, t = P[:, :, None, None, :3, :3], P[:, :, None, None, :3, 3]
-    seg = np.einsum("nkseij,sej->nksei", np.broadcast_to(R, (n, k, 3, 2, 3, 3)), segs) + t
-    clear = ~stock.segment_hits(seg[..., 0, :], seg[..., 1, :], margin).any(axis=-1)
-    if table_z is not None:
-        clear &= ~(seg[..., 2] < table_z + margin).any(axis=(-1, -2))
-    valid &= clear[:, :, None]
+    half = 0.5 * np.linalg.norm(segs[1, 0] - segs[0, 0])
+    wire = np.array([W[:3, 3] - half * W[:3, 2], W[:3, 3] + half * W[:3, 2]])
+    P8 = np.broadcast_to(P[:, :, None], (n, k, 8, 4, 4))
+    for bad in _clearance(model, q, P8, segs, wire, stock, table_z, margin).values():
+        valid &= ~bad
     qn = np.nan_to_num(q).reshape(n, k * 8, 6)
     node_ok = valid.reshape(n, k * 8)
     roll_of = np.repeat(grid, 8)
@@ -387,4 +445,31 @@ def _ladder_roll(
     if n >= 3:
         pad = np.r_[roll_s[0], roll_s, roll_s[-1]]
         roll_s = (pad[:-2] + pad[1:-1] + pad[2:]) / 3.0
-    return np.interp(np.arange(F.shape[0]), idx, roll_s)
+    rulings = np.arange(F.shape[0])
+    nearest = idx[np.abs(rulings[:, None] - idx[None, :]).argmin(axis=1)]
+    branch = (path % 8)[np.searchsorted(idx, nearest)]
+    return np.interp(rulings, idx, roll_s), branch
+
+
+def _follow_branch(
+    model, P: FloatArray, branch: np.ndarray, q_start: FloatArray | None
+) -> FloatArray | None:
+    """Joints (M, 6) of flange poses P on the given IK branches, unwrapped along the path
+    and shifted by whole turns towards ``q_start`` (else into the limits); None when a
+    branch has no solution or the path leaves the joint limits."""
+    sols = model.ik(P, check=False)
+    q = sols[np.arange(len(P)), branch]
+    if np.isnan(q).any():
+        return None
+    q = np.unwrap(q, axis=0)
+    ref = q[0] if q_start is None else np.asarray(q_start, dtype=np.float64)
+    q = q + 2.0 * np.pi * np.round((ref - q[0]) / (2.0 * np.pi))
+    for j in range(q.shape[1]):  # per joint: the whole turn that keeps it within limits
+        for turn in (0.0, -2.0 * np.pi, 2.0 * np.pi):
+            qj = q[:, j] + turn
+            if np.all((qj >= model.lower[j]) & (qj <= model.upper[j])):
+                q[:, j] = qj
+                break
+        else:
+            return None
+    return q

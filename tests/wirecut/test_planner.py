@@ -28,7 +28,7 @@ def demo(tmp_path_factory):
 
 
 def test_demo_plan_writes_every_file(demo):
-    _, res, out = demo
+    job, res, out = demo
     assert res.feasible
     for name in ("trajectory.csv", "refined.json", "surface.stl", "report.json", "plots.png"):
         assert (out / name).stat().st_size > 0
@@ -46,6 +46,12 @@ def test_demo_plan_writes_every_file(demo):
     ):
         assert key in report
     assert report["collisions"] == [] and report["unreachable"] == []
+    # verified in MuJoCo: the simulated wire stays on the target rulings inside the stock
+    assert report["max_wire_deviation_mm"] <= 0.5
+    assert report["max_tcp_tracking_error_mm"] <= 0.5
+    assert report["max_feed_speed_mm_s"] <= 1.01 * job.cut.feed_speed * 1e3
+    assert report["max_joint_speed_ratio"] <= 1.0 and report["max_joint_accel_ratio"] <= 1.0
+    assert (out / "simulation" / "report.json").exists()
 
 
 def test_trajectory_respects_limits_and_period(demo):
