@@ -20,8 +20,8 @@ app = typer.Typer(
     add_completion=False,
     pretty_exceptions_enable=False,
 )
-console = Console(stderr=False)
-err = Console(stderr=True)
+console = Console(stderr=False, soft_wrap=True)
+err = Console(stderr=True, soft_wrap=True)
 
 
 class AlgorithmName(str, Enum):
@@ -133,6 +133,62 @@ def gallery(
         raise typer.Exit(code=1)
 
 
+@app.command(epilog="Example:  ruledrobot chain lines.json --out chain.xml")
+def chain(
+    lines_file: Path = typer.Argument(..., help="Lines file (.json or .csv)."),
+    out: Path = typer.Option(Path("chain.xml"), "--out", "-o", help="Output MJCF file."),
+) -> None:
+    """Write the serial chain whose joint axes are the given lines, as MuJoCo MJCF.
+
+    At zero joint angles the joint axes coincide with the lines (the paper's view of
+    a discrete ruled surface as the axes of a robot).
+    """
+    from .sim import write_chain
+
+    try:
+        path = write_chain(lines_file, out)
+    except ValueError as exc:
+        raise _fail(str(exc)) from None
+    console.print(f"wrote {path}")
+
+
+@app.command(epilog="Example:  ruledrobot simulate out/demo/trajectory.csv --out out/sim --video")
+def simulate(
+    trajectory: Path = typer.Argument(..., help="Trajectory CSV (t,q1..q6,x,y,z,rx,ry,rz)."),
+    out: Path = typer.Option(Path("out/sim"), "--out", "-o", help="Output folder."),
+    video: bool = typer.Option(False, "--video/--no-video", help="Render video.mp4 too."),
+) -> None:
+    """Play a joint trajectory in MuJoCo: tracking errors, limits, collisions, video."""
+    from .sim import RenderUnavailable
+    from .sim import simulate as do_simulate
+
+    try:
+        with console.status("simulating") as status:
+            files = do_simulate(
+                trajectory,
+                out,
+                video=video,
+                progress=lambda f, stage: status.update(f"{stage}: {100 * f:.0f} %"),
+            )
+    except ValueError as exc:
+        raise _fail(str(exc)) from None
+    except RenderUnavailable as exc:
+        err.print(f"[yellow]no video:[/] {exc}")
+        files = {"report": out / "report.json"}
+    import json
+
+    report = json.loads((out / "report.json").read_text())
+    tcp = report.get("tcp_position_error_mm", {})
+    console.print(
+        f"  TCP position error: max {tcp.get('max', float('nan')):.3g} mm, "
+        f"rms {tcp.get('rms', float('nan')):.3g} mm",
+        highlight=False,
+    )
+    console.print(f"  collisions: {len(report.get('collisions', []))}", highlight=False)
+    for name, path in files.items():
+        console.print(f"wrote {path}  ({name})", highlight=False)
+
+
 def _print_report(report: dict) -> None:
     keys = [
         ("duration_s", "duration", "s"),
@@ -155,7 +211,10 @@ def _print_report(report: dict) -> None:
         console.print(f"  [yellow]collision:[/] {c}", highlight=False)
 
 
-def _run_plan(job_path: Path | None, out: Path, job_text: str | None = None) -> dict:
+def _run_plan(
+    job_path: Path | None, out: Path, job_text: str | None = None, video: bool = False
+) -> dict:
+    from .sim import RenderUnavailable
     from .wirecut.job import load_job
     from .wirecut.planner import plan as do_plan
 
@@ -166,9 +225,14 @@ def _run_plan(job_path: Path | None, out: Path, job_text: str | None = None) -> 
     try:
         job = load_job(job_path)
         with console.status("planning") as status:
-            result = do_plan(job, out, progress=lambda msg: status.update(f"planning: {msg}"))
+            result = do_plan(
+                job, out, progress=lambda msg: status.update(f"planning: {msg}"), video=video
+            )
     except ValueError as exc:
         raise _fail(str(exc)) from None
+    except RenderUnavailable as exc:  # the plan itself is written; only the video is missing
+        err.print(f"[yellow]no video:[/] {exc}")
+        return _run_plan(job_path, out, None, video=False)
     if not result.feasible:
         err.print("[bold red]infeasible job:[/]")
         for r in result.report.get("reasons", []):
@@ -185,28 +249,32 @@ def _run_plan(job_path: Path | None, out: Path, job_text: str | None = None) -> 
 def plan(
     job: Path = typer.Argument(..., help="Cut job file (.toml)."),
     out: Path = typer.Option(Path("out/plan"), "--out", "-o", help="Output folder."),
+    video: bool = typer.Option(False, "--video/--no-video", help="Render video.mp4 too."),
 ) -> None:
-    """Plan a hot-wire cut: refine, choose the wire motion, time it, write the trajectory.
-
-    Exits with status 1 (and the reasons) when the job is infeasible.
-    """
-    _run_plan(job, out)
+    """Plan a hot-wire cut: refine, choose the wire motion, time it, verify it in MuJoCo,
+    write the trajectory.  Exits with status 1 (and the reasons) when infeasible."""
+    _run_plan(job, out, video=video)
 
 
 @app.command(epilog="Example:  ruledrobot demo --out out/demo")
 def demo(
     out: Path = typer.Option(Path("out/demo"), "--out", "-o", help="Output folder."),
+    video: bool = typer.Option(True, "--video/--no-video", help="Render video.mp4 too."),
 ) -> None:
-    """Run the whole chain on the built-in example (a hyperbolic paraboloid cut in foam)."""
+    """Run the whole chain on the built-in example (a hyperbolic paraboloid cut in foam):
+    refine, plan, time, verify in MuJoCo, write the trajectory, render a video."""
     from .wirecut.demo import DEMO_JOB
 
     console.print("[bold]ruledrobot demo[/]: hyperbolic paraboloid through a foam block, UR5e")
-    _run_plan(None, out, job_text=DEMO_JOB)
+    _run_plan(None, out, job_text=DEMO_JOB, video=video)
     console.print(f"job file: {out / 'job.toml'} (edit it and run: ruledrobot plan)")
 
 
 def main() -> None:
     """Console-script entry point."""
+    from .sim import configure_gl
+
+    configure_gl()  # choose EGL/OSMesa before anything imports MuJoCo
     app()
 
 

@@ -64,3 +64,41 @@ def test_refine_reports_bad_input_without_traceback(tmp_path):
     )
     result = runner.invoke(app, ["refine", str(few), "--scheme", "six_point"])
     assert result.exit_code == 2 and "needs at least 6" in result.output
+
+
+def test_chain_command_writes_mjcf_whose_axes_are_the_lines(tmp_path, rng):
+    import os
+
+    os.environ.setdefault("MUJOCO_GL", "egl")
+    import mujoco
+
+    lines = rr.Lines.from_point_direction(rng.normal(size=(5, 3)), rng.normal(size=(5, 3)))
+    src = rr.save_lines(tmp_path / "lines.json", lines)
+    out = tmp_path / "chain.xml"
+    result = runner.invoke(app, ["chain", str(src), "--out", str(out)])
+    assert result.exit_code == 0, result.output
+    model = mujoco.MjModel.from_xml_string(out.read_text())
+    data = mujoco.MjData(model)
+    mujoco.mj_kinematics(model, data)
+    axes, anchors = data.xaxis[: len(lines)], data.xanchor[: len(lines)]
+    np.testing.assert_allclose(np.abs((axes * lines.direction).sum(1)), 1.0, atol=1e-9)
+    np.testing.assert_allclose(
+        np.cross(anchors, lines.direction),
+        lines.moment * np.sign((axes * lines.direction).sum(1))[:, None],
+        atol=1e-9,
+    )
+    bad = runner.invoke(app, ["chain", str(tmp_path / "missing.json")])
+    assert bad.exit_code == 2 and "no such file" in bad.output
+
+
+def test_simulate_command_reports_tracking(tmp_path):
+    from ruledrobot.io.trajectory import write_trajectory
+
+    model = rr.robot.load("ur5e")
+    t = np.arange(0, 1.0, 0.002)
+    q = np.array([3.0, -1.2, 1.4, -1.8, -1.57, 0.0]) + 0.05 * np.sin(2 * np.pi * t)[:, None]
+    traj = write_trajectory(tmp_path / "t.csv", t, q, model.fk(q), comments=["robot: ur5e"])
+    result = runner.invoke(app, ["simulate", str(traj), "--out", str(tmp_path / "sim")])
+    assert result.exit_code == 0, result.output
+    assert "TCP position error" in result.output
+    assert (tmp_path / "sim" / "report.json").exists()
