@@ -9,8 +9,9 @@ the tool inherits the smoothness of the refined SE(3) frame motion.
 
 Search (vectorised over rulings; a Python loop over the small candidate grid):
 
-1. slide: the midpoint of the intersection of all feasible slide intervals; if
-   that intersection is empty, each ruling takes the point of its own interval
+1. slide: the midpoint of the intersection of all feasible slide intervals (and,
+   when no candidate works there, slides near both ends of it); if that
+   intersection is empty, each ruling takes the point of its own interval
    nearest that midpoint (reported);
 2. every roll of a grid (default 36 values) x both wire directions is scored on
    a subsample of the rulings: branch-continuous path IK
@@ -75,6 +76,7 @@ class RedundancyResult:
 class _Score:
     roll: float
     reverse: bool
+    slide: int  # index of the slide option
     ok: bool
     travel: float
     min_measure: float
@@ -230,12 +232,18 @@ def solve_redundancy(
     stride = max(1.0, (m - 1) / max(1, idx.size - 1))
     grid = np.linspace(-np.pi, np.pi, rolls, endpoint=False)
 
-    def score(psi: float, reverse: bool) -> _Score:
+    # slide options: the middle of the common feasible interval, then (only when nothing
+    # works there) slides near both of its ends
+    slides = [slide]
+    if constant and H - L > 1e-6:
+        slides += [np.full(m, L + 0.1 * (H - L)), np.full(m, H - 0.1 * (H - L))]
+
+    def score(psi: float, reverse: bool, k: int = 0) -> _Score:
         _, ik, ok_c, lost = _evaluate(
             model,
             F[idx],
             np.full(idx.size, psi),
-            slide[idx],
+            slides[k][idx],
             reverse,
             W,
             segs,
@@ -247,16 +255,20 @@ def solve_redundancy(
             q_start,
         )
         travel = float(np.abs(np.diff(ik.q, axis=0)).sum()) if ik.q.size else np.inf
-        return _Score(float(psi), reverse, ok_c, travel, float(np.min(ik.measure)), lost)
+        return _Score(float(psi), reverse, k, ok_c, travel, float(np.min(ik.measure)), lost)
 
     scores = [score(psi, rev) for rev in (False, True) for psi in grid]
+    for k in range(1, len(slides)):
+        if any(sc.ok for sc in scores):
+            break
+        scores += [score(psi, rev, k) for rev in (False, True) for psi in grid]
     # refine the roll around the candidates that lose the fewest rulings
     step = 2.0 * np.pi / rolls
     if not any(sc.ok for sc in scores):
         best = sorted(scores, key=lambda sc: sum(sc.lost.values()))[:3]
         for sc in best:
             for frac in (-0.75, -0.5, -0.25, 0.25, 0.5, 0.75):
-                scores.append(score(sc.roll + frac * step, sc.reverse))
+                scores.append(score(sc.roll + frac * step, sc.reverse, sc.slide))
     # feasible first, then fewest lost rulings, least joint travel, best conditioned
     order = sorted(
         range(len(scores)),
@@ -278,7 +290,7 @@ def solve_redundancy(
             model,
             F,
             roll,
-            slide,
+            slides[sc.slide],
             sc.reverse,
             W,
             segs,
@@ -293,7 +305,7 @@ def solve_redundancy(
             return RedundancyResult(
                 True,
                 roll,
-                slide,
+                slides[sc.slide],
                 sc.reverse,
                 P,
                 ik.q,
