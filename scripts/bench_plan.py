@@ -67,7 +67,8 @@ def main() -> None:
             )
         print(
             "\nplanning = refine + redundancy + IK + timing; whole plan adds sampling at the "
-            "controller period, measurements and writing the files (CSV, JSON, STL, PNG)"
+            "controller period, the MuJoCo verification (playback with collision checks), "
+            "measurements and writing the files (CSV, JSON, STL, PNG); no video"
         )
 
 
