@@ -15,8 +15,10 @@ Search (vectorised over rulings; a Python loop over the small candidate grid):
    nearest that midpoint (reported);
 2. every roll of a grid (default 36 values) x both wire directions is scored on
    a subsample of the rulings: branch-continuous path IK
-   (:func:`ruledrobot.robot.path_ik`), the smallest singularity measure, bow
-   clearance from the stock (arms as segments) and the table, total joint travel;
+   (:func:`ruledrobot.robot.path_ik`), the smallest singularity measure, the
+   clearances (bow and arm vs stock and table, bow and wire vs the arm; see
+   :func:`_clearance`), total joint travel; around the candidates that lose the
+   fewest rulings the roll is refined;
 3. candidates are verified on all rulings, best first; the first that passes
    wins;
 4. when no constant roll works, the roll varies: a ladder graph over
@@ -24,7 +26,8 @@ Search (vectorised over rulings; a Python loop over the small candidate grid):
    configuration is near a singularity or the bow is not clear, edges weighted
    by the squared (wrapped) joint motion plus a roll-change penalty, solved by
    dynamic programming (Viterbi) — as semi-constrained Cartesian planners do.
-   The roll sequence is then smoothed and verified on every ruling with path IK.
+   The roll sequence is smoothed and verified on every ruling on the IK branches
+   the dynamic program chose.
    When that fails too, the result is infeasible and says, per reason, how many
    rulings the best candidate lost — the planner reports it.
 """
@@ -88,80 +91,93 @@ class _Score:
 _ARM_NEAR_BOW = slice(2, 8)
 
 
-def _clearance(model, q, P, segs, wire, stock, table_z, margin):
+@dataclass(frozen=True)
+class _Cell:
+    """The fixed setting of a search: robot, bow and wire, stock, table, thresholds."""
+
+    model: object
+    W: FloatArray  # wire frame in the flange frame
+    rods: FloatArray  # (3, 2, 3) bow rods in the flange frame
+    wire: FloatArray  # (2, 3) wire ends in the flange frame
+    stock: Box
+    table_z: float | None
+    margin: float
+    singular_min: float
+    q_start: FloatArray | None
+
+    @classmethod
+    def of(cls, model, tool: ToolSpec, stock: Box, table_z, margin, singular_min, q_start):
+        bow = BowTool.from_spec(tool)
+        wire = np.array([bow.wire_start, bow.wire_end])
+        return cls(
+            model,
+            wire_frame(tool),
+            bow.segments(),
+            wire,
+            stock,
+            table_z,
+            margin,
+            singular_min,
+            q_start,
+        )
+
+
+def _clearance(cell: _Cell, q: FloatArray, P: FloatArray) -> dict[str, np.ndarray]:
     """Per configuration (...): which clearance rule it breaks (dict of bool arrays).
 
-    ``q`` (..., 6) joints, ``P`` (..., 4, 4) their flange poses, ``segs`` (3, 2, 3) the
-    bow rods and ``wire`` (2, 3) the wire in the flange frame.  Link capsules sit on
-    the DH skeleton with the MuJoCo model's housing radii (so planner and simulation
-    agree); the bow rods have the bow's arm radius.
+    ``q`` (..., 6) joints and ``P`` (..., 4, 4) their flange poses.  Link capsules sit
+    on the DH skeleton with the MuJoCo model's housing radii (so planner and
+    simulation agree); the bow rods have the simulated bow's rod radius.  The wire
+    inside the stock is the cut, not a collision.
     """
     from ..sim.mjcf import link_radii
 
+    model, stock, margin = cell.model, cell.stock, cell.margin
     shape = q.shape[:-1]
     qf = np.nan_to_num(q.reshape(-1, q.shape[-1]))
     Pf = P.reshape(-1, 4, 4)
-    rods = np.concatenate([segs, wire[None]], axis=0)  # (4, 2, 3)
+    rods = np.concatenate([cell.rods, cell.wire[None]], axis=0)  # (4, 2, 3)
     w = np.einsum("nij,kej->nkei", Pf[:, :3, :3], rods) + Pf[:, None, None, :3, 3]
     pts = model.link_points(qf)  # (n, 13, 3)
     legs_a, legs_b = pts[:, :-1], pts[:, 1:]  # (n, 12, 3): two legs per joint
     radius = np.repeat(link_radii(model), 2)  # (12,)
-    bow_r = BowTool.arm_radius  # the default rod radius of the simulated bow
+    n = len(qf)
     out = {
         "bow hits the stock": stock.segment_hits(w[:, :3, 0], w[:, :3, 1], margin).any(axis=1),
-        "arm hits the stock": np.zeros(len(qf), bool),
-        "bow or wire hits the arm": np.zeros(len(qf), bool),
-        "bow below the table": np.zeros(len(qf), bool),
-        "arm below the table": np.zeros(len(qf), bool),
+        "arm hits the stock": np.zeros(n, bool),
+        "bow or wire hits the arm": np.zeros(n, bool),
+        "bow below the table": np.zeros(n, bool),
+        "arm below the table": np.zeros(n, bool),
     }
     for k in range(legs_a.shape[1]):
         out["arm hits the stock"] |= stock.segment_hits(
             legs_a[:, k], legs_b[:, k], margin + radius[k]
         )
-    near = range(12)[_ARM_NEAR_BOW]
-    for k in near:
+    for k in range(12)[_ARM_NEAR_BOW]:
         dist = segment_distance(legs_a[:, k, None], legs_b[:, k, None], w[:, :, 0], w[:, :, 1])
-        out["bow or wire hits the arm"] |= (dist < radius[k] + bow_r + margin).any(axis=1)
-    if table_z is not None:
-        out["bow below the table"] = (w[:, :3, :, 2] < table_z + margin).any(axis=(1, 2))
+        out["bow or wire hits the arm"] |= (dist < radius[k] + BowTool.arm_radius + margin).any(
+            axis=1
+        )
+    if cell.table_z is not None:
+        out["bow below the table"] = (w[:, :3, :, 2] < cell.table_z + margin).any(axis=(1, 2))
         # skeleton points from the shoulder on (the base stands on the table); a
         # straight leg is lowest at an end point
         r_pt = np.r_[0.0, radius][2:]
-        out["arm below the table"] = (pts[:, 2:, 2] - r_pt < table_z + margin).any(axis=1)
+        out["arm below the table"] = (pts[:, 2:, 2] - r_pt < cell.table_z + margin).any(axis=1)
     return {key: v.reshape(shape) for key, v in out.items()}
 
 
-def _evaluate(
-    model,
-    frames,
-    roll,
-    slide,
-    reverse,
-    W,
-    segs,
-    stock,
-    table_z,
-    margin,
-    singular_min,
-    jump_threshold,
-    q_start=None,
-    wire=None,
-):
+def _evaluate(cell: _Cell, frames, roll, slide, reverse, jump: float):
     """Flange poses, path IK and checks for one candidate on the given rulings."""
-    P = flange_poses(wire_poses(frames, roll, slide, reverse), W)
-    ik = path_ik(model, P, q_start=q_start, jump_threshold=jump_threshold)
-    if wire is None:
-        half = 0.5 * np.linalg.norm(segs[1, 0] - segs[0, 0])
-        wire = np.array([W[:3, 3] - half * W[:3, 2], W[:3, 3] + half * W[:3, 2]])
-    checks = _clearance(model, ik.q, P, segs, wire, stock, table_z, margin)
-    singular = ik.measure < singular_min
+    P = flange_poses(wire_poses(frames, roll, slide, reverse), cell.W)
+    ik = path_ik(cell.model, P, q_start=cell.q_start, jump_threshold=jump)
+    checks = _clearance(cell, ik.q, P)
     lost = {
         "no continuous IK solution": int((~ik.ok).sum()),
-        "near a singularity": int((ik.ok & singular).sum()),
+        "near a singularity": int((ik.ok & (ik.measure < cell.singular_min)).sum()),
         **{key: int((ik.ok & v).sum()) for key, v in checks.items()},
     }
-    ok = all(v == 0 for v in lost.values())
-    return P, ik, ok, lost
+    return P, ik, all(v == 0 for v in lost.values()), lost
 
 
 def solve_redundancy(
@@ -183,23 +199,56 @@ def solve_redundancy(
 
     ``model``: a :class:`~ruledrobot.robot.RobotModel` whose ``fk`` gives the flange
     pose (no tool set).  ``table_z``: height of the table top in the base frame
-    (None: no table check).  ``margin`` (m): clearance of the bow from stock and
-    table.  ``strategy``: "auto" (constant offset first, then a varying roll),
-    "constant" or "varying".  ``q_start`` (6,): joints the motion starts near (the
-    approach comes from there; path IK picks the branch and 2 pi representatives
-    nearest it).  See the module doc for the search.
+    (None: no table check).  ``margin`` (m): clearance of the bow and arm from
+    stock, table and each other.  ``strategy``: "auto" (constant offset first, then a
+    varying roll), "constant" or "varying".  ``q_start`` (6,): joints the motion
+    starts near (path IK picks the branch and 2 pi representatives nearest them).
+    See the module doc for the search.
     """
     if strategy not in ("auto", "constant", "varying"):
         raise ValueError(f"strategy: expected auto, constant or varying, got {strategy!r}")
     F = np.asarray(frames, dtype=np.float64)
     m = F.shape[0]
-    W = wire_frame(tool)
-    segs = bow_segments(tool)
+    cell = _Cell.of(model, tool, stock, table_z, margin, singular_min, q_start)
     c0, c1, hit = chords(F, stock)
     if not hit.any():
         raise ValueError("rulings: none of them crosses the stock; nothing to cut")
     lo, hi, ok = slide_bounds(c0, c1, hit, tool)
+    chord = np.c_[c0, c1]
     reasons: list[str] = []
+
+    def result(roll, slide, reverse, P, q, measure, step, n_scores) -> RedundancyResult:
+        return RedundancyResult(
+            True,
+            roll,
+            slide,
+            reverse,
+            P,
+            q,
+            chord,
+            hit,
+            float(measure),
+            float(step),
+            constant,
+            n_scores,
+            tuple(reasons),
+        )
+
+    def failure(reverse: bool = False, slide=None, n_scores: int = 0) -> RedundancyResult:
+        empty = np.zeros(0)
+        return RedundancyResult(
+            False,
+            empty,
+            empty if slide is None else slide,
+            reverse,
+            np.zeros((0, 4, 4)),
+            np.zeros((0, 6)),
+            chord,
+            hit,
+            candidates=n_scores,
+            reasons=tuple(reasons),
+        )
+
     if not ok.all():
         bad = np.flatnonzero(~ok)
         longest = float(np.nanmax(c1 - c0))
@@ -208,18 +257,8 @@ def solve_redundancy(
             f"wire {tool.wire_length * 1e3:.1f} mm less 2 x {tool.clearance * 1e3:.1f} mm "
             f"clearance), first at ruling {int(bad[0])}"
         )
-        empty = np.zeros(0)
-        return RedundancyResult(
-            False,
-            empty,
-            empty,
-            False,
-            np.zeros((0, 4, 4)),
-            np.zeros((0, 6)),
-            np.c_[c0, c1],
-            hit,
-            reasons=tuple(reasons),
-        )
+        constant = False
+        return failure()
     L, H = lo[hit].max(), hi[hit].min()
     constant = bool(L <= H)
     if constant:
@@ -228,10 +267,9 @@ def solve_redundancy(
         centre = 0.5 * (np.median(lo[hit]) + np.median(hi[hit]))
         slide = np.clip(np.full(m, centre), lo, hi)
         reasons.append("no single slide covers every chord: the slide varies along the cut")
-    idx = np.unique(np.r_[np.linspace(0, m - 1, min(sample, m)).round().astype(int)])
+    idx = np.unique(np.linspace(0, m - 1, min(sample, m)).round().astype(int))
     stride = max(1.0, (m - 1) / max(1, idx.size - 1))
     grid = np.linspace(-np.pi, np.pi, rolls, endpoint=False)
-
     # slide options: the middle of the common feasible interval, then (only when nothing
     # works there) slides near both of its ends
     slides = [slide]
@@ -240,19 +278,7 @@ def solve_redundancy(
 
     def score(psi: float, reverse: bool, k: int = 0) -> _Score:
         _, ik, ok_c, lost = _evaluate(
-            model,
-            F[idx],
-            np.full(idx.size, psi),
-            slides[k][idx],
-            reverse,
-            W,
-            segs,
-            stock,
-            table_z,
-            margin,
-            singular_min,
-            jump_threshold * stride,
-            q_start,
+            cell, F[idx], np.full(idx.size, psi), slides[k][idx], reverse, jump_threshold * stride
         )
         travel = float(np.abs(np.diff(ik.q, axis=0)).sum()) if ik.q.size else np.inf
         return _Score(float(psi), reverse, k, ok_c, travel, float(np.min(ik.measure)), lost)
@@ -262,111 +288,49 @@ def solve_redundancy(
         if any(sc.ok for sc in scores):
             break
         scores += [score(psi, rev, k) for rev in (False, True) for psi in grid]
-    # refine the roll around the candidates that lose the fewest rulings
     step = 2.0 * np.pi / rolls
-    if not any(sc.ok for sc in scores):
-        best = sorted(scores, key=lambda sc: sum(sc.lost.values()))[:3]
-        for sc in best:
+    if not any(sc.ok for sc in scores):  # refine the roll around the least-bad candidates
+        for sc in sorted(scores, key=lambda sc: sum(sc.lost.values()))[:3]:
             for frac in (-0.75, -0.5, -0.25, 0.25, 0.5, 0.75):
                 scores.append(score(sc.roll + frac * step, sc.reverse, sc.slide))
     # feasible first, then fewest lost rulings, least joint travel, best conditioned
     order = sorted(
-        range(len(scores)),
-        key=lambda k: (
-            not scores[k].ok,
-            sum(scores[k].lost.values()),
-            scores[k].travel,
-            -scores[k].min_measure,
-        ),
+        scores, key=lambda sc: (not sc.ok, sum(sc.lost.values()), sc.travel, -sc.min_measure)
     )
-    tried = 0
-    for k in order[:12] if strategy != "varying" else []:
-        sc = scores[k]
-        if not sc.ok and tried > 0:
-            break
-        tried += 1
-        roll = np.full(m, sc.roll)
-        P, ik, ok_c, _ = _evaluate(
-            model,
-            F,
-            roll,
-            slides[sc.slide],
-            sc.reverse,
-            W,
-            segs,
-            stock,
-            table_z,
-            margin,
-            singular_min,
-            jump_threshold,
-            q_start,
-        )
-        if ok_c:
-            return RedundancyResult(
-                True,
-                roll,
-                slides[sc.slide],
-                sc.reverse,
-                P,
-                ik.q,
-                np.c_[c0, c1],
-                hit,
-                float(ik.measure.min()),
-                float(ik.max_step),
-                constant,
-                len(scores),
-                tuple(reasons),
-            )
+    if strategy != "varying":
+        for i, sc in enumerate(order[:12]):
+            if not sc.ok and i > 0:
+                break
+            roll = np.full(m, sc.roll)
+            P, ik, ok_c, _ = _evaluate(cell, F, roll, slides[sc.slide], sc.reverse, jump_threshold)
+            if ok_c:
+                return result(
+                    roll,
+                    slides[sc.slide],
+                    sc.reverse,
+                    P,
+                    ik.q,
+                    ik.measure.min(),
+                    ik.max_step,
+                    len(scores),
+                )
     for reverse in (False, True) if strategy != "constant" else ():
-        found = _ladder_roll(
-            model,
-            F,
-            slide,
-            reverse,
-            W,
-            segs,
-            stock,
-            table_z,
-            margin,
-            singular_min,
-            np.linspace(-np.pi, np.pi, 2 * rolls, endpoint=False),
-            idx,
-            jump_threshold * stride,
-        )
+        fine = np.linspace(-np.pi, np.pi, 2 * rolls, endpoint=False)
+        found = _ladder_roll(cell, F, slide, reverse, fine, idx, jump_threshold * stride)
         if found is None:
             continue
         roll, branch = found
-        P = flange_poses(wire_poses(F, roll, slide, reverse), W)
+        P = flange_poses(wire_poses(F, roll, slide, reverse), cell.W)
         q = _follow_branch(model, P, branch, q_start)
         if q is None:
             continue
-        half = 0.5 * np.linalg.norm(segs[1, 0] - segs[0, 0])
-        wire = np.array([W[:3, 3] - half * W[:3, 2], W[:3, 3] + half * W[:3, 2]])
-        checks = _clearance(model, q, P, segs, wire, stock, table_z, margin)
         measure = model.singularity_measure(q)
-        step = float(np.abs(np.diff(q, axis=0)).max()) if m > 1 else 0.0
-        if (
-            step <= jump_threshold
-            and measure.min() >= singular_min
-            and not any(v.any() for v in checks.values())
-        ):
+        jump = float(np.abs(np.diff(q, axis=0)).max()) if m > 1 else 0.0
+        clear = not any(v.any() for v in _clearance(cell, q, P).values())
+        if jump <= jump_threshold and measure.min() >= singular_min and clear:
             reasons.append("no constant roll works: the roll varies along the cut")
-            return RedundancyResult(
-                True,
-                roll,
-                slide,
-                reverse,
-                P,
-                q,
-                np.c_[c0, c1],
-                hit,
-                float(measure.min()),
-                step,
-                constant,
-                len(scores),
-                tuple(reasons),
-            )
-    best = scores[order[0]]
+            return result(roll, slide, reverse, P, q, measure.min(), jump, len(scores))
+    best = order[0]
     summary = "; ".join(f"{v} ruling(s) {r}" for r, v in best.lost.items() if v)
     reasons.append(
         "no constant or varying roll works: the best constant candidate "
@@ -374,19 +338,7 @@ def solve_redundancy(
         f"{'reversed' if best.reverse else 'along the ruling'}) fails on the sampled rulings "
         f"with {summary or 'problems only on the full path'}"
     )
-    empty = np.zeros(0)
-    return RedundancyResult(
-        False,
-        empty,
-        slide,
-        best.reverse,
-        np.zeros((0, 4, 4)),
-        np.zeros((0, 6)),
-        np.c_[c0, c1],
-        hit,
-        candidates=len(scores),
-        reasons=tuple(reasons),
-    )
+    return failure(best.reverse, slide, len(scores))
 
 
 def _wrap(a: FloatArray) -> FloatArray:
@@ -394,16 +346,10 @@ def _wrap(a: FloatArray) -> FloatArray:
 
 
 def _ladder_roll(
-    model,
+    cell: _Cell,
     F,
     slide,
     reverse,
-    W,
-    segs,
-    stock,
-    table_z,
-    margin,
-    singular_min,
     grid: FloatArray,
     idx: np.ndarray,
     jump: float,
@@ -412,20 +358,18 @@ def _ladder_roll(
     """Roll (M,) and IK branch (M,) per ruling from a Viterbi pass over (roll x branch)
     nodes at the sampled rulings ``idx`` (roll smoothed and interpolated, branch of the
     nearest sample); None when no path exists."""
+    model = cell.model
     n, k = idx.size, grid.size
-    Fs = F[idx]
     psi = np.broadcast_to(grid, (n, k))
     P = flange_poses(
-        wire_poses(Fs[:, None], psi, np.broadcast_to(slide[idx, None], (n, k)), reverse), W
+        wire_poses(F[idx][:, None], psi, np.broadcast_to(slide[idx, None], (n, k)), reverse),
+        cell.W,
     )  # (n, k, 4, 4)
     q = model.ik(P, check=False)  # (n, k, 8, 6)
     valid = ~np.isnan(q).any(axis=-1)
     meas = np.where(valid, model.singularity_measure(np.nan_to_num(q)), 0.0)
-    valid &= meas >= singular_min
-    half = 0.5 * np.linalg.norm(segs[1, 0] - segs[0, 0])
-    wire = np.array([W[:3, 3] - half * W[:3, 2], W[:3, 3] + half * W[:3, 2]])
-    P8 = np.broadcast_to(P[:, :, None], (n, k, 8, 4, 4))
-    for bad in _clearance(model, q, P8, segs, wire, stock, table_z, margin).values():
+    valid &= meas >= cell.singular_min
+    for bad in _clearance(cell, q, np.broadcast_to(P[:, :, None], (n, k, 8, 4, 4))).values():
         valid &= ~bad
     qn = np.nan_to_num(q).reshape(n, k * 8, 6)
     node_ok = valid.reshape(n, k * 8)

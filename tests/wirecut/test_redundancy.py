@@ -8,7 +8,6 @@ import pytest
 import ruledrobot as rr
 from ruledrobot.wirecut import redundancy as red
 from ruledrobot.wirecut.job import load_job
-from ruledrobot.wirecut.toolpath import wire_frame
 
 from .test_job import EXAMPLE
 
@@ -47,11 +46,9 @@ def test_solution_puts_the_wire_on_every_ruling_and_covers_every_chord(setup):
 def test_search_solves_a_job_where_the_plain_dh_motion_fails(setup):
     job, F, model = setup
     m = len(F)
-    W, segs = wire_frame(job.tool), red.bow_segments(job.tool)
-    _, _, ok, lost = red._evaluate(
-        model, F, np.zeros(m), np.zeros(m), False, W, segs, job.stock, 0.0, 0.005, 0.02, 0.5
-    )
-    assert not ok and lost["no continuous IK solution"] > 0  # roll 0 fails here
+    cell = red._Cell.of(model, job.tool, job.stock, 0.0, 0.005, 0.02, None)
+    _, _, ok, lost = red._evaluate(cell, F, np.zeros(m), np.zeros(m), False, 0.5)
+    assert not ok and sum(lost.values()) > 0  # the plain DH motion (roll 0) fails here
     r = red.solve_redundancy(F, job.stock, job.tool, model)
     assert r.feasible and abs(r.roll[0]) > 0.1
 
