@@ -167,17 +167,35 @@ def _clearance(cell: _Cell, q: FloatArray, P: FloatArray) -> dict[str, np.ndarra
     return {key: v.reshape(shape) for key, v in out.items()}
 
 
-def _evaluate(cell: _Cell, frames, roll, slide, reverse, jump: float):
-    """Flange poses, path IK and checks for one candidate on the given rulings."""
+def _failures(cell: _Cell, frames, roll, slide, reverse, jump: float):
+    """Flange poses, path IK and, per reason, the rulings (bool masks) that fail."""
     P = flange_poses(wire_poses(frames, roll, slide, reverse), cell.W)
     ik = path_ik(cell.model, P, q_start=cell.q_start, jump_threshold=jump)
     checks = _clearance(cell, ik.q, P)
-    lost = {
-        "no continuous IK solution": int((~ik.ok).sum()),
-        "near a singularity": int((ik.ok & (ik.measure < cell.singular_min)).sum()),
-        **{key: int((ik.ok & v).sum()) for key, v in checks.items()},
+    masks = {
+        "no continuous IK solution": ~ik.ok,
+        "near a singularity": ik.ok & (ik.measure < cell.singular_min),
+        **{key: ik.ok & v for key, v in checks.items()},
     }
+    return P, ik, masks
+
+
+def _evaluate(cell: _Cell, frames, roll, slide, reverse, jump: float):
+    """Flange poses, path IK, whether all checks pass, and lost rulings per reason."""
+    P, ik, masks = _failures(cell, frames, roll, slide, reverse, jump)
+    lost = {key: int(v.sum()) for key, v in masks.items()}
     return P, ik, all(v == 0 for v in lost.values()), lost
+
+
+def _ranges(mask: np.ndarray) -> str:
+    """Indices of True as compact ranges: ``3-17, 40``."""
+    idx = np.flatnonzero(mask)
+    if idx.size == 0:
+        return ""
+    breaks = np.flatnonzero(np.diff(idx) > 1)
+    starts = np.r_[idx[0], idx[breaks + 1]]
+    ends = np.r_[idx[breaks], idx[-1]]
+    return ", ".join(f"{a}" if a == b else f"{a}-{b}" for a, b in zip(starts, ends, strict=True))
 
 
 def solve_redundancy(
@@ -331,12 +349,15 @@ def solve_redundancy(
             reasons.append("no constant roll works: the roll varies along the cut")
             return result(roll, slide, reverse, P, q, measure.min(), jump, len(scores))
     best = order[0]
-    summary = "; ".join(f"{v} ruling(s) {r}" for r, v in best.lost.items() if v)
+    _, _, masks = _failures(
+        cell, F, np.full(m, best.roll), slides[best.slide], best.reverse, jump_threshold
+    )
+    summary = "; ".join(f"{why} at rulings {_ranges(v)}" for why, v in masks.items() if v.any())
     reasons.append(
         "no constant or varying roll works: the best constant candidate "
         f"(roll {np.degrees(best.roll):.0f} deg, "
-        f"{'reversed' if best.reverse else 'along the ruling'}) fails on the sampled rulings "
-        f"with {summary or 'problems only on the full path'}"
+        f"{'reversed' if best.reverse else 'along the ruling'}, of {m} rulings) fails: "
+        f"{summary or 'no single failing ruling (a jump between rulings)'}"
     )
     return failure(best.reverse, slide, len(scores))
 
