@@ -1,0 +1,44 @@
+"""A UR controller emulator that the real ``ur_rtde`` client can drive.
+
+``Emulator(host, model)`` serves RTDE (30004), the dashboard (29999) and the
+script port (30003) on a loopback address, with a simulated arm behind them
+(:class:`KinematicBackend` by default; any :class:`ArmBackend` plugs in).
+See ``docs/rtde.md`` for the protocol coverage, faults and timing.
+
+Modules, one job each: ``rtde_types`` (variable/type table), ``protocol``
+(RTDE packets and recipes), ``rtde_server``, ``dashboard``, ``script_port``
+(the three servers), ``program`` (URScript parsing), ``handshake`` (ur_rtde's
+control-script register protocol), ``script_runner`` (standalone programs),
+``controller`` (state machine), ``motion`` (trajectory generator),
+``backend`` (the arm), ``kinematics``, ``server`` (:class:`ThreadedEmulator`,
+:func:`serve`), ``process`` (:class:`Emulator`: the emulator in a child
+process, so that a ur_rtde client in this process does not deadlock it).
+"""
+
+from __future__ import annotations
+
+from .backend import HARDWARE_ACCELERATION, ArmBackend, ArmState, KinematicBackend
+from .controller import DEFAULT_Q, Controller
+from .handshake import Command
+from .process import Emulator
+from .server import ClockStats, ThreadedEmulator, serve
+from .states import JointMode, RobotMode, RuntimeState, SafetyMode, SafetyStatusBit
+
+__all__ = [
+    "DEFAULT_Q",
+    "HARDWARE_ACCELERATION",
+    "ArmBackend",
+    "ArmState",
+    "ClockStats",
+    "Command",
+    "Controller",
+    "Emulator",
+    "JointMode",
+    "KinematicBackend",
+    "RobotMode",
+    "RuntimeState",
+    "SafetyMode",
+    "SafetyStatusBit",
+    "ThreadedEmulator",
+    "serve",
+]

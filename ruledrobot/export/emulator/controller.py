@@ -1,0 +1,676 @@
+"""The emulated controller: robot/safety/program state machine, registers, I/O, motion.
+
+One :class:`Controller` owns the state a UR controller publishes over RTDE.
+:meth:`Controller.tick` advances it by one control period (2 ms e-Series,
+8 ms CB3): the running program (ur_rtde's control script, via
+:class:`~.handshake.ControlScript`, or a standalone program, via
+:class:`~.script_runner.ScriptRunner`) reads its inputs, the trajectory
+generator produces a setpoint, the arm backend steps, and the published
+variables (``values``, keyed by RTDE name) are refreshed.
+
+State machine (the parts clients see):
+
+* ``robot_mode``: RUNNING after start-up; ``power off`` -> POWER_OFF,
+  ``power on`` -> IDLE, ``brake release`` -> RUNNING (dashboard).  Programs
+  only start while RUNNING with safety NORMAL.
+* ``safety_mode``: NORMAL; :meth:`protective_stop` -> PROTECTIVE_STOP (the
+  arm brakes, the program stops; ``unlock protective stop`` after
+  ``unlock_delay`` s); :meth:`emergency_stop` -> ROBOT_EMERGENCY_STOP (the
+  arm brakes, power goes off; :meth:`release_emergency_stop`, then power on
+  and brake release).
+* ``runtime_state``: STOPPED / PLAYING / PAUSED of the current program.
+
+Thread safety: every public method takes ``lock`` (re-entrant); the RTDE,
+dashboard and script-port threads call in concurrently with the clock thread.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import time
+from collections import deque
+from collections.abc import Sequence
+from pathlib import Path
+from threading import RLock
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from ...robot import RobotModel
+from .backend import ArmBackend, KinematicBackend
+from .handshake import ControlScript
+from .kinematics import ArmKinematics
+from .motion import MotionError, PathMotion, Segment, StopMotion, joint_segment, linear_segment
+from .program import PathWaypoint, Program, parse_program
+from .script_runner import ScriptRunner
+from .states import JointMode, RobotMode, RuntimeState, SafetyMode, SafetyStatusBit
+
+__all__ = ["DEFAULT_Q", "Controller", "Event"]
+
+log = logging.getLogger("ruledrobot.export.emulator")
+
+#: Start configuration [rad]: elbow up, tool pointing down, away from singularities.
+DEFAULT_Q = (0.0, -1.5707963267948966, 1.5707963267948966, -1.5707963267948966,
+             -1.5707963267948966, 0.0)  # fmt: skip
+
+_IN_INT = [f"input_int_register_{i}" for i in range(48)]
+_IN_DOUBLE = [f"input_double_register_{i}" for i in range(48)]
+_OUT_INT = [f"output_int_register_{i}" for i in range(48)]
+_OUT_DOUBLE = [f"output_double_register_{i}" for i in range(48)]
+
+_ZERO6 = np.zeros(6)
+
+_SAFETY_BITS = {
+    SafetyMode.NORMAL: 1 << SafetyStatusBit.NORMAL_MODE,
+    SafetyMode.REDUCED: 1 << SafetyStatusBit.REDUCED_MODE,
+    SafetyMode.PROTECTIVE_STOP: (1 << SafetyStatusBit.PROTECTIVE_STOPPED)
+    | (1 << SafetyStatusBit.STOPPED_DUE_TO_SAFETY),
+    SafetyMode.RECOVERY: 1 << SafetyStatusBit.RECOVERY_MODE,
+    SafetyMode.SAFEGUARD_STOP: 1 << SafetyStatusBit.SAFEGUARD_STOPPED,
+    SafetyMode.SYSTEM_EMERGENCY_STOP: (1 << SafetyStatusBit.SYSTEM_EMERGENCY_STOPPED)
+    | (1 << SafetyStatusBit.EMERGENCY_STOPPED),
+    SafetyMode.ROBOT_EMERGENCY_STOP: (1 << SafetyStatusBit.ROBOT_EMERGENCY_STOPPED)
+    | (1 << SafetyStatusBit.EMERGENCY_STOPPED),
+    SafetyMode.VIOLATION: 1 << SafetyStatusBit.VIOLATION,
+    SafetyMode.FAULT: 1 << SafetyStatusBit.FAULT,
+}
+
+Event = tuple[float, int, str]
+
+
+class _IdleProgram:
+    """A program loaded from the dashboard (``.urp``) that the emulator cannot run: it idles."""
+
+    program = Program("", "", "idle")
+
+    def step(self) -> None:
+        return None
+
+
+def _int32(v: int) -> int:
+    v = int(v) & 0xFFFFFFFF
+    return v - (1 << 32) if v & 0x80000000 else v
+
+
+class Controller:
+    """The controller state machine behind the emulator's three servers.
+
+    Parameters
+    ----------
+    model : the arm (DH, limits, control period; its ``tool`` is the initial TCP).
+    backend : the arm backend (default :class:`KinematicBackend`).
+    q0 : initial joint positions [rad] (default :data:`DEFAULT_Q`).
+    unlock_delay : seconds after a protective stop before ``unlock protective
+        stop`` is accepted (5 s on a real controller).
+    fault_deceleration : joint deceleration [rad/s^2] of the braking after a
+        protective or emergency stop.
+    """
+
+    def __init__(
+        self,
+        model: RobotModel,
+        backend: ArmBackend | None = None,
+        *,
+        q0: ArrayLike | None = None,
+        unlock_delay: float = 5.0,
+        fault_deceleration: float = 20.0,
+    ) -> None:
+        self.model = model
+        self.period = float(model.control_period)
+        self.lock = RLock()
+        self.kin = ArmKinematics(model)
+        self.backend: ArmBackend = backend if backend is not None else KinematicBackend(model)
+        q = np.asarray(DEFAULT_Q if q0 is None else q0, dtype=float).reshape(6)
+        self.backend.reset(q)
+        self.unlock_delay = float(unlock_delay)
+        self.fault_deceleration = float(fault_deceleration)
+        self.robot_mode = RobotMode.RUNNING
+        self.safety_mode = SafetyMode.NORMAL
+        self.runtime_state = RuntimeState.STOPPED
+        self.program: Program | None = None
+        self.runner: ControlScript | ScriptRunner | _IdleProgram | None = None
+        self.loaded_program: str | None = None
+        self._loaded_script: Program | None = None
+        self.motion: PathMotion | StopMotion | None = None
+        self.mode = "idle"  # idle | move | servo | speed
+        self._hold_q: np.ndarray | None = None  # where an idle arm rests
+        self.time = 0.0
+        self.ticks = 0
+        self.speed_fraction = 1.0
+        self.freedrive = False
+        self.std_do = 0
+        self.conf_do = 0
+        self.tool_do = 0
+        self.analog_out = [0.0, 0.0]
+        self.last_input_names: frozenset[str] = frozenset()
+        self.history: deque[list[float]] = deque(maxlen=1024)
+        self.events: deque[Event] = deque(maxlen=2000)
+        self.limit_events = 0
+        self._fault_time = -math.inf
+        self._watch_name: str | None = None  # RTDE watchdog (rtde_set_watchdog)
+        self._watch_timeout = 0.0
+        self._watch_action = "stop"
+        self._watch_last = 0.0
+        self._power_off_when_stopped = False
+        self.values: dict[str, object] = {}
+        self._init_values()
+        self._update_values()
+
+    # ------------------------------------------------------------ values
+
+    def _init_values(self) -> None:
+        v = self.values
+        z6 = (0.0,) * 6
+        for names, zero in ((_IN_INT, 0), (_OUT_INT, 0), (_IN_DOUBLE, 0.0), (_OUT_DOUBLE, 0.0)):
+            for n in names:
+                v[n] = zero
+        for i in range(64, 128):
+            v[f"input_bit_register_{i}"] = 0
+            v[f"output_bit_register_{i}"] = 0
+        v.update(
+            {
+                "input_bit_registers0_to_31": 0,
+                "input_bit_registers32_to_63": 0,
+                "output_bit_registers0_to_31": 0,
+                "output_bit_registers32_to_63": 0,
+                "target_current": z6,
+                "target_moment": z6,
+                "actual_current_window": z6,
+                "actual_current_as_torque": z6,
+                "joint_control_output": z6,
+                "actual_TCP_force": z6,
+                "ft_raw_wrench": z6,
+                "actual_digital_input_bits": 0,
+                "joint_temperatures": (32.0, 33.5, 33.0, 35.0, 35.5, 36.0),
+                "actual_tool_accelerometer": (0.0, 0.0, 9.81),
+                "actual_momentum": 0.0,
+                "actual_main_voltage": 48.0,
+                "actual_robot_voltage": 48.0,
+                "actual_robot_current": 0.8,
+                "actual_joint_voltage": (47.5,) * 6,
+                "standard_analog_input0": 0.0,
+                "standard_analog_input1": 0.0,
+                "analog_io_types": 0,
+                "io_current": 0.05,
+                "tool_mode": 0,
+                "tool_analog_input_types": 0,
+                "tool_analog_input0": 0.0,
+                "tool_analog_input1": 0.0,
+                "tool_output_voltage": 0,
+                "tool_output_current": 0.0,
+                "tool_temperature": 30.0,
+                "tcp_force_scalar": 0.0,
+                "payload": 0.0,
+                "payload_cog": (0.0, 0.0, 0.0),
+                "payload_inertia": z6,
+                "joint_position_deviation_ratio": 0.0,
+                "collision_detection_ratio": 0.0,
+                "time_scale_source": 0,
+                "euromap67_input_bits": 0,
+                "euromap67_output_bits": 0,
+                "euromap67_24V_voltage": 0.0,
+                "euromap67_24V_current": 0.0,
+            }
+        )
+
+    def _update_values(self, exec_time: float = 0.0) -> None:
+        st = self.backend.state()
+        v = self.values
+        q = st.q.tolist()
+        qd = st.qd.tolist()
+        tq = st.target_q.tolist()
+        tqd = st.target_qd.tolist()
+        pose, speed, elbow = self.kin.state(q, qd)
+        if tq == q and tqd == qd:
+            tpose, tspeed = pose, speed
+        else:
+            tpose, tspeed, _ = self.kin.state(tq, tqd)
+        self.history.append(q)
+        running = self.robot_mode == RobotMode.RUNNING
+        if running:
+            jm = JointMode.RUNNING
+        elif self.robot_mode in (RobotMode.IDLE, RobotMode.POWER_ON):
+            jm = JointMode.IDLE
+        else:
+            jm = JointMode.POWER_OFF
+        powered = self.robot_mode >= RobotMode.POWER_ON
+        playing = self.runtime_state == RuntimeState.PLAYING
+        v.update(
+            {
+                "timestamp": self.time,
+                "target_q": tq,
+                "target_qd": tqd,
+                "target_qdd": st.target_qdd.tolist(),
+                "actual_q": q,
+                "actual_qd": qd,
+                "actual_current": st.current.tolist(),
+                "actual_TCP_pose": pose,
+                "actual_TCP_speed": speed,
+                "target_TCP_pose": tpose,
+                "target_TCP_speed": tspeed,
+                "elbow_position": elbow,
+                "elbow_velocity": (0.0, 0.0, 0.0),
+                "actual_execution_time": exec_time * 1000.0,
+                "robot_mode": int(self.robot_mode),
+                "joint_mode": (int(jm),) * 6,
+                "safety_mode": int(self.safety_mode),
+                "safety_status": int(self.safety_mode),
+                "safety_status_bits": _SAFETY_BITS.get(self.safety_mode, 0),
+                "robot_status_bits": int(powered) | (int(playing) << 1),
+                "runtime_state": int(self.runtime_state),
+                "speed_scaling": self.speed_fraction if running else 0.0,
+                "target_speed_fraction": self.speed_fraction,
+                "actual_digital_output_bits": self.std_do
+                | (self.conf_do << 8)
+                | (self.tool_do << 16),
+                "standard_analog_output0": self.analog_out[0],
+                "standard_analog_output1": self.analog_out[1],
+                "tcp_offset": self.kin.tcp_offset,
+                "script_control_line": self._script_line(),
+            }
+        )
+
+    def _script_line(self) -> int:
+        r = self.runner
+        return r.line if isinstance(r, ScriptRunner) else 0
+
+    # ------------------------------------------------------------ registers and inputs
+
+    def in_int(self, i: int) -> int:
+        return self.values.get(_IN_INT[i], 0)  # type: ignore[return-value]
+
+    def in_double(self, i: int) -> float:
+        return self.values.get(_IN_DOUBLE[i], 0.0)  # type: ignore[return-value]
+
+    def set_out_int(self, i: int, value: int) -> None:
+        self.values[_OUT_INT[i]] = _int32(value)
+
+    def set_out_double(self, i: int, value: float) -> None:
+        self.values[_OUT_DOUBLE[i]] = float(value)
+
+    def set_out_bit(self, i: int, value: bool) -> None:
+        with self.lock:
+            if 64 <= i <= 127:
+                self.values[f"output_bit_register_{i}"] = int(value)
+            elif 0 <= i <= 63:
+                key = "output_bit_registers0_to_31" if i < 32 else "output_bit_registers32_to_63"
+                word = int(self.values[key])  # type: ignore[call-overload]
+                bit = 1 << (i % 32)
+                self.values[key] = (word | bit) if value else (word & ~bit)
+
+    def apply_inputs(self, values: dict[str, object], names: Sequence[str]) -> None:
+        """Apply a client's input data package (registers, I/O masks, speed slider)."""
+        with self.lock:
+            self.values.update(values)
+            self.last_input_names = frozenset(names)
+            if self._watch_name is not None and self._watch_name in self.last_input_names:
+                self._watch_last = self.time
+            if "standard_digital_output_mask" in values:
+                m = int(values["standard_digital_output_mask"])  # type: ignore[call-overload]
+                b = int(values.get("standard_digital_output", 0))  # type: ignore[call-overload]
+                self.std_do = (self.std_do & ~m) | (b & m)
+            if "configurable_digital_output_mask" in values:
+                m = int(values["configurable_digital_output_mask"])  # type: ignore[call-overload]
+                b = int(values.get("configurable_digital_output", 0))  # type: ignore[call-overload]
+                self.conf_do = (self.conf_do & ~m) | (b & m)
+            if "tool_digital_output_mask" in values:
+                m = int(values["tool_digital_output_mask"]) & 3  # type: ignore[call-overload]
+                b = int(values.get("tool_digital_output", 0))  # type: ignore[call-overload]
+                self.tool_do = (self.tool_do & ~m) | (b & m)
+            if int(values.get("speed_slider_mask", 0)) & 1:  # type: ignore[call-overload]
+                f = float(values.get("speed_slider_fraction", 1.0))  # type: ignore[arg-type]
+                self.speed_fraction = min(max(f, 0.0), 1.0)
+            if "standard_analog_output_mask" in values:
+                m = int(values["standard_analog_output_mask"])  # type: ignore[call-overload]
+                for k in (0, 1):
+                    if m & (1 << k):
+                        x = float(values.get(f"standard_analog_output_{k}", 0.0))  # type: ignore[arg-type]
+                        self.analog_out[k] = min(max(x, 0.0), 1.0)
+
+    def set_digital_out(self, kind: str, n: int, value: bool) -> None:
+        """URScript ``set_standard_digital_out`` / ``set_configurable_digital_out`` / tool."""
+        with self.lock:
+            bit = 1 << n
+            if kind == "set_configurable_digital_out":
+                self.conf_do = (self.conf_do | bit) if value else (self.conf_do & ~bit)
+            elif kind == "set_tool_digital_out":
+                self.tool_do = (self.tool_do | bit) if value else (self.tool_do & ~bit)
+            else:
+                self.std_do = (self.std_do | bit) if value else (self.std_do & ~bit)
+
+    def set_payload(self, mass: float, cog: ArrayLike) -> None:
+        with self.lock:
+            self.values["payload"] = float(mass)
+            self.values["payload_cog"] = tuple(float(x) for x in np.asarray(cog).reshape(3))
+
+    def set_watchdog(self, name: str, min_frequency: float, action: str = "stop") -> None:
+        """URScript ``rtde_set_watchdog``: act when input ``name`` is not updated in time.
+
+        ``action`` is ``"stop"`` (stop the program, the arm brakes), ``"pause"``
+        or ``"ignore"``; a frequency <= 0 removes the watchdog.  It ends with
+        the program that set it.
+        """
+        with self.lock:
+            if min_frequency <= 0 or action == "ignore":
+                self._watch_name = None
+                return
+            self._watch_name = name
+            self._watch_timeout = 1.0 / float(min_frequency)
+            self._watch_action = action
+            self._watch_last = self.time
+
+    def _check_watchdog(self) -> None:
+        if self._watch_name is None or self.runtime_state != RuntimeState.PLAYING:
+            return
+        silent = self.time - self._watch_last
+        if silent > self._watch_timeout:
+            name = self._watch_name
+            self._watch_name = None
+            self.log(f"RTDE watchdog: {name} not updated for {silent:.3f} s", level=1)
+            if self._watch_action == "pause":
+                self.pause_program()
+            else:
+                self.stop_program("RTDE watchdog", decelerate=True)
+
+    # ------------------------------------------------------------ log
+
+    def log(self, message: str, level: int = 3) -> None:
+        """Record an event (level 0 exception, 1 error, 2 warning, 3 info)."""
+        self.events.append((self.time, level, message))
+        log.log({0: logging.ERROR, 1: logging.ERROR, 2: logging.WARNING}.get(level, logging.INFO),
+                "emulator: %s", message)  # fmt: skip
+
+    # ------------------------------------------------------------ motion
+
+    def start_motion(self, motion: PathMotion | StopMotion) -> None:
+        with self.lock:
+            self.motion = motion
+            self.mode = "move"
+
+    def stop_motion(self, deceleration: float) -> StopMotion:
+        """Brake from the current setpoint to rest (``stopj``); returns the stop motion."""
+        with self.lock:
+            st = self.backend.state()
+            stop = StopMotion(st.target_q, st.target_qd, deceleration)
+            self.motion = stop
+            self.mode = "move"
+            return stop
+
+    def set_servo(self, q: ArrayLike, lookahead_time: float, gain: float) -> None:
+        with self.lock:
+            if not self._can_move():
+                return
+            self.motion = None
+            self.mode = "servo"
+            self._hold_q = None
+            self.backend.servo(q, lookahead_time, gain)
+
+    def set_speed(self, qd: ArrayLike, acceleration: float) -> None:
+        with self.lock:
+            if not self._can_move():
+                return
+            self.motion = None
+            self.mode = "speed"
+            self._hold_q = None
+            self.backend.speed(qd, acceleration)
+
+    def _can_move(self) -> bool:
+        return self.robot_mode == RobotMode.RUNNING and self.safety_mode in (
+            SafetyMode.NORMAL,
+            SafetyMode.REDUCED,
+        )
+
+    def build_path(self, waypoints: Sequence[PathWaypoint]) -> PathMotion:
+        """A blended path from injected or programmed waypoints, starting at the setpoint."""
+        q = self.backend.state().target_q.copy()
+        q0 = q.copy()
+        segs: list[Segment] = []
+        for wp in waypoints:
+            target = np.asarray(wp.target, dtype=float)
+            if wp.kind == "movej":
+                if wp.pose:
+                    qt = self.kin.ik_nearest(target, q)
+                    if qt is None:
+                        raise MotionError(f"path: movej pose p{list(wp.target)} out of reach")
+                    target = qt
+                seg = joint_segment(q, target, wp.v, wp.a, wp.r, self.kin)
+            else:
+                if not wp.pose:
+                    target = np.asarray(self.kin.tcp_vector(target.tolist()))
+                seg = linear_segment(q, target, wp.v, wp.a, wp.r, self.kin)
+            segs.append(seg)
+            q = seg.q_end
+        return PathMotion(q0, segs)
+
+    # ------------------------------------------------------------ programs
+
+    def load_script(self, text: str) -> bool:
+        """A program arrived on the script port: it replaces the running one and starts."""
+        try:
+            prog = parse_program(text)
+        except (ValueError, MotionError) as exc:
+            with self.lock:
+                self.log(f"script port: cannot parse program: {exc}", level=1)
+            return False
+        return self.start_program(prog)
+
+    def start_program(self, prog: Program) -> bool:
+        with self.lock:
+            if self.robot_mode != RobotMode.RUNNING:
+                self.log(f"cannot start program {prog.name!r}: robot mode "
+                         f"{self.robot_mode.name}", level=1)  # fmt: skip
+                return False
+            if self.safety_mode not in (SafetyMode.NORMAL, SafetyMode.REDUCED):
+                self.log(f"cannot start program {prog.name!r}: safety mode "
+                         f"{self.safety_mode.name}", level=1)  # fmt: skip
+                return False
+            if self.runner is not None:
+                self.stop_program(f"replaced by {prog.name or 'a new program'}", decelerate=True)
+            self.program = prog
+            if prog.kind == "rtde_control":
+                self.runner = ControlScript(self, prog)
+                self.log(f"rtde_control started (register offset {prog.register_offset}, "
+                         f"{len(prog.path)} path waypoints)")  # fmt: skip
+            elif prog.kind == "idle":
+                self.runner = _IdleProgram()
+            else:
+                self.runner = ScriptRunner(self, prog)
+                self.log(f"program {prog.name or '<line>'} started "
+                         f"({len(prog.statements)} statements)")  # fmt: skip
+            self.runtime_state = RuntimeState.PLAYING
+            return True
+
+    def stop_program(self, reason: str = "", *, decelerate: bool = True) -> None:
+        """End the running program (runtime state STOPPED); brake servo/speed/moves."""
+        with self.lock:
+            if self.runner is None and self.runtime_state == RuntimeState.STOPPED:
+                return
+            name = self.program.name if self.program else ""
+            self.runner = None
+            self.runtime_state = RuntimeState.STOPPED
+            self._watch_name = None
+            if reason:
+                self.log(f"program {name or '<none>'} stopped: {reason}")
+            if decelerate and self.mode != "idle" and not isinstance(self.motion, StopMotion):
+                self.stop_motion(4.0)
+
+    def program_finished(self) -> None:
+        with self.lock:
+            name = self.program.name if self.program else ""
+            self.log(f"program {name or '<line>'} finished")
+            self.stop_program("", decelerate=True)
+
+    def program_error(self, message: str) -> None:
+        """A runtime error in the program: it stops, as on the controller (popup + log)."""
+        with self.lock:
+            self.log(f"runtime error: {message}", level=1)
+            self.stop_program("runtime error", decelerate=True)
+
+    def pause_program(self) -> bool:
+        with self.lock:
+            if self.runtime_state != RuntimeState.PLAYING:
+                return False
+            self.runtime_state = RuntimeState.PAUSED
+            if self.mode != "idle":
+                self.stop_motion(4.0)
+            return True
+
+    def play(self) -> bool:
+        """Dashboard ``play``: resume a paused program or start the loaded one."""
+        with self.lock:
+            if self.runtime_state == RuntimeState.PAUSED and self.runner is not None:
+                if not self._can_move():
+                    return False
+                self.runtime_state = RuntimeState.PLAYING
+                return True
+            if self.loaded_program is None:
+                return False
+            prog = self._loaded_script or Program(Path(self.loaded_program).stem, "", "idle")
+            return self.start_program(prog)
+
+    def load(self, path: str) -> bool:
+        """Dashboard ``load``: a ``.script`` file is parsed and run by ``play``; ``.urp`` idles."""
+        p = Path(path)
+        if not p.is_file():
+            return False
+        with self.lock:
+            self.loaded_program = str(p)
+            self._loaded_script = None
+            if p.suffix == ".script":
+                try:
+                    self._loaded_script = parse_program(p.read_text(encoding="utf-8"))
+                except (OSError, ValueError) as exc:
+                    self.log(f"load {p}: {exc}", level=1)
+                    return False
+            return True
+
+    # ------------------------------------------------------------ power and safety
+
+    def power_on(self) -> bool:
+        with self.lock:
+            if self.safety_mode != SafetyMode.NORMAL:
+                return False
+            if self.robot_mode in (RobotMode.POWER_OFF, RobotMode.POWER_ON):
+                self.robot_mode = RobotMode.IDLE
+            return True
+
+    def brake_release(self) -> bool:
+        with self.lock:
+            if self.safety_mode != SafetyMode.NORMAL or self.robot_mode < RobotMode.POWER_ON:
+                return False
+            self.robot_mode = RobotMode.RUNNING
+            return True
+
+    def power_off(self) -> None:
+        with self.lock:
+            self.stop_program("power off", decelerate=False)
+            self.motion = None
+            self.mode = "idle"
+            self._hold_q = None
+            self.backend.hold()
+            self.robot_mode = RobotMode.POWER_OFF
+
+    def _brake(self) -> None:
+        st = self.backend.state()
+        self.motion = StopMotion(st.target_q, st.target_qd, self.fault_deceleration)
+        self.mode = "move"
+
+    def protective_stop(self, reason: str = "protective stop") -> None:
+        """Fault: protective stop (the arm brakes, the program stops)."""
+        with self.lock:
+            if self.safety_mode == SafetyMode.PROTECTIVE_STOP:
+                return
+            self.safety_mode = SafetyMode.PROTECTIVE_STOP
+            self._fault_time = time.monotonic()
+            self.log(f"protective stop: {reason}", level=1)
+            self.stop_program("protective stop", decelerate=False)
+            self._brake()
+
+    def unlock_protective_stop(self) -> tuple[bool, str]:
+        """Dashboard ``unlock protective stop``: (accepted, reply)."""
+        with self.lock:
+            if self.safety_mode != SafetyMode.PROTECTIVE_STOP:
+                return True, "Protective stop releasing"
+            if time.monotonic() - self._fault_time < self.unlock_delay:
+                return False, (
+                    f"Cannot unlock protective stop until {self.unlock_delay:g}s after occurrence. "
+                    "Always inspect cause of protective stop before unlocking"
+                )
+            self.safety_mode = SafetyMode.NORMAL
+            self.log("protective stop released")
+            return True, "Protective stop releasing"
+
+    def emergency_stop(self, reason: str = "emergency stop button pressed") -> None:
+        """Fault: robot emergency stop (the arm brakes, then power goes off)."""
+        with self.lock:
+            if self.safety_mode == SafetyMode.ROBOT_EMERGENCY_STOP:
+                return
+            self.safety_mode = SafetyMode.ROBOT_EMERGENCY_STOP
+            self.log(f"emergency stop: {reason}", level=1)
+            self.stop_program("emergency stop", decelerate=False)
+            self._brake()
+            self._power_off_when_stopped = True
+
+    def release_emergency_stop(self) -> None:
+        """The e-stop button is released: safety NORMAL; power on + brake release to run."""
+        with self.lock:
+            if self.safety_mode == SafetyMode.ROBOT_EMERGENCY_STOP:
+                self.safety_mode = SafetyMode.NORMAL
+                self.log("emergency stop released")
+
+    def clear_faults(self) -> None:
+        """Back to NORMAL and RUNNING at once (test helper; a real robot needs the steps)."""
+        with self.lock:
+            self.safety_mode = SafetyMode.NORMAL
+            self.robot_mode = RobotMode.RUNNING
+            self._power_off_when_stopped = False
+
+    # ------------------------------------------------------------ tick
+
+    def tick(self) -> dict[str, object]:
+        """Advance one control period; returns ``values`` (do not modify)."""
+        t0 = time.perf_counter()
+        with self.lock:
+            self.time += self.period
+            self.ticks += 1
+            self._check_watchdog()
+            runner = self.runner
+            if runner is not None and self.runtime_state == RuntimeState.PLAYING:
+                try:
+                    runner.step()
+                except MotionError as exc:
+                    self.program_error(str(exc))
+                except Exception as exc:  # never let a program kill the controller
+                    log.exception("emulator: program step failed")
+                    self.program_error(f"internal error: {exc!r}")
+            m = self.motion
+            if m is not None:
+                scale = self.speed_fraction if isinstance(m, PathMotion) else 1.0
+                sp = m.next(self.period, scale)
+                if sp is None:
+                    self.motion = None
+                    self.mode = "idle"
+                    if self._power_off_when_stopped:
+                        self._power_off_when_stopped = False
+                        self.robot_mode = RobotMode.POWER_OFF
+                else:
+                    self._hold_q = sp[0]
+                    self.backend.track(*sp)
+            if self.mode == "idle":
+                # at rest on the last setpoint (an arm that lags behind still gets there)
+                if self._hold_q is not None and self.robot_mode != RobotMode.POWER_OFF:
+                    self.backend.track(self._hold_q, _ZERO6, _ZERO6)
+                else:
+                    self.backend.hold()
+            self.backend.step(self.period)
+            st = self.backend.state()
+            if st.limited:
+                self.limit_events += 1
+            if self._can_move() and (
+                np.any(st.q <= self.model.lower) or np.any(st.q >= self.model.upper)
+            ):
+                j = int(np.argmax((st.q <= self.model.lower) | (st.q >= self.model.upper)))
+                self.protective_stop(f"joint {j} position limit")
+            self._update_values(time.perf_counter() - t0)
+            return self.values

@@ -1,0 +1,332 @@
+"""The emulator in a child process, driven from this one: :class:`Emulator`.
+
+ur_rtde's Python bindings keep the GIL while they wait for the controller
+(the interface constructors, ``moveJ``, ...).  An emulator on threads of the
+same process can then never answer: the client deadlocks.  :class:`Emulator`
+therefore runs the :class:`~.server.ThreadedEmulator` in a child process
+(``python -c``, talking over a socket pair) and forwards fault injection and
+state queries to it.  With
+``in_process=True`` it runs the threaded emulator here instead (for clients
+in other processes, or raw-socket clients).
+
+The child exits when :meth:`Emulator.close` is called or when this process
+dies (its pipe closes).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import gc
+import os
+import signal
+import socket
+import subprocess
+import sys
+import threading
+import time
+from collections.abc import Callable
+from multiprocessing.connection import Connection
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from ...robot import RobotModel
+from .backend import ArmBackend
+from .server import ThreadedEmulator
+from .states import RobotMode, RuntimeState, SafetyMode
+
+__all__ = ["Emulator"]
+
+#: methods and properties of ThreadedEmulator the parent may call
+_CALLS = frozenset(
+    {
+        "protective_stop",
+        "emergency_stop",
+        "release_emergency_stop",
+        "drop_connections",
+        "set_slow",
+        "clear_faults",
+        "stats_summary",
+        "reset",
+    }
+)
+_PROPS = frozenset(
+    {"actual_q", "tcp_pose", "robot_mode", "safety_mode", "runtime_state", "events", "ports"}
+)
+
+
+def _kill(proc: subprocess.Popen) -> None:
+    with contextlib.suppress(OSError):
+        proc.kill()
+    with contextlib.suppress(subprocess.TimeoutExpired):
+        proc.wait(2.0)
+
+
+def _child_entry(fd: int) -> None:  # pragma: no cover - runs in the child
+    """Entry point of the child process: run the emulator, serve the parent's requests."""
+    with contextlib.suppress(ValueError, OSError):
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+    conn = Connection(fd)
+    try:
+        kwargs = conn.recv()
+        emu = ThreadedEmulator(**kwargs).start()
+        # everything allocated so far lives as long as the process: keep it out of
+        # the cyclic collector so that full collections stay short (no clock stalls)
+        gc.collect()
+        gc.freeze()
+    except BaseException as exc:
+        with contextlib.suppress(OSError):
+            conn.send(("error", f"{type(exc).__name__}: {exc}"))
+        return
+    conn.send(("ready", emu.ports))
+    try:
+        while True:
+            try:
+                name, args, kw = conn.recv()
+            except (EOFError, OSError):
+                break
+            if name == "close":
+                break
+            try:
+                if name in _CALLS:
+                    result = getattr(emu, name)(*args, **kw)
+                elif name in _PROPS:
+                    result = getattr(emu, name)
+                else:
+                    raise AttributeError(f"emulator has no remote method {name!r}")
+                conn.send(("ok", result))
+            except Exception as exc:
+                conn.send(("error", f"{type(exc).__name__}: {exc}"))
+    finally:
+        emu.close()
+        with contextlib.suppress(OSError):
+            conn.send(("closed", None))
+
+
+class Emulator:
+    """A UR controller emulator on ``host`` (RTDE 30004, dashboard 29999, script 30003).
+
+    The real ur_rtde client (RTDEReceiveInterface, RTDEControlInterface,
+    RTDEIOInterface, DashboardClient) connects to it as to a robot.
+
+    Parameters
+    ----------
+    host : loopback address to bind, e.g. ``"127.0.0.2"`` (see ``allow_remote``).
+    model : robot model name (``"ur5e"``, ...) or a :class:`RobotModel`.
+    in_process : run on threads of this process instead of a child process
+        (never with a ur_rtde client in this process: it would deadlock).
+    start_timeout : seconds to wait for the child to listen.
+    **options : passed to :class:`~.server.ThreadedEmulator`: ``backend`` (an
+        :class:`ArmBackend`, or a picklable factory ``model -> backend`` for the
+        child process), ``q0``, ``rtde_port``, ``dashboard_port``,
+        ``script_port``, ``version``, ``serial_number``, ``unlock_delay``,
+        ``allow_remote``.
+
+    Use as a context manager, or call :meth:`start` / :meth:`close`.
+    """
+
+    def __init__(
+        self,
+        host: str = "127.0.0.1",
+        model: str | RobotModel = "ur5e",
+        *,
+        in_process: bool = False,
+        start_timeout: float = 20.0,
+        backend: ArmBackend | Callable[[RobotModel], ArmBackend] | None = None,
+        q0: ArrayLike | None = None,
+        **options: Any,
+    ) -> None:
+        self.host = host
+        self.model_name = model if isinstance(model, str) else model.name
+        self.in_process = in_process
+        self.start_timeout = float(start_timeout)
+        self._kwargs: dict[str, Any] = dict(options, host=host, model=model, backend=backend)
+        if q0 is not None:
+            self._kwargs["q0"] = np.asarray(q0, dtype=float).tolist()
+        self._local: ThreadedEmulator | None = None
+        self._proc: Any = None
+        self._conn: Any = None
+        self._lock = threading.Lock()
+        self._ports: dict[str, int] = {}
+        if in_process:
+            self._local = ThreadedEmulator(**self._kwargs)
+
+    # ------------------------------------------------------------ lifecycle
+
+    def start(self) -> Emulator:
+        """Start serving (in the child process unless ``in_process``); returns self."""
+        if self._local is not None:
+            self._local.start()
+            self._ports = self._local.ports
+            return self
+        if self._proc is not None:
+            return self
+        ours, theirs = socket.socketpair()
+        env = dict(os.environ)
+        env["PYTHONPATH"] = os.pathsep.join(p for p in sys.path if p)
+        code = f"from {__name__} import _child_entry; _child_entry({theirs.fileno()})"
+        proc = subprocess.Popen(
+            [sys.executable, "-c", code], pass_fds=(theirs.fileno(),), env=env,
+            stdin=subprocess.DEVNULL,
+        )  # fmt: skip
+        theirs.close()
+        conn = Connection(ours.detach())
+        try:
+            conn.send(self._kwargs)
+            if not conn.poll(self.start_timeout):
+                raise RuntimeError(
+                    f"emulator on {self.host}: did not start in {self.start_timeout} s"
+                )
+            status, payload = conn.recv()
+        except (EOFError, OSError) as exc:
+            _kill(proc)
+            conn.close()
+            raise RuntimeError(
+                f"emulator on {self.host}: the child process died ({exc or proc.poll()})"
+            ) from None
+        except BaseException:
+            _kill(proc)
+            conn.close()
+            raise
+        if status != "ready":
+            _kill(proc)
+            conn.close()
+            raise OSError(f"emulator on {self.host}: {payload}")
+        self._proc, self._conn, self._ports = proc, conn, payload
+        return self
+
+    def close(self, timeout: float = 5.0) -> None:
+        """Stop the emulator; bounded by ``timeout`` seconds (the child is killed after it)."""
+        if self._local is not None:
+            self._local.close(timeout)
+            return
+        proc, conn = self._proc, self._conn
+        if proc is None:
+            return
+        self._proc = self._conn = None
+        deadline = time.monotonic() + timeout
+        with contextlib.suppress(OSError, BrokenPipeError, EOFError):
+            with self._lock:
+                conn.send(("close", (), {}))
+                while conn.poll(max(0.0, deadline - time.monotonic())):
+                    if conn.recv()[0] == "closed":
+                        break
+        try:
+            proc.wait(max(0.1, deadline - time.monotonic()))
+        except subprocess.TimeoutExpired:
+            _kill(proc)
+        with contextlib.suppress(OSError):
+            conn.close()
+
+    def __enter__(self) -> Emulator:
+        return self.start()
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    @property
+    def running(self) -> bool:
+        if self._local is not None:
+            return self._local.running
+        return self._proc is not None and self._proc.poll() is None
+
+    @property
+    def pid(self) -> int | None:
+        """Process id of the child (None in-process or when not started)."""
+        return None if self._proc is None else self._proc.pid
+
+    # ------------------------------------------------------------ remote calls
+
+    def _call(self, name: str, *args: Any, timeout: float = 10.0, **kw: Any) -> Any:
+        if self._local is not None:
+            attr = getattr(self._local, name)
+            return attr(*args, **kw) if name in _CALLS else attr
+        if self._conn is None:
+            raise RuntimeError(f"emulator on {self.host} is not running")
+        with self._lock:
+            self._conn.send((name, args, kw))
+            if not self._conn.poll(timeout):
+                raise TimeoutError(f"emulator on {self.host}: no answer to {name} in {timeout} s")
+            status, payload = self._conn.recv()
+        if status != "ok":
+            raise RuntimeError(f"emulator on {self.host}: {name}: {payload}")
+        return payload
+
+    # faults
+    def protective_stop(self, reason: str = "protective stop injected") -> None:
+        """Fault: protective stop (the arm brakes, the program stops; dashboard unlock)."""
+        self._call("protective_stop", reason)
+
+    def emergency_stop(self, reason: str = "emergency stop injected") -> None:
+        """Fault: emergency stop (the arm brakes, power goes off)."""
+        self._call("emergency_stop", reason)
+
+    def release_emergency_stop(self) -> None:
+        """Release the e-stop; then dashboard ``power on`` and ``brake release``."""
+        self._call("release_emergency_stop")
+
+    def drop_connections(self, refuse_for: float = 0.0) -> int:
+        """Fault: close every client connection; refuse new ones for ``refuse_for`` s."""
+        return int(self._call("drop_connections", refuse_for))
+
+    def set_slow(self, delay: float, jitter: float = 0.0) -> None:
+        """Fault: slow controller; data packages arrive ``delay`` (+ up to ``jitter``) s late."""
+        self._call("set_slow", delay, jitter)
+
+    def clear_faults(self) -> None:
+        """Safety NORMAL, robot RUNNING, normal stream (test helper)."""
+        self._call("clear_faults")
+
+    def reset(self, q: ArrayLike) -> None:
+        """Put the arm at rest at joint positions ``q``."""
+        self._call("reset", np.asarray(q, dtype=float).tolist())
+
+    # state
+    @property
+    def ports(self) -> dict[str, int]:
+        return dict(self._ports)
+
+    @property
+    def actual_q(self) -> np.ndarray:
+        """Actual joint positions [rad]."""
+        return np.asarray(self._call("actual_q"), dtype=float)
+
+    @property
+    def tcp_pose(self) -> np.ndarray:
+        """Actual TCP pose (UR vector)."""
+        return np.asarray(self._call("tcp_pose"), dtype=float)
+
+    @property
+    def robot_mode(self) -> RobotMode:
+        return RobotMode(self._call("robot_mode"))
+
+    @property
+    def safety_mode(self) -> SafetyMode:
+        return SafetyMode(self._call("safety_mode"))
+
+    @property
+    def runtime_state(self) -> RuntimeState:
+        return RuntimeState(self._call("runtime_state"))
+
+    @property
+    def events(self) -> list[tuple[float, int, str]]:
+        """The controller's log: (controller time, level, message)."""
+        return list(self._call("events"))
+
+    def stats(self) -> dict[str, float]:
+        """Clock timing and counters (see :meth:`ThreadedEmulator.stats_summary`)."""
+        return dict(self._call("stats_summary"))
+
+    def wait_for(self, predicate: Callable[[], bool], timeout: float = 5.0) -> bool:
+        """Poll ``predicate`` every 10 ms until it holds or ``timeout`` passes."""
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            if predicate():
+                return True
+            time.sleep(0.01)
+        return bool(predicate())
+
+    def __repr__(self) -> str:
+        where = "in-process" if self.in_process else f"pid {self.pid}"
+        return f"Emulator({self.model_name!r} on {self.host}, {where})"

@@ -1,0 +1,283 @@
+"""The RTDE server (port 30004): protocol negotiation, recipes, and the data stream.
+
+Per connection: ``V`` (protocol version 1 or 2) -> ``v`` (controller
+version) -> ``O`` (output recipe, with a frequency in v2) and ``I`` (input
+recipes, ids 1, 2, ... in setup order) -> ``S`` (start streaming) / ``P``
+(pause).  Exactly one reply per request and nothing unsolicited before the
+``S`` reply (ur_rtde reads one message per setup request).  Input data
+packages (``U``) are applied to the controller whether or not the connection
+is started (ur_rtde's IO interface never sends ``S``).
+
+Streaming: the controller's clock thread calls :meth:`RTDEServer.publish`
+once per control period; each started connection gets a data package when its
+own frequency is due (e.g. every 4th period for 125 Hz at 500 Hz).  Sends
+never block the clock: a connection that does not drain its socket
+accumulates a backlog and is closed beyond ``max_backlog`` bytes, as a real
+controller drops clients that do not read.  The ``slow controller`` fault
+holds every data package back by ``delay`` seconds.
+
+Malformed input (bad header, unknown packet type, wrong data size, unknown
+recipe id, non-finite doubles) closes that connection and is logged; the
+other connections are not affected.
+"""
+
+from __future__ import annotations
+
+import logging
+import random
+import socket
+import struct
+import threading
+from collections import deque
+from collections.abc import Mapping
+
+from .controller import Controller
+from .protocol import (
+    CONTROL_PACKAGE_PAUSE,
+    CONTROL_PACKAGE_SETUP_INPUTS,
+    CONTROL_PACKAGE_SETUP_OUTPUTS,
+    CONTROL_PACKAGE_START,
+    DATA_PACKAGE,
+    GET_URCONTROL_VERSION,
+    REQUEST_PROTOCOL_VERSION,
+    TEXT_MESSAGE,
+    InputRecipe,
+    OutputRecipe,
+    PacketFramer,
+    ProtocolError,
+    pack_packet,
+    parse_names,
+    parse_output_setup,
+)
+from .tcp import Connection, TcpServer
+
+__all__ = ["RTDEConnection", "RTDEServer", "StreamStats"]
+
+log = logging.getLogger("ruledrobot.export.emulator")
+
+
+class StreamStats:
+    """Counters of one connection's stream."""
+
+    def __init__(self) -> None:
+        self.packages = 0
+        self.bytes = 0
+        self.dropped_backlog = 0
+
+
+class RTDEConnection(Connection):
+    """Protocol state of one RTDE client."""
+
+    def __init__(self, sock: socket.socket, addr: tuple) -> None:
+        super().__init__(sock, addr)
+        self.protocol_version = 1
+        self.output: OutputRecipe | None = None
+        self.inputs: dict[int, InputRecipe] = {}
+        self.started = False
+        self.phase = 0.0
+        self.backlog = bytearray()
+        self.delayed: deque[tuple[float, bytes]] = deque()
+        self.stats = StreamStats()
+        self.owned: set[str] = set()
+        self.broken = False  # a send failed or the backlog overflowed: close
+
+    def push(self, data: bytes, max_backlog: int) -> None:
+        """Queue bytes and send what the socket takes now, never blocking."""
+        with self.write_lock:
+            if self.closed or self.broken:
+                return
+            self.backlog += data
+            self._flush_locked()
+            if len(self.backlog) > max_backlog:
+                self.stats.dropped_backlog += 1
+                log.warning("rtde: client %s does not read its data (%d bytes queued): closing",
+                            self.peer, len(self.backlog))  # fmt: skip
+                self.backlog.clear()
+                self.broken = True
+        if self.broken:
+            self.close()
+
+    def flush(self) -> None:
+        with self.write_lock:
+            if not self.closed and not self.broken and self.backlog:
+                self._flush_locked()
+        if self.broken:
+            self.close()
+
+    def _flush_locked(self) -> None:
+        try:
+            n = self.sock.send(self.backlog, socket.MSG_DONTWAIT)
+        except (BlockingIOError, InterruptedError):
+            return
+        except OSError:
+            self.backlog.clear()
+            self.broken = True
+            return
+        del self.backlog[:n]
+
+    def reply(self, kind: int, payload: bytes) -> None:
+        self.push(pack_packet(kind, payload), 1 << 30)
+
+
+class RTDEServer(TcpServer):
+    """RTDE on ``port`` (30004), feeding a :class:`Controller`.
+
+    ``version``: (major, minor, bugfix, build) reported to ``v`` requests.
+    """
+
+    name = "rtde"
+
+    def __init__(
+        self,
+        host: str,
+        port: int,
+        controller: Controller,
+        version: tuple[int, int, int, int],
+        *,
+        max_backlog: int = 512 * 1024,
+    ) -> None:
+        super().__init__(host, port)
+        self.controller = controller
+        self.version = version
+        self.max_backlog = max_backlog
+        self.delay = 0.0
+        self.jitter = 0.0
+        self._owners: dict[str, int] = {}
+        self._owner_lock = threading.Lock()
+        self._rng = random.Random(1)
+        self.protocol_errors = 0
+
+    def make_connection(self, sock: socket.socket, addr: tuple) -> Connection:
+        return RTDEConnection(sock, addr)
+
+    # ------------------------------------------------------------ reading
+
+    def handle(self, conn: Connection) -> None:
+        assert isinstance(conn, RTDEConnection)
+        framer = PacketFramer()
+
+        def on_data(data: bytes) -> None:
+            framer.feed(data)
+            for kind, payload in framer.packets():
+                self._packet(conn, kind, payload)
+
+        try:
+            self.recv_loop(conn, on_data)
+        except ProtocolError as exc:
+            self.protocol_errors += 1
+            log.warning("rtde: closing %s: protocol error: %s", conn.peer, exc)
+
+    def on_close(self, conn: Connection) -> None:
+        assert isinstance(conn, RTDEConnection)
+        with self._owner_lock:
+            for name in conn.owned:
+                if self._owners.get(name) == id(conn):
+                    del self._owners[name]
+
+    def _packet(self, conn: RTDEConnection, kind: int, payload: bytes) -> None:
+        if kind == REQUEST_PROTOCOL_VERSION:
+            if len(payload) != 2:
+                raise ProtocolError(f"protocol version request with {len(payload)} bytes")
+            (version,) = struct.unpack(">H", payload)
+            ok = version in (1, 2)
+            if ok:
+                conn.protocol_version = version
+            conn.reply(REQUEST_PROTOCOL_VERSION, bytes([int(ok)]))
+        elif kind == GET_URCONTROL_VERSION:
+            if payload:
+                raise ProtocolError("controller version request with a payload")
+            conn.reply(GET_URCONTROL_VERSION, struct.pack(">IIII", *self.version))
+        elif kind == CONTROL_PACKAGE_SETUP_OUTPUTS:
+            freq, names = parse_output_setup(payload, conn.protocol_version)
+            base = 1.0 / self.controller.period
+            freq = base if freq is None else min(freq, base)
+            if conn.started:
+                conn.reply(CONTROL_PACKAGE_SETUP_OUTPUTS, bytes([0]))
+                return
+            recipe = OutputRecipe(1, names, freq)
+            if recipe.ok:
+                conn.output = recipe
+                conn.phase = 1.0  # first package on the next period
+            else:
+                missing = [n for n, t in zip(names, recipe.types, strict=True) if t == "NOT_FOUND"]
+                log.info("rtde: %s asked for unknown outputs %s", conn.peer, missing)
+            conn.reply(CONTROL_PACKAGE_SETUP_OUTPUTS, recipe.reply())
+        elif kind == CONTROL_PACKAGE_SETUP_INPUTS:
+            names = parse_names(payload, "input setup")
+            if conn.started:
+                conn.reply(CONTROL_PACKAGE_SETUP_INPUTS, bytes([0]))
+                return
+            recipe = InputRecipe(len(conn.inputs) + 1, names)
+            if recipe.ok and recipe.recipe_id <= 255:
+                with self._owner_lock:
+                    taken = [n for n in names if self._owners.get(n, id(conn)) != id(conn)]
+                    if taken:
+                        types = ["IN_USE" if n in taken else t
+                                 for n, t in zip(names, recipe.types, strict=True)]  # fmt: skip
+                        conn.reply(CONTROL_PACKAGE_SETUP_INPUTS,
+                                   bytes([0]) + ",".join(types).encode())  # fmt: skip
+                        return
+                    for n in names:
+                        self._owners[n] = id(conn)
+                        conn.owned.add(n)
+                conn.inputs[recipe.recipe_id] = recipe
+            conn.reply(CONTROL_PACKAGE_SETUP_INPUTS, recipe.reply())
+        elif kind == CONTROL_PACKAGE_START:
+            ok = conn.output is not None
+            conn.started = ok
+            conn.reply(CONTROL_PACKAGE_START, bytes([int(ok)]))
+        elif kind == CONTROL_PACKAGE_PAUSE:
+            conn.started = False
+            conn.reply(CONTROL_PACKAGE_PAUSE, bytes([1]))
+        elif kind == DATA_PACKAGE:
+            if not payload:
+                raise ProtocolError("data package without a recipe id")
+            recipe = conn.inputs.get(payload[0])
+            if recipe is None:
+                raise ProtocolError(f"data package for unknown input recipe {payload[0]}")
+            values = recipe.unpack(payload[1:])
+            self.controller.apply_inputs(values, recipe.names)
+        elif kind == TEXT_MESSAGE:
+            log.info("rtde: text message from %s: %r", conn.peer, payload[:200])
+        else:  # pragma: no cover - the framer only passes known types
+            raise ProtocolError(f"unexpected packet type {kind}")
+
+    # ------------------------------------------------------------ streaming
+
+    def publish(self, state: Mapping[str, object], now: float) -> None:
+        """Send a data package to each started connection whose frequency is due."""
+        period = self.controller.period
+        delay = self.delay
+        for conn in self.connections():
+            if not isinstance(conn, RTDEConnection) or conn.closed:
+                continue
+            if conn.started and conn.output is not None:
+                conn.phase += conn.output.frequency * period
+                if conn.phase >= 1.0 - 1e-9:
+                    conn.phase -= 1.0
+                    conn.phase = min(conn.phase, 1.0)
+                    data = conn.output.pack(state)
+                    conn.stats.packages += 1
+                    conn.stats.bytes += len(data)
+                    if delay > 0.0 or conn.delayed:
+                        jit = self._rng.uniform(0.0, self.jitter) if self.jitter > 0 else 0.0
+                        conn.delayed.append((now + delay + jit, data))
+                    else:
+                        conn.push(data, self.max_backlog)
+            while conn.delayed and conn.delayed[0][0] <= now:
+                conn.push(conn.delayed.popleft()[1], self.max_backlog)
+            if conn.backlog:
+                conn.flush()
+
+    def set_delay(self, delay: float, jitter: float = 0.0) -> None:
+        """Slow-controller fault: hold data packages back by ``delay`` (+ up to ``jitter``) s."""
+        self.delay = max(0.0, float(delay))
+        self.jitter = max(0.0, float(jitter))
+
+    def stream_stats(self) -> list[tuple[str, int, int]]:
+        """(peer, packages sent, bytes sent) per connection."""
+        return [
+            (c.peer, c.stats.packages, c.stats.bytes)
+            for c in self.connections()
+            if isinstance(c, RTDEConnection)
+        ]

@@ -1,0 +1,390 @@
+"""The emulator core: a controller, its clock, and the three servers ur_rtde talks to.
+
+Ports default to the controller's (RTDE 30004, dashboard 29999, script
+30003).  ur_rtde's Python bindings cannot change them, so parallel emulators
+use distinct loopback addresses (127.0.0.2, 127.0.0.3, ...; all of
+127.0.0.0/8 is loopback on Linux).  The emulator binds to loopback only
+unless ``allow_remote=True``.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import ipaddress
+import logging
+import socket
+import sys
+import threading
+import time
+from collections import deque
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from ...robot import RobotModel, load
+from .backend import ArmBackend
+from .controller import Controller
+from .dashboard import DashboardServer
+from .rtde_server import RTDEServer
+from .script_port import ScriptPortServer
+from .states import RobotMode, RuntimeState, SafetyMode
+from .tcp import try_realtime_priority
+
+__all__ = ["CB3_VERSION", "E_SERIES_VERSION", "ClockStats", "ThreadedEmulator", "serve"]
+
+log = logging.getLogger("ruledrobot.export.emulator")
+
+#: controller versions reported to ``v``: e-Series (500 Hz) and CB3 (125 Hz)
+E_SERIES_VERSION = (5, 11, 1, 108318)
+CB3_VERSION = (3, 15, 7, 106331)
+
+_switch_lock = threading.Lock()
+_switch_users = 0
+_switch_saved = 0.005
+
+
+@dataclass
+class ClockStats:
+    """Timing of the controller clock.
+
+    ``ticks``: control periods run.  ``missed``: periods the clock was too
+    late to publish (it steps the controller to catch up, without sending).
+    ``lateness``: recent publish times minus their scheduled times [s].
+    """
+
+    ticks: int = 0
+    missed: int = 0
+    resyncs: int = 0
+    lateness: deque | None = None
+
+    def summary(self) -> dict[str, float]:
+        lat = np.asarray(self.lateness or [0.0])
+        return {
+            "ticks": float(self.ticks),
+            "missed": float(self.missed),
+            "missed_fraction": self.missed / max(1, self.ticks),
+            "lateness_mean_ms": float(lat.mean() * 1e3),
+            "lateness_p99_ms": float(np.percentile(lat, 99) * 1e3),
+            "lateness_max_ms": float(lat.max() * 1e3),
+        }
+
+
+def _check_host(host: str, allow_remote: bool) -> None:
+    try:
+        addr = ipaddress.ip_address(socket.gethostbyname(host))
+    except (OSError, ValueError):
+        raise ValueError(f"host: cannot resolve {host!r}") from None
+    if not addr.is_loopback and not allow_remote:
+        raise ValueError(
+            f"host: {host!r} is not a loopback address; pass allow_remote=True to serve "
+            "a network interface"
+        )
+
+
+class ThreadedEmulator:
+    """A UR controller on ``host`` in this process: RTDE, dashboard, script port, simulated arm.
+
+    Runs on threads of the calling process.  ur_rtde's Python bindings hold
+    the GIL while they wait for the controller, so a ur_rtde client in the
+    same process would deadlock it: use :class:`~.process.Emulator` (a child
+    process, the default) there; this class is what the child runs, and what
+    :func:`serve` runs.
+
+    Parameters
+    ----------
+    host : address to bind (loopback, e.g. ``"127.0.0.2"``, unless ``allow_remote``).
+    model : robot model name or :class:`RobotModel` (its control period sets the
+        clock: 500 Hz e-Series, 125 Hz CB3; its tool is the initial TCP).
+    backend : arm backend, or a factory called with the model (default: kinematic).
+    q0 : initial joint positions [rad].
+    rtde_port, dashboard_port, script_port : ports (0 picks free ones).
+    version : controller version reported to clients (default 5.11.1 for
+        e-Series models, 3.15.7 for CB3).
+    serial_number : digits, reported by ``get serial number``.
+    unlock_delay : seconds before a protective stop can be unlocked (5 on a robot).
+    allow_remote : allow a non-loopback ``host``.
+    realtime : try to run the clock thread with real-time priority
+        (``SCHED_FIFO`` 10, the server threads 5; needs CAP_SYS_NICE, silently
+        skipped otherwise): fewer missed periods when clients load the CPU.
+    """
+
+    def __init__(
+        self,
+        host: str = "127.0.0.1",
+        model: str | RobotModel = "ur5e",
+        *,
+        backend: ArmBackend | Callable[[RobotModel], ArmBackend] | None = None,
+        q0: ArrayLike | None = None,
+        rtde_port: int = 30004,
+        dashboard_port: int = 29999,
+        script_port: int = 30003,
+        version: tuple[int, int, int, int] | None = None,
+        serial_number: str = "20235500001",
+        unlock_delay: float = 5.0,
+        allow_remote: bool = False,
+        realtime: bool = True,
+    ) -> None:
+        _check_host(host, allow_remote)
+        self.realtime = realtime
+        self.realtime_clock = False
+        self.model = load(model) if isinstance(model, str) else model
+        if not serial_number.isdigit():
+            raise ValueError(f"serial_number: digits only, got {serial_number!r}")
+        if version is None:
+            version = E_SERIES_VERSION if self.model.control_period < 0.005 else CB3_VERSION
+        self.version = tuple(int(x) for x in version)
+        self.host = host
+        if isinstance(backend, type) or (callable(backend) and not hasattr(backend, "state")):
+            backend = backend(self.model)  # a factory: called with the model
+        self.controller = Controller(self.model, backend, q0=q0, unlock_delay=unlock_delay)
+        self.rtde = RTDEServer(host, rtde_port, self.controller, self.version)  # type: ignore[arg-type]
+        self.dashboard = DashboardServer(
+            host, dashboard_port, self.controller, version=self.version,  # type: ignore[arg-type]
+            serial_number=serial_number,
+        )  # fmt: skip
+        self.script = ScriptPortServer(host, script_port, self.controller)
+        for srv in (self.rtde, self.dashboard, self.script):
+            srv.realtime = realtime
+        self.stats = ClockStats(lateness=deque(maxlen=20000))
+        self._stop = threading.Event()
+        self._clock: threading.Thread | None = None
+        self._started = False
+
+    # ------------------------------------------------------------ lifecycle
+
+    def start(self) -> ThreadedEmulator:
+        """Bind the three ports and start the clock; returns self."""
+        if self._started:
+            return self
+        started = []
+        try:
+            for srv in (self.rtde, self.dashboard, self.script):
+                srv.start()
+                started.append(srv)
+        except OSError:
+            for srv in started:
+                srv.close(timeout=1.0)
+            raise
+        _acquire_switch_interval()
+        self._started = True
+        self._clock = threading.Thread(target=self._run_clock, name="emu-clock", daemon=True)
+        self._clock.start()
+        log.info("emulator %s on %s: rtde %d, dashboard %d, script %d", self.model.name,
+                 self.host, self.rtde.port, self.dashboard.port, self.script.port)  # fmt: skip
+        return self
+
+    def close(self, timeout: float = 3.0) -> None:
+        """Stop the clock and the servers; bounded by ``timeout`` seconds."""
+        if not self._started:
+            return
+        self._started = False
+        deadline = time.monotonic() + timeout
+        self._stop.set()
+        if self._clock is not None:
+            self._clock.join(max(0.1, deadline - time.monotonic()))
+        for srv in (self.rtde, self.dashboard, self.script):
+            srv.close(timeout=max(0.1, (deadline - time.monotonic()) / 3))
+        _release_switch_interval()
+
+    def __enter__(self) -> ThreadedEmulator:
+        return self.start()
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    @property
+    def running(self) -> bool:
+        return self._started and self._clock is not None and self._clock.is_alive()
+
+    # ------------------------------------------------------------ clock
+
+    def _run_clock(self) -> None:
+        if self.realtime:
+            self.realtime_clock = try_realtime_priority(10)
+        ctrl = self.controller
+        period = ctrl.period
+        stats = self.stats
+        lateness = stats.lateness
+        assert lateness is not None
+        next_t = time.perf_counter() + period
+        while not self._stop.is_set():
+            now = time.perf_counter()
+            wait = next_t - now
+            if wait > 0:
+                time.sleep(wait)
+            now = time.perf_counter()
+            late = now - next_t
+            if late > period:
+                # behind: step the controller through the missed periods without publishing
+                missed = int(late // period)
+                if missed > 25:
+                    stats.resyncs += 1
+                    next_t = now
+                    missed = 0
+                for _ in range(missed):
+                    ctrl.tick()
+                    stats.ticks += 1
+                stats.missed += missed
+                next_t += missed * period
+                late = now - next_t
+            try:
+                state = ctrl.tick()
+                self.rtde.publish(state, now)
+            except Exception:  # pragma: no cover - keep the clock alive whatever happens
+                log.exception("emulator: clock tick failed")
+            stats.ticks += 1
+            lateness.append(late)
+            next_t += period
+
+    # ------------------------------------------------------------ faults
+
+    def protective_stop(self, reason: str = "protective stop injected") -> None:
+        """Fault: protective stop (arm brakes, program stops; unlock via dashboard)."""
+        self.controller.protective_stop(reason)
+
+    def emergency_stop(self, reason: str = "emergency stop injected") -> None:
+        """Fault: emergency stop (arm brakes, power off)."""
+        self.controller.emergency_stop(reason)
+
+    def release_emergency_stop(self) -> None:
+        """Release the e-stop (then dashboard ``power on`` and ``brake release``)."""
+        self.controller.release_emergency_stop()
+
+    def drop_connections(self, refuse_for: float = 0.0) -> int:
+        """Fault: close every client connection; refuse new ones for ``refuse_for`` s."""
+        n = 0
+        for srv in (self.rtde, self.dashboard, self.script):
+            n += srv.drop_all(refuse_for)
+        self.controller.log(f"dropped {n} connections (refusing for {refuse_for:g} s)", level=2)
+        return n
+
+    def set_slow(self, delay: float, jitter: float = 0.0) -> None:
+        """Fault: a slow controller; every data package arrives ``delay`` (+ jitter) s late.
+
+        ``set_slow(0)`` restores the normal stream.
+        """
+        self.rtde.set_delay(delay, jitter)
+        self.controller.log(f"slow controller: delay {delay:g} s, jitter {jitter:g} s", level=2)
+
+    def clear_faults(self) -> None:
+        """Back to safety NORMAL, robot RUNNING, no delay (test helper)."""
+        self.rtde.set_delay(0.0)
+        self.controller.clear_faults()
+
+    # ------------------------------------------------------------ observation
+
+    @property
+    def actual_q(self) -> np.ndarray:
+        with self.controller.lock:
+            return self.controller.backend.state().q.copy()
+
+    @property
+    def tcp_pose(self) -> np.ndarray:
+        """Actual TCP pose as a UR vector."""
+        with self.controller.lock:
+            return np.asarray(self.controller.values["actual_TCP_pose"], dtype=float)
+
+    @property
+    def robot_mode(self) -> RobotMode:
+        return self.controller.robot_mode
+
+    @property
+    def safety_mode(self) -> SafetyMode:
+        return self.controller.safety_mode
+
+    @property
+    def runtime_state(self) -> RuntimeState:
+        return self.controller.runtime_state
+
+    @property
+    def events(self) -> list[tuple[float, int, str]]:
+        """Controller log: (controller time, level, message)."""
+        with self.controller.lock:
+            return list(self.controller.events)
+
+    @property
+    def ports(self) -> dict[str, int]:
+        """The bound ports: ``{"rtde": ..., "dashboard": ..., "script": ...}``."""
+        return {
+            "rtde": self.rtde.port,
+            "dashboard": self.dashboard.port,
+            "script": self.script.port,
+        }
+
+    def stats_summary(self) -> dict[str, float]:
+        """Clock timing (:meth:`ClockStats.summary`) plus RTDE counters."""
+        out = self.stats.summary()
+        out["rtde_protocol_errors"] = float(self.rtde.protocol_errors)
+        out["rtde_connections"] = float(len(self.rtde.connections()))
+        out["programs_received"] = float(self.script.programs_received)
+        out["limit_events"] = float(self.controller.limit_events)
+        out["realtime_clock"] = float(self.realtime_clock)
+        return out
+
+    def reset(self, q: ArrayLike) -> None:
+        """Put the arm at rest at ``q`` (no motion, no program change)."""
+        with self.controller.lock:
+            self.controller.motion = None
+            self.controller.mode = "idle"
+            self.controller._hold_q = None
+            self.controller.backend.reset(np.asarray(q, dtype=float))
+
+    def wait_for(self, predicate: Callable[[], bool], timeout: float = 5.0) -> bool:
+        """Poll ``predicate`` every 5 ms until it holds or ``timeout`` passes."""
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            if predicate():
+                return True
+            time.sleep(0.005)
+        return bool(predicate())
+
+    def __repr__(self) -> str:
+        return (f"ThreadedEmulator({self.model.name!r} on {self.host}, rtde {self.rtde.port}, "
+                f"{'running' if self.running else 'stopped'})")  # fmt: skip
+
+
+def _acquire_switch_interval() -> None:
+    """Shorten the GIL switch interval while an emulator runs (500 Hz needs < 1 ms)."""
+    global _switch_users, _switch_saved
+    with _switch_lock:
+        if _switch_users == 0:
+            _switch_saved = sys.getswitchinterval()
+            sys.setswitchinterval(min(_switch_saved, 0.0005))
+        _switch_users += 1
+
+
+def _release_switch_interval() -> None:
+    global _switch_users
+    with _switch_lock:
+        _switch_users = max(0, _switch_users - 1)
+        if _switch_users == 0:
+            with contextlib.suppress(ValueError):
+                sys.setswitchinterval(_switch_saved)
+
+
+def serve(
+    host: str = "127.0.0.1",
+    model: str | RobotModel = "ur5e",
+    *,
+    duration: float | None = None,
+    ready: Callable[[ThreadedEmulator], None] | None = None,
+    **kwargs: object,
+) -> None:
+    """Run an emulator until Ctrl-C (or for ``duration`` seconds); blocking.
+
+    ``ready(emulator)`` is called once it listens (e.g. to print the address);
+    other keyword arguments go to :class:`ThreadedEmulator`.  The emulator
+    runs in this process: connect clients from another process.
+    """
+    emu = ThreadedEmulator(host, model, **kwargs)  # type: ignore[arg-type]
+    with emu:
+        if ready is not None:
+            ready(emu)
+        t0 = time.monotonic()
+        try:
+            while duration is None or time.monotonic() - t0 < duration:
+                time.sleep(0.1)
+        except KeyboardInterrupt:
+            log.info("emulator: interrupted, shutting down")

@@ -1,0 +1,224 @@
+"""A small threaded TCP server: accept loop, one reader thread per connection, clean shutdown.
+
+Subclasses implement :meth:`TcpServer.handle` (the per-connection loop).  Every
+socket has a short timeout so threads notice :meth:`TcpServer.close` within
+``POLL`` seconds; ``close`` is bounded in time.  :meth:`TcpServer.drop_all`
+closes every connection and refuses new ones for a while (the "dropped
+connection" fault).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import logging
+import os
+import socket
+import threading
+import time
+from collections.abc import Callable
+
+__all__ = ["POLL", "Connection", "TcpServer"]
+
+log = logging.getLogger("ruledrobot.export.emulator")
+
+#: seconds between checks of the stop flag in blocking socket calls
+POLL = 0.1
+
+
+class Connection:
+    """One accepted client socket with a lock for writes and a closed flag."""
+
+    def __init__(self, sock: socket.socket, addr: tuple) -> None:
+        self.sock = sock
+        self.addr = addr
+        self.closed = False
+        self.write_lock = threading.Lock()
+
+    @property
+    def peer(self) -> str:
+        return f"{self.addr[0]}:{self.addr[1]}" if len(self.addr) >= 2 else str(self.addr)
+
+    def sendall(self, data: bytes) -> bool:
+        """Blocking send (replies); False when the connection is gone."""
+        if self.closed:
+            return False
+        try:
+            with self.write_lock:
+                self.sock.sendall(data)
+            return True
+        except OSError:
+            self.close()
+            return False
+
+    def close(self) -> None:
+        if self.closed:
+            return
+        self.closed = True
+        with contextlib.suppress(OSError):
+            self.sock.shutdown(socket.SHUT_RDWR)
+        with contextlib.suppress(OSError):
+            self.sock.close()
+
+
+def try_realtime_priority(priority: int) -> bool:
+    """Give the calling thread ``SCHED_FIFO`` ``priority`` if allowed (Linux, CAP_SYS_NICE)."""
+    setter = getattr(os, "sched_setscheduler", None)
+    if setter is None:
+        return False
+    try:
+        setter(0, os.SCHED_FIFO, os.sched_param(priority))
+    except (OSError, AttributeError):
+        return False
+    return True
+
+
+class TcpServer:
+    """Listens on (host, port); runs :meth:`handle` in a thread per connection.
+
+    With ``realtime`` set, the server's threads ask for ``SCHED_FIFO`` priority 5
+    (below the clock's 10): a thread holding the GIL is then never preempted by
+    ordinary processes while the clock waits for the GIL.
+    """
+
+    name = "tcp"
+    realtime = False
+
+    def __init__(self, host: str, port: int) -> None:
+        self.host = host
+        self.port = int(port)
+        self._stop = threading.Event()
+        self._lock = threading.Lock()
+        self._conns: dict[int, Connection] = {}
+        self._threads: list[threading.Thread] = []
+        self._refuse_until = 0.0
+        self._listener: socket.socket | None = None
+        self._accept_thread: threading.Thread | None = None
+        self.accepted = 0
+        self.errors = 0
+
+    # ------------------------------------------------------------ lifecycle
+
+    def start(self) -> None:
+        s = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+        s.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        try:
+            s.bind((self.host, self.port))
+        except OSError as exc:
+            s.close()
+            raise OSError(
+                f"{self.name} server: cannot listen on {self.host}:{self.port}: {exc}"
+            ) from None
+        s.listen(16)
+        s.settimeout(POLL)
+        self.port = s.getsockname()[1]
+        self._listener = s
+        self._accept_thread = threading.Thread(
+            target=self._accept_loop, name=f"emu-{self.name}-accept", daemon=True
+        )
+        self._accept_thread.start()
+
+    @property
+    def stopping(self) -> bool:
+        return self._stop.is_set()
+
+    def close(self, timeout: float = 2.0) -> None:
+        """Stop accepting, close every connection, join the threads (bounded by ``timeout``)."""
+        self._stop.set()
+        if self._listener is not None:
+            with contextlib.suppress(OSError):
+                self._listener.close()
+        for c in self.connections():
+            c.close()
+        deadline = time.monotonic() + timeout
+        threads = [self._accept_thread, *self._threads]
+        for t in threads:
+            if t is not None and t is not threading.current_thread():
+                t.join(max(0.0, deadline - time.monotonic()))
+
+    def connections(self) -> list[Connection]:
+        with self._lock:
+            return list(self._conns.values())
+
+    def drop_all(self, refuse_for: float = 0.0) -> int:
+        """Close every connection; refuse new ones for ``refuse_for`` seconds. Returns the count."""
+        self._refuse_until = time.monotonic() + max(0.0, refuse_for)
+        conns = self.connections()
+        for c in conns:
+            c.close()
+        return len(conns)
+
+    # ------------------------------------------------------------ internals
+
+    def _accept_loop(self) -> None:
+        assert self._listener is not None
+        if self.realtime:
+            try_realtime_priority(5)
+        while not self._stop.is_set():
+            try:
+                sock, addr = self._listener.accept()
+            except TimeoutError:
+                continue
+            except OSError:
+                if self._stop.is_set():
+                    return
+                time.sleep(POLL)
+                continue
+            if time.monotonic() < self._refuse_until:
+                with contextlib.suppress(OSError):
+                    sock.close()
+                continue
+            sock.settimeout(POLL)
+            with contextlib.suppress(OSError):
+                sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+            conn = self.make_connection(sock, addr)
+            self.accepted += 1
+            with self._lock:
+                self._conns[id(conn)] = conn
+                self._threads = [t for t in self._threads if t.is_alive()]
+                t = threading.Thread(
+                    target=self._run, args=(conn,), name=f"emu-{self.name}-{conn.peer}", daemon=True
+                )
+                self._threads.append(t)
+            t.start()
+
+    def _run(self, conn: Connection) -> None:
+        if self.realtime:
+            try_realtime_priority(5)
+        try:
+            self.handle(conn)
+        except Exception as exc:
+            self.errors += 1
+            log.warning(
+                "%s server: connection %s closed after an error: %s", self.name, conn.peer, exc
+            )
+        finally:
+            conn.close()
+            with self._lock:
+                self._conns.pop(id(conn), None)
+            self.on_close(conn)
+
+    def recv_loop(
+        self, conn: Connection, on_data: Callable[[bytes], None], bufsize: int = 65536
+    ) -> None:
+        """Read until the peer closes, the server stops or ``on_data`` raises."""
+        while not self._stop.is_set() and not conn.closed:
+            try:
+                data = conn.sock.recv(bufsize)
+            except TimeoutError:
+                continue
+            except OSError:
+                return
+            if not data:
+                return
+            on_data(data)
+
+    # ------------------------------------------------------------ for subclasses
+
+    def make_connection(self, sock: socket.socket, addr: tuple) -> Connection:
+        return Connection(sock, addr)
+
+    def handle(self, conn: Connection) -> None:
+        raise NotImplementedError
+
+    def on_close(self, conn: Connection) -> None:
+        """Called after a connection is closed and removed."""

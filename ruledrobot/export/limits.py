@@ -1,0 +1,92 @@
+"""Checks of a joint trajectory against a robot's limits, before anything moves.
+
+Speeds and accelerations are finite differences of the samples (the way the
+controller will see them when the samples are streamed one per period):
+``v_k = (q_k - q_{k-1}) / (t_k - t_{k-1})`` belongs to sample k,
+``a_k = (v_{k+1} - v_k) / ((t_{k+1} - t_{k-1}) / 2)`` to sample k.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..io.trajectory import Trajectory
+from ..robot import RobotModel
+
+__all__ = ["check_trajectory", "trajectory_rates"]
+
+
+def trajectory_rates(t: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Finite-difference joint speeds (M-1, J) and accelerations (M-2, J) of samples (M, J)."""
+    dt = np.diff(t)
+    v = np.diff(q, axis=0) / dt[:, None]
+    if q.shape[0] < 3:
+        return v, np.zeros((0, q.shape[1]))
+    a = np.diff(v, axis=0) / (0.5 * (t[2:] - t[:-2]))[:, None]
+    return v, a
+
+
+def check_trajectory(
+    traj: Trajectory,
+    model: RobotModel,
+    *,
+    speed_scale: float = 1.0,
+    tolerance: float = 0.01,
+) -> None:
+    """Raise ValueError at the first sample and joint outside the model's limits.
+
+    Positions must lie within ``[lower, upper]``; speeds within
+    ``max_velocity`` and accelerations within ``max_acceleration``, both
+    ``(1 + tolerance)`` times (finite differences of sampled, rounded files
+    carry a little noise).  ``speed_scale`` replays the trajectory that much
+    faster (speeds scale by it, accelerations by its square).  The message
+    names the sample index (0-based, the CSV data row), its time, the joint
+    (``q1`` .. ``q6``), the value and the limit.
+    """
+    if not speed_scale > 0:
+        raise ValueError(f"speed_scale: must be positive, got {speed_scale}")
+    t = np.asarray(traj.t, dtype=float)
+    q = np.asarray(traj.q, dtype=float)
+    n = model.n_joints
+    if t.ndim != 1 or q.ndim != 2 or q.shape != (t.size, n):
+        raise ValueError(
+            f"trajectory: expected t (M,) and q (M, {n}), got t {t.shape} and q {q.shape}"
+        )
+    if t.size < 2:
+        raise ValueError(f"trajectory: needs at least 2 samples, got {t.size}")
+    bad = ~np.isfinite(q)
+    if bad.any():
+        k, j = np.argwhere(bad)[0]
+        raise ValueError(f"trajectory sample {k}: joint q{j + 1} is not a finite number")
+    if np.any(~np.isfinite(t)) or np.any(np.diff(t) <= 0):
+        k = int(np.argmax(~np.isfinite(t[1:]) | (np.diff(t) <= 0))) + 1
+        raise ValueError(f"trajectory sample {k}: time t = {t[k]!r} does not increase")
+    ts = (t - t[0]) / speed_scale
+    lo, hi = np.asarray(model.lower), np.asarray(model.upper)
+    bad = (q < lo - 1e-9) | (q > hi + 1e-9)
+    if bad.any():
+        k, j = np.argwhere(bad)[0]
+        raise ValueError(
+            f"trajectory sample {k} (t = {t[k]:.4f} s): joint q{j + 1} position {q[k, j]:.6g} rad "
+            f"outside the limits [{lo[j]:.6g}, {hi[j]:.6g}] rad of {model.name}"
+        )
+    v, a = trajectory_rates(ts, q)
+    vmax = np.asarray(model.max_velocity) * (1.0 + tolerance)
+    bad = np.abs(v) > vmax
+    if bad.any():
+        k, j = np.argwhere(bad)[0]
+        raise ValueError(
+            f"trajectory sample {k + 1} (t = {t[k + 1]:.4f} s): joint q{j + 1} speed "
+            f"{abs(v[k, j]):.4g} rad/s exceeds the limit {model.max_velocity[j]:.4g} rad/s of "
+            f"{model.name}" + (f" at speed_scale {speed_scale:g}" if speed_scale != 1.0 else "")
+        )
+    amax = np.asarray(model.max_acceleration) * (1.0 + tolerance)
+    bad = np.abs(a) > amax
+    if bad.any():
+        k, j = np.argwhere(bad)[0]
+        raise ValueError(
+            f"trajectory sample {k + 1} (t = {t[k + 1]:.4f} s): joint q{j + 1} acceleration "
+            f"{abs(a[k, j]):.4g} rad/s^2 exceeds the limit {model.max_acceleration[j]:.4g} "
+            f"rad/s^2 of {model.name}"
+            + (f" at speed_scale {speed_scale:g}" if speed_scale != 1.0 else "")
+        )
