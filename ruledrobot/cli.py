@@ -189,6 +189,125 @@ def simulate(
         console.print(f"wrote {path}  ({name})", highlight=False)
 
 
+class ExportFormat(str, Enum):
+    csv = "csv"
+    json = "json"
+    npz = "npz"
+    urscript = "urscript"
+
+
+@app.command(
+    epilog="Example:  ruledrobot export out/demo/trajectory.csv --out cut.script --format urscript"
+)
+def export(
+    trajectory: Path = typer.Argument(..., help="Trajectory CSV."),
+    out: Path = typer.Option(..., "--out", "-o", help="Output file."),
+    fmt: ExportFormat | None = typer.Option(
+        None, "--format", "-f", help="csv, json, npz or urscript (default: from the suffix)."
+    ),
+    mode: str = typer.Option("servoj", help="URScript motion: servoj, movep or movel."),
+) -> None:
+    """Export a trajectory as CSV/JSON/NPZ or a standalone URScript program for the pendant."""
+    from .export import export_trajectory
+    from .io.trajectory import read_trajectory
+
+    try:
+        traj = read_trajectory(trajectory)
+        model = next(
+            (c.split(":", 1)[1].strip() for c in traj.comments if c.startswith("robot:")), "ur5e"
+        )
+        options = (
+            {"mode": mode}
+            if (fmt and fmt.value == "urscript") or out.suffix in (".script", ".urscript")
+            else {}
+        )
+        path = export_trajectory(
+            traj, out, None if fmt is None else fmt.value, model=model, **options
+        )
+    except ValueError as exc:
+        raise _fail(str(exc)) from None
+    console.print(f"wrote {path}")
+
+
+@app.command(
+    epilog="Example:  ruledrobot run out/demo/trajectory.csv --host 192.168.1.10   "
+    "(--dry-run checks without motion; without --host a local emulator is used)"
+)
+def run(
+    trajectory: Path = typer.Argument(..., help="Trajectory CSV."),
+    host: str | None = typer.Option(
+        None, help="Robot controller address; default: an embedded emulator on 127.0.0.42."
+    ),
+    mode: str = typer.Option("servoj", help="servoj (stream) or path (moveJ path + blends)."),
+    speed_scale: float = typer.Option(1.0, min=0.01, max=1.0, help="Slow the whole run down."),
+    dry_run: bool = typer.Option(False, "--dry-run", help="Check everything, move nothing."),
+) -> None:
+    """Stream a planned trajectory to a UR controller through RTDE (ur_rtde), with checks
+    before motion, monitoring and a safe stop; records the actual trajectory."""
+    result = _stream(trajectory, host, mode=mode, speed_scale=speed_scale, dry_run=dry_run)
+    if result.status != "completed" and not dry_run:
+        raise typer.Exit(code=1)
+
+
+def _stream(trajectory: Path, host: str | None, **options):
+    from .export import ControllerError, Emulator, run_trajectory
+    from .io.trajectory import read_trajectory
+
+    try:
+        traj = read_trajectory(trajectory)
+    except ValueError as exc:
+        raise _fail(str(exc)) from None
+    model = next(
+        (c.split(":", 1)[1].strip() for c in traj.comments if c.startswith("robot:")), "ur5e"
+    )
+    emulator = None
+    try:
+        if host is None and not options.get("dry_run"):
+            host = "127.0.0.42"
+            console.print(f"no --host: starting the embedded controller emulator on {host}")
+            emulator = Emulator(host, model, q0=traj.q[0]).start()
+        with console.status("streaming") as status:
+            result = run_trajectory(
+                trajectory,
+                host,
+                model,
+                progress=lambda i, n: status.update(f"streaming: sample {i} of {n}"),
+                **options,
+            )
+    except (ValueError, ControllerError) as exc:
+        raise _fail(str(exc)) from None
+    finally:
+        if emulator is not None:
+            emulator.close()
+    console.print(f"  {result.status}: {result.message}", highlight=False)
+    console.print(
+        f"  max deviation actual vs commanded: {result.max_deviation:.3g} rad", highlight=False
+    )
+    if result.actual_path is not None:
+        console.print(f"wrote {result.actual_path}  (actual trajectory)")
+    return result
+
+
+@app.command(epilog="Example:  ruledrobot ursim --host 127.0.0.2 --model ur5e")
+def ursim(
+    host: str = typer.Option("127.0.0.1", help="Address to listen on (loopback by default)."),
+    model: str = typer.Option("ur5e", help="Robot model."),
+) -> None:
+    """Run the controller emulator (RTDE 30004, dashboard 29999, script 30003) until Ctrl-C."""
+    from .export import serve
+
+    console.print(
+        f"UR controller emulator ({model}) on {host}: RTDE 30004, dashboard 29999, "
+        "script 30003; Ctrl-C to stop"
+    )
+    try:
+        serve(host, model)
+    except KeyboardInterrupt:
+        pass
+    except (ValueError, OSError) as exc:
+        raise _fail(str(exc)) from None
+
+
 def _print_report(report: dict) -> None:
     keys = [
         ("duration_s", "duration", "s"),
@@ -260,13 +379,26 @@ def plan(
 def demo(
     out: Path = typer.Option(Path("out/demo"), "--out", "-o", help="Output folder."),
     video: bool = typer.Option(True, "--video/--no-video", help="Render video.mp4 too."),
+    stream: bool = typer.Option(
+        True, "--stream/--no-stream", help="Stream the cut to the embedded RTDE emulator."
+    ),
 ) -> None:
     """Run the whole chain on the built-in example (a hyperbolic paraboloid cut in foam):
-    refine, plan, time, verify in MuJoCo, write the trajectory, render a video."""
+    refine, plan, time, verify in MuJoCo, render a video, export URScript, and stream
+    the cut through ur_rtde to the embedded controller emulator."""
+    from .export import export_trajectory
+    from .io.trajectory import read_trajectory
     from .wirecut.demo import DEMO_JOB
 
     console.print("[bold]ruledrobot demo[/]: hyperbolic paraboloid through a foam block, UR5e")
     _run_plan(None, out, job_text=DEMO_JOB, video=video)
+    traj_path = out / "trajectory.csv"
+    script = export_trajectory(read_trajectory(traj_path), out / "cut.script", model="ur5e")
+    console.print(f"wrote {script}  (URScript for the teach pendant)")
+    if stream:
+        result = _stream(traj_path, None)
+        if result.status != "completed":
+            raise typer.Exit(code=1)
     console.print(f"job file: {out / 'job.toml'} (edit it and run: ruledrobot plan)")
 
 

@@ -102,3 +102,33 @@ def test_simulate_command_reports_tracking(tmp_path):
     assert result.exit_code == 0, result.output
     assert "TCP position error" in result.output
     assert (tmp_path / "sim" / "report.json").exists()
+
+
+def _small_trajectory(tmp_path):
+    from ruledrobot.io.trajectory import write_trajectory
+
+    model = rr.robot.load("ur5e")
+    t = np.arange(0, 0.6, 0.002)
+    q = np.array([3.0, -1.2, 1.4, -1.8, -1.57, 0.0]) + 0.02 * (1 - np.cos(np.pi * t / 0.6))[:, None]
+    return write_trajectory(tmp_path / "t.csv", t, q, model.fk(q), comments=["robot: ur5e"])
+
+
+def test_export_urscript_and_dry_run(tmp_path):
+    traj = _small_trajectory(tmp_path)
+    out = tmp_path / "cut.script"
+    result = runner.invoke(app, ["export", str(traj), "--out", str(out)])
+    assert result.exit_code == 0, result.output
+    text = out.read_text()
+    assert "movej(" in text and text.count("servoj(") >= 299
+    result = runner.invoke(app, ["run", str(traj), "--dry-run"])
+    assert result.exit_code == 0, result.output
+    bad = runner.invoke(app, ["export", str(traj), "--out", str(tmp_path / "x.txt")])
+    assert bad.exit_code == 2
+
+
+def test_run_streams_to_the_embedded_emulator(tmp_path):
+    traj = _small_trajectory(tmp_path)
+    result = runner.invoke(app, ["run", str(traj)])
+    assert result.exit_code == 0, result.output
+    assert "completed" in result.output
+    assert (tmp_path / "t.actual.csv").exists()
