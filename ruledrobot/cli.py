@@ -264,8 +264,12 @@ def _stream(trajectory: Path, host: str | None, **options):
     try:
         if host is None and not options.get("dry_run"):
             host = "127.0.0.42"
-            console.print(f"no --host: starting the embedded controller emulator on {host}")
-            emulator = Emulator(host, model, q0=traj.q[0]).start()
+            console.print(
+                f"no --host: starting the embedded MuJoCo-backed controller emulator on {host}"
+            )
+            from .export.emulator.physics import MujocoBackend
+
+            emulator = Emulator(host, model, q0=traj.q[0], backend=MujocoBackend).start()
         with console.status("streaming") as status:
             result = run_trajectory(
                 trajectory,
