@@ -21,7 +21,7 @@ __version__ = "0.1.0"
 
 def __getattr__(name: str):
     """Import the heavier sub-packages on first use (``rr.robot``), keeping ``import`` fast."""
-    if name in ("robot",):
+    if name in ("robot", "sim", "export", "wirecut"):
         import importlib
 
         return importlib.import_module(f".{name}", __name__)

@@ -1,0 +1,10 @@
+"""Hot-wire cutting: job files, the cut path, the time law, the planner.
+
+    from ruledrobot.wirecut import load_job, plan
+    result = plan(load_job("job.toml"), "out/cut")
+"""
+
+from .job import Job, load_job, parse_job
+from .planner import PlanResult, plan
+
+__all__ = ["Job", "PlanResult", "load_job", "parse_job", "plan"]
