@@ -28,6 +28,7 @@ from numpy.typing import ArrayLike
 from ..geometry._arrays import FloatArray
 from ..geometry.lines import Lines, plucker_from_point_direction, validate_plucker
 from .atomic import atomic_write_text
+from .text import read_user_text
 
 __all__ = ["FORMAT", "LinesDocument", "load_lines", "read_lines_document", "save_lines"]
 
@@ -171,13 +172,7 @@ def _read_csv(path: Path, text: str) -> LinesDocument:
 
 def read_lines_document(path: str | os.PathLike[str]) -> LinesDocument:
     """Read a ``.json`` or ``.csv`` lines file (see module doc); ValueError on bad content."""
-    p = Path(path)
-    try:
-        text = p.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise ValueError(f"{p}: no such file") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ValueError(f"{p}: cannot read ({exc})") from None
+    p, text = read_user_text(path, "file")
     suffix = p.suffix.lower()
     if suffix == ".json":
         return _read_json(p, text)

@@ -19,6 +19,7 @@ from numpy.typing import ArrayLike
 from ..geometry._arrays import FloatArray, as_float_array
 from ..geometry.se3 import pose_from_ur_vector, ur_vector_from_pose
 from .atomic import atomic_write_text
+from .text import read_user_text
 
 __all__ = ["HEADER", "Trajectory", "read_trajectory", "write_trajectory"]
 
@@ -80,13 +81,7 @@ def write_trajectory(
 
 def read_trajectory(path: str | os.PathLike[str]) -> Trajectory:
     """Read a trajectory CSV; ValueError names the file and line of any problem."""
-    p = Path(path)
-    try:
-        text = p.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise ValueError(f"{p}: no such trajectory file") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ValueError(f"{p}: cannot read ({exc})") from None
+    p, text = read_user_text(path, "trajectory file")
     comments: list[str] = []
     rows: list[list[float]] = []
     header_seen = False

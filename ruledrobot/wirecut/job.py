@@ -54,6 +54,7 @@ import numpy as np
 from ..geometry import se3
 from ..geometry.box import Box
 from ..geometry.lines import Lines
+from ..io.text import read_user_text
 from ..subdivision.schemes import SCHEME_NAMES
 
 if sys.version_info >= (3, 11):
@@ -356,13 +357,7 @@ def parse_job(doc: dict, where: str = "job", base_dir: Path | None = None) -> Jo
 
 def load_job(path: str | os.PathLike[str]) -> Job:
     """Read and validate a TOML job file; ValueError names the file, section and field."""
-    p = Path(path)
-    try:
-        text = p.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise ValueError(f"{p}: no such job file") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ValueError(f"{p}: cannot read ({exc})") from None
+    p, text = read_user_text(path, "job file")
     try:
         doc = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
