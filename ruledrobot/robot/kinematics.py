@@ -133,6 +133,38 @@ def dh_fk(
     return out
 
 
+def dh_skeleton(
+    q: FloatArray,
+    d: FloatArray,
+    a: FloatArray,
+    alpha: FloatArray,
+    theta_offset: FloatArray,
+    base: FloatArray | None = None,
+) -> FloatArray:
+    """The DH skeleton of configurations ``q`` (n, J): points (n, 2J + 1, 3) [m].
+
+    Point 0 is the base origin; joint ``i`` adds the point ``d_i`` along the previous
+    z axis and then its frame origin (``a_i`` along x_i), with the joint step of
+    :func:`dh_fk`.
+    """
+    n = q.shape[0]
+    theta = np.ascontiguousarray((q + theta_offset).T)
+    ct, st = np.cos(theta), np.sin(theta)
+    frame = _start_frame(np.eye(4) if base is None else base)
+    pts = [frame[3]]
+    for j in range(theta.shape[0]):
+        p, z = frame[3], frame[2]
+        pts.append([p[k] + float(d[j]) * z[k] for k in range(3)])
+        ca, sa = _snap(float(np.cos(alpha[j]))), _snap(float(np.sin(alpha[j])))
+        frame = _joint_step(frame, ct[j], st[j], float(d[j]), float(a[j]), ca, sa)
+        pts.append(frame[3])
+    out = np.empty((n, len(pts), 3))
+    for i, pt in enumerate(pts):
+        for k in range(3):
+            out[:, i, k] = pt[k]
+    return out
+
+
 def _broadcast(frame: Frame, n: int) -> Frame:
     """Frame components as arrays of length n (a joint-free chain keeps floats)."""
     return tuple([np.broadcast_to(v, (n,)) for v in vec] for vec in frame)  # type: ignore[return-value]

@@ -36,7 +36,7 @@ from ._checks import (
     as_poses,
     readonly,
 )
-from .kinematics import dh_fk, dh_jacobian
+from .kinematics import dh_fk, dh_jacobian, dh_skeleton
 
 if TYPE_CHECKING:
     from .path import PathIKResult
@@ -484,22 +484,10 @@ class RobotModel:
         """
         q = self._joints(q)
         shape = q.shape[:-1]
-        qf = q.reshape(-1, self.n_joints) + self.theta_offset
-        n = qf.shape[0]
-        T = np.broadcast_to(self.base, (n, 4, 4)).copy()
-        pts = [T[:, :3, 3].copy()]
-        for j in range(self.n_joints):
-            pts.append(T[:, :3, 3] + self.d[j] * T[:, :3, 2])
-            c, s_ = np.cos(qf[:, j]), np.sin(qf[:, j])
-            ca, sa = np.cos(self.alpha[j]), np.sin(self.alpha[j])
-            A = np.zeros((n, 4, 4))
-            A[:, 0, 0], A[:, 0, 1], A[:, 0, 2], A[:, 0, 3] = c, -s_ * ca, s_ * sa, self.a[j] * c
-            A[:, 1, 0], A[:, 1, 1], A[:, 1, 2], A[:, 1, 3] = s_, c * ca, -c * sa, self.a[j] * s_
-            A[:, 2, 1], A[:, 2, 2], A[:, 2, 3] = sa, ca, self.d[j]
-            A[:, 3, 3] = 1.0
-            T = T @ A
-            pts.append(T[:, :3, 3].copy())
-        return np.stack(pts, axis=1).reshape(*shape, 2 * self.n_joints + 1, 3)
+        base = None if self._base_inv is None else self.base
+        pts = dh_skeleton(q.reshape(-1, self.n_joints), self.d, self.a, self.alpha,
+                          self.theta_offset, base)  # fmt: skip
+        return pts.reshape(*shape, 2 * self.n_joints + 1, 3)
 
     def within_limits(self, q: ArrayLike, tol: float = 0.0) -> np.ndarray:
         """(...) bool: every joint of ``q`` (..., J) inside ``[lower - tol, upper + tol]``."""

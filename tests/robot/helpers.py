@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..conftest import random_poses, random_rotations  # noqa: F401  (shared generators)
+
 
 def dh_matrix(theta: float, d: float, a: float, alpha: float) -> np.ndarray:
     """Standard DH link transform Rz(theta) Tz(d) Tx(a) Rx(alpha), written out."""
@@ -41,27 +43,6 @@ def angle_diff(x: np.ndarray, y: np.ndarray) -> np.ndarray:
 def pose_error(A: np.ndarray, B: np.ndarray) -> np.ndarray:
     """Max absolute entry difference of poses (..., 4, 4)."""
     return np.abs(np.asarray(A) - np.asarray(B)).max(axis=(-1, -2))
-
-
-def random_rotations(rng: np.random.Generator, n: int) -> np.ndarray:
-    """Uniform random rotations (n, 3, 3) from unit quaternions."""
-    q = rng.normal(size=(n, 4))
-    q /= np.linalg.norm(q, axis=1, keepdims=True)
-    w, x, y, z = q.T
-    R = np.empty((n, 3, 3))
-    R[:, 0] = np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], -1)
-    R[:, 1] = np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], -1)
-    R[:, 2] = np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], -1)
-    return R
-
-
-def random_poses(rng: np.random.Generator, n: int, scale: float = 1.0) -> np.ndarray:
-    """Random rigid motions (n, 4, 4), translations ~ N(0, scale^2)."""
-    T = np.zeros((n, 4, 4))
-    T[:, :3, :3] = random_rotations(rng, n)
-    T[:, :3, 3] = scale * rng.normal(size=(n, 3))
-    T[:, 3, 3] = 1.0
-    return T
 
 
 def solutions_contain(sols: np.ndarray, q: np.ndarray, tol: float) -> np.ndarray:

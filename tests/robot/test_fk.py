@@ -113,3 +113,25 @@ def test_within_limits() -> None:
     q = np.zeros((3, 6))
     q[1, 2] = 3.5
     assert m.within_limits(q).tolist() == [True, False, True]
+
+
+def test_link_points_are_the_dh_skeleton(rng) -> None:
+    from ruledrobot.geometry import se3
+    from ruledrobot.robot import load
+
+    from .helpers import dh_matrix
+
+    model = load("ur10e").with_base(se3.pose_from_ur_vector([0.1, 0.2, 0.3, 0.1, -0.2, 0.3]))
+    q = rng.uniform(-3.0, 3.0, size=(20, 6))
+    pts = model.link_points(q)
+    assert pts.shape == (20, 13, 3)
+    for n in range(20):
+        T = model.base.copy()
+        expected = [T[:3, 3]]
+        for j in range(6):
+            expected.append(T[:3, 3] + model.d[j] * T[:3, 2])  # along the previous z by d
+            T = T @ dh_matrix(q[n, j] + model.theta_offset[j], model.d[j], model.a[j],
+                              model.alpha[j])  # fmt: skip
+            expected.append(T[:3, 3])
+        np.testing.assert_allclose(pts[n], expected, atol=1e-12)
+    np.testing.assert_allclose(pts[:, -1], model.fk(q)[:, :3, 3], atol=1e-12)
