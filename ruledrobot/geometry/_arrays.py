@@ -64,3 +64,13 @@ def cross(a: FloatArray, b: FloatArray) -> FloatArray:
 def dot(a: FloatArray, b: FloatArray) -> FloatArray:
     """Dot product over the last axis (..., 3) -> (...), broadcasting."""
     return a[..., 0] * b[..., 0] + a[..., 1] * b[..., 1] + a[..., 2] * b[..., 2]
+
+
+def dot3(a: tuple, b: tuple) -> FloatArray:
+    """Dot product of vectors given as component tuples ``(x, y, z)`` of arrays."""
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+def cross3(a: tuple, b: tuple) -> tuple:
+    """Cross product of vectors given as component tuples ``(x, y, z)`` of arrays."""
+    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])

@@ -21,7 +21,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ._arrays import FloatArray, as_float_array, cross, dot, first_index, norm
+from ._arrays import FloatArray, as_float_array, cross, cross3, dot, dot3, first_index, norm
 
 __all__ = [
     "CommonNormal",
@@ -218,14 +218,6 @@ def _any_normal(l: FloatArray) -> FloatArray:
     return n / norm(n)[..., None]
 
 
-def _cross3(a: tuple, b: tuple) -> tuple:
-    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
-
-
-def _dot3(a: tuple, b: tuple) -> FloatArray:
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-
-
 def common_normal(
     line1: ArrayLike,
     line2: ArrayLike,
@@ -247,15 +239,15 @@ def common_normal(
     a = np.ascontiguousarray(np.moveaxis(np.broadcast_to(x1, shape), -1, 0))
     b = np.ascontiguousarray(np.moveaxis(np.broadcast_to(x2, shape), -1, 0))
     l1, m1, l2, m2 = tuple(a[:3]), tuple(a[3:]), tuple(b[:3]), tuple(b[3:])
-    p1 = _cross3(l1, m1)
-    p2 = _cross3(l2, m2)
-    c = _cross3(l1, l2)
-    s2 = _dot3(c, c)
+    p1 = cross3(l1, m1)
+    p2 = cross3(l2, m2)
+    c = cross3(l1, l2)
+    s2 = dot3(c, c)
     s = np.sqrt(s2)
-    cosang = _dot3(l1, l2)
+    cosang = dot3(l1, l2)
     d = tuple(p2[k] - p1[k] for k in range(3))
-    dl1 = _dot3(d, l1)
-    dl2 = _dot3(d, l2)
+    dl1 = dot3(d, l1)
+    dl2 = dot3(d, l2)
     parallel = s <= angle_tol
     any_parallel = bool(parallel.any())
     s2safe = np.where(parallel, 1.0, s2) if any_parallel else s2
@@ -265,7 +257,7 @@ def common_normal(
     # distance (p2 - p1) . n is well conditioned even when the feet are not
     inv_s = 1.0 / (np.where(parallel, 1.0, s) if any_parallel else s)
     n = tuple(ck * inv_s for ck in c)
-    signed = _dot3(d, n)
+    signed = dot3(d, n)
     dist = np.abs(signed)
     sign = np.where(signed < 0.0, -1.0, 1.0)
     if any_parallel:
@@ -277,8 +269,8 @@ def common_normal(
                 np.broadcast_to(np.asarray(reference, dtype=np.float64), (*shape[:-1], 3)), -1, 0
             )
             ref = tuple(r)
-        t1 = np.where(parallel, _dot3(tuple(ref[k] - p1[k] for k in range(3)), l1), t1)
-        t2 = np.where(parallel, _dot3(tuple(ref[k] - p2[k] for k in range(3)), l2), t2)
+        t1 = np.where(parallel, dot3(tuple(ref[k] - p1[k] for k in range(3)), l1), t1)
+        t2 = np.where(parallel, dot3(tuple(ref[k] - p2[k] for k in range(3)), l2), t2)
     f1 = tuple(p1[k] + t1 * l1[k] for k in range(3))
     f2 = tuple(p2[k] + t2 * l2[k] for k in range(3))
     intersecting = ~parallel & (dist <= dist_tol)
@@ -287,9 +279,9 @@ def common_normal(
     if any_parallel:
         # the gap between the feet, made exactly normal to l1
         gap = tuple(f2[k] - f1[k] for k in range(3))
-        along = _dot3(gap, l1)
+        along = dot3(gap, l1)
         gap = tuple(gap[k] - along * l1[k] for k in range(3))
-        gap_len = np.sqrt(_dot3(gap, gap))
+        gap_len = np.sqrt(dot3(gap, gap))
         inv_g = 1.0 / np.where(gap_len > 0.0, gap_len, 1.0)
         direction = tuple(np.where(parallel, gap[k] * inv_g, direction[k]) for k in range(3))
         dist = np.where(parallel, gap_len, dist)
@@ -298,7 +290,7 @@ def common_normal(
             other = np.moveaxis(_any_normal(np.stack(l1, axis=-1)), -1, 0)
             direction = tuple(np.where(identical, other[k], direction[k]) for k in range(3))
     # twist angle about the normal direction, in (-pi, pi]
-    angle = np.arctan2(_dot3(c, direction), cosang)
+    angle = np.arctan2(dot3(c, direction), cosang)
     dist = np.where(intersecting, 0.0, dist)
     f2 = tuple(np.where(intersecting, f1[k], f2[k]) for k in range(3))
     f1 = np.stack(f1, axis=-1)

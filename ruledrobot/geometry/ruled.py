@@ -39,7 +39,8 @@ rule is used.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
+from functools import cached_property
 from typing import Literal
 
 import numpy as np
@@ -103,7 +104,6 @@ class RuledSurface:
     flip: bool | None = None
     tol: float = 1e-10
     angle_tol: float = 1e-10
-    _normals: list = field(default_factory=list, init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         if not isinstance(self.lines, Lines):
@@ -138,15 +138,16 @@ class RuledSurface:
 
     def common_normals(self) -> CommonNormal:
         """Common normals of consecutive rulings (pairs (i, i+1)), parallel rule applied."""
-        if self._normals:
-            return self._normals[0]
+        return self._common_normals
+
+    @cached_property
+    def _common_normals(self) -> CommonNormal:
         x = self.lines.plucker
         first = x[: self.n_pairs]
         second = self._next_lines()
         cn = common_normal(first, second, angle_tol=self.angle_tol, dist_tol=self.tol)
         if np.any(cn.parallel):
             cn = self._parallel_rule(cn, first, second)
-        self._normals.append(cn)
         return cn
 
     def _parallel_rule(

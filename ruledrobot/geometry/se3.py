@@ -39,7 +39,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ._arrays import FloatArray, as_float_array, first_index
+from ._arrays import FloatArray, as_float_array, cross3, dot3, first_index
 
 __all__ = [
     "ScrewPair",
@@ -318,15 +318,15 @@ def validate_poses(T: ArrayLike, name: str = "poses", tol: float = 1e-6) -> Floa
     for lo in range(0, n, _CHUNK):
         c = flat[lo : lo + _CHUNK].T
         x, y, z = (c[0], c[4], c[8]), (c[1], c[5], c[9]), (c[2], c[6], c[10])
-        e = np.abs(_dot3(x, x) - 1.0)
-        e = np.maximum(e, np.abs(_dot3(y, y) - 1.0))
-        e = np.maximum(e, np.abs(_dot3(z, z) - 1.0))
-        e = np.maximum(e, np.abs(_dot3(x, y)))
-        e = np.maximum(e, np.abs(_dot3(x, z)))
-        e = np.maximum(e, np.abs(_dot3(y, z)))
+        e = np.abs(dot3(x, x) - 1.0)
+        e = np.maximum(e, np.abs(dot3(y, y) - 1.0))
+        e = np.maximum(e, np.abs(dot3(z, z) - 1.0))
+        e = np.maximum(e, np.abs(dot3(x, y)))
+        e = np.maximum(e, np.abs(dot3(x, z)))
+        e = np.maximum(e, np.abs(dot3(y, z)))
         # right-handed: (x cross y) . z = det R = +1; a reflection gives -1
-        xy = (x[1] * y[2] - x[2] * y[1], x[2] * y[0] - x[0] * y[2], x[0] * y[1] - x[1] * y[0])
-        e = np.maximum(e, np.abs(_dot3(xy, z) - 1.0))
+        xy = cross3(x, y)
+        e = np.maximum(e, np.abs(dot3(xy, z) - 1.0))
         for k in (12, 13, 14):
             e = np.maximum(e, np.abs(c[k]))
         err[lo : lo + _CHUNK] = np.maximum(e, np.abs(c[15] - 1.0))
@@ -343,10 +343,6 @@ def validate_poses(T: ArrayLike, name: str = "poses", tol: float = 1e-6) -> Floa
             what = f"rotation part is not orthonormal (error {err[i]:.2e}, tolerance {tol:g})"
         raise ValueError(f"{name}{where}: {what}")
     return T
-
-
-def _dot3(u: tuple, v: tuple) -> FloatArray:
-    return u[0] * v[0] + u[1] * v[1] + u[2] * v[2]
 
 
 def compose(A: ArrayLike, B: ArrayLike) -> FloatArray:

@@ -1,5 +1,7 @@
 """Hot-wire cutting: job files, the cut path, the time law, the planner.
 
+Usage::
+
     from ruledrobot.wirecut import load_job, plan
     result = plan(load_job("job.toml"), "out/cut")
 """

@@ -30,7 +30,7 @@ from ..geometry._arrays import FloatArray
 from ..io.atomic import atomic_write_bytes, atomic_write_text
 from ..io.lines import save_lines
 from ..io.trajectory import write_trajectory
-from ..robot import load
+from ..robot import load, wrap_angle
 from .job import Job
 from .measure import feed_speeds, limit_ratios, wire_points
 from .path import CutPath, chord_ends_in_flange, cut_path
@@ -55,7 +55,8 @@ class PlanResult:
 
 
 def _wrap_near(q: FloatArray, ref: FloatArray) -> FloatArray:
-    return ref + (q - ref + np.pi) % (2.0 * np.pi) - np.pi
+    """The 2 pi representatives of ``q`` nearest ``ref``."""
+    return ref + wrap_angle(q - ref)
 
 
 def _backed_off(model, q: FloatArray, away: FloatArray, dist: float) -> FloatArray | None:
@@ -221,7 +222,7 @@ def plan(
             sim_files["video"] = render_video(scene, out / "video.mp4", traj.t, pb.q)
         timings["simulation_s"] = time.perf_counter() - t3
     cut_feed = feed[hit_t]
-    interior = hit_t & ~traj.feed_limited if hasattr(traj, "feed_limited") else hit_t
+    interior = hit_t & ~traj.feed_limited
     report.setdefault("max_wire_deviation_mm", None)
     report.setdefault("max_tcp_tracking_error_mm", None)
     report.update(

@@ -41,7 +41,7 @@ import numpy as np
 from ..geometry._arrays import FloatArray
 from ..geometry.box import Box
 from ..geometry.segments import segment_distance
-from ..robot import path_ik
+from ..robot import path_ik, wrap_angle
 from ..sim.scene import BowTool
 from .job import ToolSpec
 from .toolpath import chords, flange_poses, slide_bounds, wire_frame, wire_poses
@@ -362,10 +362,6 @@ def solve_redundancy(
     return failure(best.reverse, slide, len(scores))
 
 
-def _wrap(a: FloatArray) -> FloatArray:
-    return (a + np.pi) % (2.0 * np.pi) - np.pi
-
-
 def _ladder_roll(
     cell: _Cell,
     F,
@@ -395,11 +391,11 @@ def _ladder_roll(
     qn = np.nan_to_num(q).reshape(n, k * 8, 6)
     node_ok = valid.reshape(n, k * 8)
     roll_of = np.repeat(grid, 8)
-    droll = _wrap(roll_of[:, None] - roll_of[None, :]) ** 2
+    droll = wrap_angle(roll_of[:, None] - roll_of[None, :]) ** 2
     cost = np.where(node_ok[0], 0.0, np.inf)
     back = np.zeros((n, k * 8), dtype=np.intp)
     for i in range(1, n):
-        dq = _wrap(qn[i - 1][:, None, :] - qn[i][None, :, :])  # (N, N, 6)
+        dq = wrap_angle(qn[i - 1][:, None, :] - qn[i][None, :, :])  # (N, N, 6)
         step = np.abs(dq).max(axis=-1)
         c = (dq * dq).sum(-1) + roll_weight * droll
         c = np.where(step <= jump, c, np.inf)
