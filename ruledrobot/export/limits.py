@@ -12,18 +12,9 @@ import numpy as np
 
 from ..io.trajectory import Trajectory
 from ..robot import RobotModel
+from ..robot.rates import finite_difference_rates
 
-__all__ = ["check_trajectory", "trajectory_rates"]
-
-
-def trajectory_rates(t: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Finite-difference joint speeds (M-1, J) and accelerations (M-2, J) of samples (M, J)."""
-    dt = np.diff(t)
-    v = np.diff(q, axis=0) / dt[:, None]
-    if q.shape[0] < 3:
-        return v, np.zeros((0, q.shape[1]))
-    a = np.diff(v, axis=0) / (0.5 * (t[2:] - t[:-2]))[:, None]
-    return v, a
+__all__ = ["check_trajectory"]
 
 
 def check_trajectory(
@@ -70,7 +61,7 @@ def check_trajectory(
             f"trajectory sample {k} (t = {t[k]:.4f} s): joint q{j + 1} position {q[k, j]:.6g} rad "
             f"outside the limits [{lo[j]:.6g}, {hi[j]:.6g}] rad of {model.name}"
         )
-    v, a = trajectory_rates(ts, q)
+    v, a = finite_difference_rates(ts, q)
     vmax = np.asarray(model.max_velocity) * (1.0 + tolerance)
     bad = np.abs(v) > vmax
     if bad.any():

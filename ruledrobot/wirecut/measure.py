@@ -1,6 +1,7 @@
 """Independent measurements of a sampled cut trajectory (used by the report and tests).
 
-Everything here works on the *sampled* joints (what the controller receives),
+Everything here works on the *sampled* joints (the joint-limit check is
+:func:`ruledrobot.wirecut.timing.trajectory_limits_report`) (what the controller receives),
 through forward kinematics — never on the planner's internal numbers.
 """
 
@@ -10,7 +11,7 @@ import numpy as np
 
 from ..geometry._arrays import FloatArray
 
-__all__ = ["feed_speeds", "limit_ratios", "wire_points"]
+__all__ = ["feed_speeds", "wire_points"]
 
 
 def wire_points(flange: FloatArray, points_in_flange: FloatArray) -> FloatArray:
@@ -36,18 +37,3 @@ def feed_speeds(
     behind = wire_points(flange[prv], e)
     v = np.linalg.norm(ahead - behind, axis=-1) / (t[nxt] - t[prv])[:, None]
     return np.where(inside, v.max(axis=1), 0.0)
-
-
-def limit_ratios(
-    t: FloatArray, q: FloatArray, velocity: FloatArray, acceleration: FloatArray
-) -> dict[str, float]:
-    """Largest ``|qd|/limit`` and ``|qdd|/limit`` over the samples (finite differences)."""
-    if len(t) < 3:
-        return {"max_joint_speed_ratio": 0.0, "max_joint_accel_ratio": 0.0}
-    qd = np.diff(q, axis=0) / np.diff(t)[:, None]
-    tm = 0.5 * (t[1:] + t[:-1])
-    qdd = np.diff(qd, axis=0) / np.diff(tm)[:, None]
-    return {
-        "max_joint_speed_ratio": float((np.abs(qd) / velocity).max()),
-        "max_joint_accel_ratio": float((np.abs(qdd) / acceleration).max()),
-    }

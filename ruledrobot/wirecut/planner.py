@@ -32,10 +32,10 @@ from ..io.lines import save_lines
 from ..io.trajectory import write_trajectory
 from ..robot import load, wrap_angle
 from .job import Job
-from .measure import feed_speeds, limit_ratios, wire_points
+from .measure import feed_speeds, wire_points
 from .path import CutPath, chord_ends_in_flange, cut_path
 from .redundancy import bow_segments
-from .timing import TimedPath, concatenate, joint_move, time_path
+from .timing import TimedPath, concatenate, joint_move, time_path, trajectory_limits_report
 from .toolpath import speed_factor, wire_frame
 
 __all__ = ["LIFT", "PlanResult", "plan"]
@@ -176,7 +176,7 @@ def plan(
     hit_t = in_cut & m.hit[i0] & m.hit[i0 + 1]
     ends_t = _interp_rows(s_t, s, _fill_nearest(ends, m.hit))
     feed = feed_speeds(traj.t, flange, ends_t, hit_t)
-    ratios = limit_ratios(traj.t, traj.q, model.max_velocity, model.max_acceleration)
+    ratios = trajectory_limits_report(traj.t, traj.q, model.max_velocity, model.max_acceleration)
     # bow clearance along the whole sampled motion (approach and retract too)
     segs = bow_segments(job.tool)
     world = wire_points(flange, segs.reshape(1, 6, 3).repeat(len(flange), 0)).reshape(-1, 3, 2, 3)
@@ -238,8 +238,8 @@ def plan(
             )
             if interior.any()
             else 0.0,
-            "max_joint_speed_ratio": ratios["max_joint_speed_ratio"],
-            "max_joint_accel_ratio": ratios["max_joint_accel_ratio"],
+            "max_joint_speed_ratio": ratios["max_speed_ratio"],
+            "max_joint_accel_ratio": ratios["max_acc_ratio"],
             "min_singularity_measure": float(model.singularity_measure(traj.q[in_cut]).min()),
             "max_planned_wire_deviation_mm": float(dev[hit_t].max() * 1e3) if hit_t.any() else 0.0,
             "collisions": collisions,

@@ -68,6 +68,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ..robot.rates import finite_difference_rates
+
 __all__ = [
     "CONTINUITY_TOL",
     "FEED_HOLD_TOL",
@@ -316,8 +318,7 @@ def trajectory_limits_report(
         "worst_acc": None,
     }
     if M >= 2:
-        h = np.diff(t)
-        v = np.diff(q, axis=0) / h[:, None]
+        v, a = finite_difference_rates(t, q)
         r = np.abs(v) / vlim
         k, j = np.unravel_index(int(np.argmax(r)), r.shape)
         out.update(
@@ -325,7 +326,6 @@ def trajectory_limits_report(
             max_speed_ratio=float(r[k, j]), worst_speed=(int(k), int(j)),
         )  # fmt: skip
         if M >= 3:
-            a = np.diff(v, axis=0) / (0.5 * (h[1:] + h[:-1]))[:, None]
             r = np.abs(a) / alim
             k, j = np.unravel_index(int(np.argmax(r)), r.shape)
             out.update(
