@@ -39,8 +39,32 @@ class SchemeName(str, Enum):
 
 
 def _fail(message: str) -> typer.Exit:
-    err.print(f"[bold red]error:[/] {message}", highlight=False)
+    """Print a bad-input error literally (no markup: ``[cut]`` stays) and exit 2."""
+    from rich.text import Text
+
+    err.print(Text("error: ", style="bold red") + Text(str(message)), highlight=False)
     return typer.Exit(code=2)
+
+
+def _print_verdict(verdict, title: str) -> None:
+    """The table of checks (value, limit, ok) and the verdict line, printed literally."""
+    from rich.table import Table
+    from rich.text import Text
+
+    table = Table(title=title, title_justify="left", show_edge=False, pad_edge=False)
+    for col in ("check", "value", "limit", "ok"):
+        table.add_column(col, justify="right" if col in ("value", "limit") else "left")
+    for c in verdict.checks:
+        mark = (Text("ok", style="green") if c.ok else Text("FAIL", style="bold red")) \
+            if c.gating else Text("info", style="dim")
+        table.add_row(Text(c.label), Text(c.value_text), Text(c.limit_text), mark)
+    console.print(table)
+    for c in verdict.failed:
+        for line in c.detail.splitlines():
+            err.print(Text(f"  {c.name}: ", style="bold red") + Text(line), highlight=False)
+    style = "bold green" if verdict.ok else "bold red"
+    word = "PASS" if verdict.ok else "FAIL"
+    console.print(Text(f"verdict: {word} — {verdict.summary()}", style=style), highlight=False)
 
 
 @app.command(
@@ -189,6 +213,12 @@ def simulate(
         console.print(f"wrote {path}  ({name})", highlight=False)
 
 
+class ScriptMode(str, Enum):
+    servoj = "servoj"
+    movep = "movep"
+    movel = "movel"
+
+
 class ExportFormat(str, Enum):
     csv = "csv"
     json = "json"
@@ -205,25 +235,22 @@ def export(
     fmt: ExportFormat | None = typer.Option(
         None, "--format", "-f", help="csv, json, npz or urscript (default: from the suffix)."
     ),
-    mode: str = typer.Option("servoj", help="URScript motion: servoj, movep or movel."),
+    mode: ScriptMode = typer.Option(ScriptMode.servoj, help="URScript motion."),
+    allow_long: bool = typer.Option(
+        False, "--allow-long", help="Write a URScript program beyond the safe size (see docs)."
+    ),
 ) -> None:
-    """Export a trajectory as CSV/JSON/NPZ or a standalone URScript program for the pendant."""
+    """Export a trajectory as CSV/JSON/NPZ or a standalone URScript program for the pendant.
+
+    Every program sets the TCP and the payload from the trajectory's metadata."""
     from .export import export_trajectory
     from .io.trajectory import read_trajectory
 
     try:
         traj = read_trajectory(trajectory)
-        model = next(
-            (c.split(":", 1)[1].strip() for c in traj.comments if c.startswith("robot:")), "ur5e"
-        )
-        options = (
-            {"mode": mode}
-            if (fmt and fmt.value == "urscript") or out.suffix in (".script", ".urscript")
-            else {}
-        )
-        path = export_trajectory(
-            traj, out, None if fmt is None else fmt.value, model=model, **options
-        )
+        is_script = (fmt and fmt.value == "urscript") or out.suffix in (".script", ".urscript")
+        options = {"mode": mode.value, "allow_long": allow_long} if is_script else {}
+        path = export_trajectory(traj, out, None if fmt is None else fmt.value, **options)
     except ValueError as exc:
         raise _fail(str(exc)) from None
     console.print(f"wrote {path}")
@@ -257,9 +284,8 @@ def _stream(trajectory: Path, host: str | None, **options):
         traj = read_trajectory(trajectory)
     except ValueError as exc:
         raise _fail(str(exc)) from None
-    model = next(
-        (c.split(":", 1)[1].strip() for c in traj.comments if c.startswith("robot:")), "ur5e"
-    )
+    options.pop("yes", None)
+    model = traj.meta.robot
     emulator = None
     try:
         if host is None and not options.get("dry_run"):
@@ -312,39 +338,15 @@ def ursim(
         raise _fail(str(exc)) from None
 
 
-def _print_report(report: dict) -> None:
-    keys = [
-        ("duration_s", "duration", "s"),
-        ("cut_duration_s", "cut", "s"),
-        ("path_rulings", "rulings on the path", ""),
-        ("max_feed_speed_mm_s", "max feed speed", "mm/s"),
-        ("feed_within_1pct_fraction", "feed within 1% (fraction of the cut)", ""),
-        ("max_joint_speed_ratio", "max joint speed / limit", ""),
-        ("max_joint_accel_ratio", "max joint accel / limit", ""),
-        ("min_singularity_measure", "min singularity measure", ""),
-        ("max_planned_wire_deviation_mm", "planned wire deviation", "mm"),
-        ("max_wire_deviation_mm", "simulated wire deviation", "mm"),
-        ("max_tcp_tracking_error_mm", "simulated TCP tracking error", "mm"),
-    ]
-    for key, label, unit in keys:
-        v = report.get(key)
-        if v is not None:
-            console.print(f"  {label}: {v:.4g} {unit}".rstrip(), highlight=False)
-    for c in report.get("collisions", []):
-        console.print(f"  [yellow]collision:[/] {c}", highlight=False)
+def _run_plan(job_path: Path, out: Path, video: bool = False):
+    """Plan a job file into ``out``; prints the table of checks and the verdict.
 
-
-def _run_plan(
-    job_path: Path | None, out: Path, job_text: str | None = None, video: bool = False
-) -> dict:
-    from .sim import RenderUnavailable
+    Exit 2 on bad input (nothing written), 1 when a check fails (report and plots
+    written, no trajectory); returns the :class:`~ruledrobot.wirecut.planner.PlanResult`.
+    """
     from .wirecut.job import load_job
     from .wirecut.planner import plan as do_plan
 
-    if job_text is not None:
-        from .io.atomic import atomic_write_text
-
-        job_path = atomic_write_text(out / "job.toml", job_text)
     try:
         job = load_job(job_path)
         with console.status("planning") as status:
@@ -353,19 +355,16 @@ def _run_plan(
             )
     except ValueError as exc:
         raise _fail(str(exc)) from None
-    except RenderUnavailable as exc:  # the plan itself is written; only the video is missing
-        err.print(f"[yellow]no video:[/] {exc}")
-        return _run_plan(job_path, out, None, video=False)
-    if not result.feasible:
-        err.print("[bold red]infeasible job:[/]")
-        for r in result.report.get("reasons", []):
-            err.print(f"  - {r}", highlight=False)
-        err.print(f"wrote {out / 'report.json'}")
-        raise typer.Exit(code=1)
-    _print_report(result.report)
+    for note in result.report.get("notes", []):
+        err.print(f"note: {note}", highlight=False, markup=False)
+    _print_verdict(result.verdict, f"checks of {job_path}")
     for name, path in result.files.items():
-        console.print(f"wrote {path}  ({name})", highlight=False)
-    return result.report
+        console.print(f"wrote {path}  ({name})", highlight=False, markup=False)
+    if not result.feasible:
+        err.print(f"no trajectory written: the plan fails ({out / 'report.json'} says why)",
+                  highlight=False, markup=False)  # fmt: skip
+        raise typer.Exit(code=1)
+    return result
 
 
 @app.command(epilog="Example:  ruledrobot plan job.toml --out out/cut   (job format: README)")
@@ -390,20 +389,29 @@ def demo(
     """Run the whole chain on the built-in example (a hyperbolic paraboloid cut in foam):
     refine, plan, time, verify in MuJoCo, render a video, export URScript, and stream
     the cut through ur_rtde to the embedded controller emulator."""
+    import tempfile
+
     from .export import export_trajectory
-    from .io.trajectory import read_trajectory
     from .wirecut.demo import DEMO_JOB
 
     console.print("[bold]ruledrobot demo[/]: hyperbolic paraboloid through a foam block, UR5e")
-    _run_plan(None, out, job_text=DEMO_JOB, video=video)
+    with tempfile.TemporaryDirectory() as tmp:
+        job_path = Path(tmp) / "job.toml"
+        job_path.write_text(DEMO_JOB, encoding="utf-8")
+        result = _run_plan(job_path, out, video=video)
     traj_path = out / "trajectory.csv"
-    script = export_trajectory(read_trajectory(traj_path), out / "cut.script", model="ur5e")
-    console.print(f"wrote {script}  (URScript for the teach pendant)")
+    try:
+        script = export_trajectory(result.trajectory, out / "cut.script", allow_long=True)
+    except ValueError as exc:
+        raise _fail(str(exc)) from None
+    console.print(f"wrote {script}  (URScript for the teach pendant; streaming is the route for "
+                  "long cuts: docs/rtde.md)", highlight=False, markup=False)  # fmt: skip
     if stream:
-        result = _stream(traj_path, None)
-        if result.status != "completed":
+        res = _stream(traj_path, None, yes=True)
+        if res.status != "completed":
             raise typer.Exit(code=1)
-    console.print(f"job file: {out / 'job.toml'} (edit it and run: ruledrobot plan)")
+    console.print(f"job file: {out / 'job.toml'} (edit it and run: ruledrobot plan)",
+                  highlight=False, markup=False)  # fmt: skip
 
 
 def main() -> None:

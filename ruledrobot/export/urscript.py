@@ -1,25 +1,36 @@
-"""Standalone URScript programs from a joint trajectory, and trajectory export in four formats.
+"""Standalone URScript programs from a trajectory, and trajectory export in four formats.
 
 :func:`urscript_program` writes a program a UR controller runs by itself
-(send it to port 30003, or load it on the pendant)::
+(send it to port 30003, or load it in a Script node on the pendant; see
+``docs/rtde.md``)::
 
     def ruledrobot_cut():
-      set_tcp(p[...])                                  # the model's tool
+      set_tcp(p[...])                                  # the trajectory's TCP offset
+      set_payload(1.0, [cx, cy, cz])                   # the trajectory's payload
       movej([q0...], a=0.5, v=0.25)                    # approach at reduced speed
-      servoj([q...], t=0.002, lookahead_time=0.1, gain=300)   # one line per sample
+      servoj([q...], t=0.002, lookahead_time=0.1, gain=300)   # one per sample
       ...
       stopj(2.0)
     end
 
-``mode="servoj"`` streams every sample (``t`` = the time to the next
-sample: the controller period for trajectories sampled at it; the last one
-holds for ``5 * lookahead`` so that the arm settles on it);
-``mode="movep"`` / ``"movel"`` replaces the samples by linear moves through
-the TCP path decimated to a tolerance, with blends, each at the speed the
-trajectory has there.
+Sent to port 30003 (or 30001/30002) the ``def`` runs as a program; in a Script
+node of PolyScope the file only defines ``ruledrobot_cut()``, which a second
+node must call (``docs/rtde.md``).  Every mode sets the TCP and the payload from the trajectory's metadata, so the
+poses of ``movel``/``movep`` (the trajectory's TCP column) are the controller's
+TCP poses, and FK(q) · TCP equals them.  ``mode="servoj"`` streams every sample
+(``t`` = the time to the next sample; the last one holds for ``5 * lookahead``
+so that the arm settles on it); ``mode="movep"`` / ``"movel"`` replaces the
+samples by linear moves through the TCP path decimated to a tolerance, with
+blends, each at the speed the trajectory has there.
 
-:func:`export_trajectory` writes a trajectory as CSV (the project format),
-JSON, NPZ or URScript, atomically.
+Size: programs with more than :data:`WARN_MOTION_LINES` motion lines say so in
+a comment and a ``textmsg``; beyond :data:`MAX_MOTION_LINES` lines or
+:data:`MAX_PROGRAM_BYTES` bytes they are refused unless ``allow_long=True``
+(field reports tell of programs with a few thousand targets failing and of an
+18 MB program crashing a controller; stream long cuts with ``ruledrobot run``).
+
+:func:`export_trajectory` writes a trajectory as CSV (with its sidecar), JSON,
+NPZ or URScript, atomically.
 """
 
 from __future__ import annotations
@@ -33,15 +44,42 @@ import numpy as np
 
 from ..geometry.se3 import ur_vector_from_pose
 from ..io.atomic import atomic_write_bytes, atomic_write_text
-from ..io.trajectory import HEADER, Trajectory, write_trajectory
-from ..robot import RobotModel, load
+from ..io.trajectory import HEADER, TRAJECTORY_FORMAT, meta_to_dict, write_trajectory
+from ..robot import model_for
+from ..robot.trajectory import Trajectory
 from .decimate import decimate_tcp_path
 
-__all__ = ["EXPORT_FORMATS", "export_trajectory", "urscript_program"]
+__all__ = [
+    "EXPORT_FORMATS",
+    "MAX_MOTION_LINES",
+    "MAX_PROGRAM_BYTES",
+    "WARN_MOTION_LINES",
+    "export_trajectory",
+    "program_size_note",
+    "urscript_program",
+]
 
 #: formats of :func:`export_trajectory` and the file suffixes that select them
 EXPORT_FORMATS = {".csv": "csv", ".json": "json", ".npz": "npz", ".script": "urscript",
                   ".urscript": "urscript"}  # fmt: skip
+#: Programs with more motion lines than this carry a warning (comment, textmsg).
+WARN_MOTION_LINES = 2_000
+#: Programs beyond either size are refused unless ``allow_long``.
+MAX_MOTION_LINES = 20_000
+MAX_PROGRAM_BYTES = 2_000_000
+#: servoj/lookahead ranges the controller accepts (URScript manual).
+LOOKAHEAD_RANGE = (0.03, 0.2)
+GAIN_RANGE = (100.0, 2000.0)
+
+
+def check_servo_options(lookahead: float, gain: float) -> None:
+    """ValueError unless ``lookahead`` [s] and ``gain`` are in the controller's ranges."""
+    lo, hi = LOOKAHEAD_RANGE
+    if not lo <= lookahead <= hi:
+        raise ValueError(f"lookahead: {lookahead} s outside [{lo}, {hi}] (URScript servoj)")
+    lo, hi = GAIN_RANGE
+    if not lo <= gain <= hi:
+        raise ValueError(f"gain: {gain} outside [{lo:g}, {hi:g}] (URScript servoj)")
 
 
 def _num(x: float, digits: int) -> str:
@@ -53,9 +91,17 @@ def _vec(v: np.ndarray, digits: int) -> str:
     return "[" + ", ".join(_num(x, digits) for x in v) + "]"
 
 
+def program_size_note(motion_lines: int, size: int) -> str | None:
+    """A warning for a long program (None when it is short)."""
+    if motion_lines <= WARN_MOTION_LINES:
+        return None
+    return (f"long program: {motion_lines:,} motion lines, {size / 1e6:.1f} MB; controllers "
+            f"have failed on programs of a few thousand targets: prefer streaming "
+            f"(ruledrobot run) or a path mode (movep/movel)")  # fmt: skip
+
+
 def urscript_program(
     traj: Trajectory,
-    model: RobotModel | str = "ur5e",
     *,
     mode: str = "servoj",
     lookahead: float = 0.1,
@@ -67,17 +113,17 @@ def urscript_program(
     blend: float = 0.002,
     acceleration: float = 1.0,
     name: str = "ruledrobot_cut",
-    set_tcp: bool = True,
     digits: int = 10,
+    allow_long: bool = False,
 ) -> str:
     """A standalone URScript program playing ``traj`` (see the module docstring).
 
     Parameters
     ----------
-    traj : the trajectory (joint samples; the TCP column is used by the path modes).
-    model : robot model or name (its tool is written as ``set_tcp``).
+    traj : the trajectory; its metadata gives the TCP offset and payload set by the
+        program, and the robot (control period).
     mode : ``"servoj"`` (one ``servoj`` per sample), ``"movep"`` or ``"movel"``
-        (decimated linear moves with blends).
+        (decimated linear moves of the TCP column, with blends).
     lookahead, gain : servoj parameters (0.03-0.2 s, 100-2000).
     approach_speed, approach_acceleration : the initial ``movej`` [rad/s, rad/s^2].
     tolerance, angle_tolerance : decimation of the path modes [m, rad].
@@ -86,33 +132,23 @@ def urscript_program(
     acceleration : tool acceleration of the path modes [m/s^2].
     name : the program's function name.
     digits : significant digits of every number.
+    allow_long : write programs beyond :data:`MAX_MOTION_LINES` / :data:`MAX_PROGRAM_BYTES`.
     """
-    robot = load(model) if isinstance(model, str) else model
+    if not isinstance(traj, Trajectory):
+        raise ValueError(f"trajectory: expected a ruledrobot Trajectory, got {type(traj).__name__}")
+    robot = model_for(traj.meta)
     if mode not in ("servoj", "movep", "movel"):
         raise ValueError(f"mode: expected 'servoj', 'movep' or 'movel', got {mode!r}")
     if not name.isidentifier():
         raise ValueError(f"name: {name!r} is not a URScript identifier")
-    if not 0.03 <= lookahead <= 0.2:
-        raise ValueError(f"lookahead: {lookahead} s outside [0.03, 0.2]")
-    if not 100 <= gain <= 2000:
-        raise ValueError(f"gain: {gain} outside [100, 2000]")
-    t = np.asarray(traj.t, dtype=float)
-    q = np.asarray(traj.q, dtype=float)
-    if q.ndim != 2 or q.shape[1] != 6 or q.shape[0] != t.size or t.size < 1:
-        raise ValueError(f"trajectory: expected t (M,) and q (M, 6), got {t.shape}, {q.shape}")
-    if not np.all(np.isfinite(q)):
-        k = int(np.argwhere(~np.isfinite(q))[0, 0])
-        raise ValueError(f"trajectory sample {k}: not a finite joint vector")
+    check_servo_options(lookahead, gain)
+    t, q = traj.t, traj.q
     period = float(robot.control_period)
-    out = io.StringIO()
-    w = out.write
-    w(f"def {name}():\n")
-    w(f"  # ruledrobot trajectory program: {t.size} samples, {t[-1] - t[0]:.3f} s, "
-      f"robot {robot.name}, mode {mode}\n")  # fmt: skip
-    for c in traj.comments:
-        w(f"  # {c}\n")
-    if set_tcp:
-        w(f"  set_tcp(p{_vec(ur_vector_from_pose(robot.tool), digits)})\n")
+    meta = traj.meta
+    body = io.StringIO()
+    w = body.write
+    w(f"  set_tcp(p{_vec(ur_vector_from_pose(meta.tcp_offset), digits)})\n")
+    w(f"  set_payload({_num(meta.payload.mass, digits)}, {_vec(meta.payload.cog, digits)})\n")
     w('  textmsg("ruledrobot: moving to the start")\n')
     w(f"  movej({_vec(q[0], digits)}, a={_num(approach_acceleration, digits)}, "
       f"v={_num(approach_speed, digits)})\n")  # fmt: skip
@@ -126,8 +162,9 @@ def urscript_program(
             w(f"  servoj({_vec(qk, digits)}, t={_num(dt, digits)}, lookahead_time={la}, "
               f"gain={g})\n")  # fmt: skip
         w("  stopj(2.0)\n")
+        motion_lines = t.size
     else:
-        tcp = np.asarray(traj.tcp, dtype=float)
+        tcp = traj.tcp
         keep = decimate_tcp_path(tcp, tolerance, angle_tolerance)
         p = tcp[:, :3]
         arc = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(p, axis=0), axis=1))]
@@ -139,8 +176,30 @@ def urscript_program(
             r = min(blend, 0.45 * L, 0.45 * float(lengths[n])) if n < len(keep) - 1 else 0.0
             w(f"  {mode}(p{_vec(tcp[k], digits)}, a={_num(acceleration, digits)}, "
               f"v={_num(v, digits)}, r={_num(max(r, 0.0), digits)})\n")  # fmt: skip
+        motion_lines = len(keep) - 1
     w('  textmsg("ruledrobot: done")\n')
-    w("end\n")
+    size = body.tell()
+    if not allow_long and (motion_lines > MAX_MOTION_LINES or size > MAX_PROGRAM_BYTES):
+        raise ValueError(
+            f"URScript program: {motion_lines:,} motion lines, {size / 1e6:.1f} MB — beyond the "
+            f"safe size ({MAX_MOTION_LINES:,} lines, {MAX_PROGRAM_BYTES / 1e6:g} MB). Stream it "
+            "with `ruledrobot run`, use mode movep/movel, or pass allow_long (--allow-long)"
+        )
+    out = io.StringIO()
+    out.write(f"def {name}():\n")
+    out.write(f"  # ruledrobot trajectory program: {t.size} samples, {traj.duration:.3f} s, "
+              f"robot {robot.name}, mode {mode}\n")  # fmt: skip
+    out.write(f"  # kinematics {meta.kinematics.source} {meta.kinematics.checksum}\n")
+    if meta.source:
+        out.write(f"  # from: {meta.source}\n")
+    if meta.job:
+        out.write(f"  # job: {meta.job.get('path')} sha256 {meta.job.get('sha256')}\n")
+    note = program_size_note(motion_lines, size)
+    if note:
+        out.write(f"  # {note}\n")
+        out.write(f'  textmsg("ruledrobot: {note.split(":")[0]}: {motion_lines} motion lines")\n')
+    out.write(body.getvalue())
+    out.write("end\n")
     return out.getvalue()
 
 
@@ -148,18 +207,16 @@ def export_trajectory(
     traj: Trajectory,
     path: str | os.PathLike[str],
     fmt: str | None = None,
-    *,
-    model: RobotModel | str = "ur5e",
     **urscript_options: object,
 ) -> Path:
     """Write ``traj`` to ``path`` as ``"csv"``, ``"json"``, ``"npz"`` or ``"urscript"`` (atomic).
 
-    ``fmt`` defaults to the suffix (:data:`EXPORT_FORMATS`).  CSV is the
-    project's trajectory format; JSON is ``{"format": "ruledrobot.trajectory/1",
-    "units": ..., "header": [...], "t": [...], "q": [[...]], "tcp": [[...]],
-    "comments": [...]}``; NPZ holds arrays ``t``, ``q``, ``tcp`` and
-    ``comments``; URScript is :func:`urscript_program` (``model`` and
-    ``urscript_options`` go to it).  Returns the path written.
+    ``fmt`` defaults to the suffix (:data:`EXPORT_FORMATS`).  CSV is the project's
+    trajectory format (the CSV and its sidecar ``.json``); JSON is
+    ``{"format": "ruledrobot.trajectory/1", "meta": {sidecar fields}, "header": [...],
+    "t": [...], "q": [[...]], "tcp": [[...]]}``; NPZ holds arrays ``t``, ``q``,
+    ``tcp`` and ``meta`` (the sidecar fields as JSON text); URScript is
+    :func:`urscript_program` (``urscript_options`` go to it).  Returns the path.
     """
     p = Path(path)
     if fmt is None:
@@ -169,26 +226,27 @@ def export_trajectory(
                 f"{p}: cannot tell the format from the suffix {p.suffix!r}; pass fmt= one of "
                 "'csv', 'json', 'npz', 'urscript'"
             )
-    t = np.asarray(traj.t, dtype=float)
-    q = np.asarray(traj.q, dtype=float)
-    tcp = np.asarray(traj.tcp, dtype=float)
     if fmt == "csv":
-        return write_trajectory(p, t, q, tcp, traj.comments)
+        return write_trajectory(p, traj)
     if fmt == "json":
+        if p.with_suffix(".csv").exists():
+            raise ValueError(f"{p}: would replace the metadata of {p.with_suffix('.csv').name} "
+                             "beside it; choose another name")  # fmt: skip
         doc = {
-            "format": "ruledrobot.trajectory/1",
-            "units": {"t": "s", "q": "rad", "tcp": "m, rad (UR pose vector)"},
+            "format": TRAJECTORY_FORMAT,
+            "units": {"t": "s", "q": "rad", "tcp": "m, rad (UR pose vector, robot base frame)"},
+            "meta": meta_to_dict(traj.meta),
             "header": HEADER,
-            "comments": list(traj.comments),
-            "t": t.tolist(),
-            "q": q.tolist(),
-            "tcp": tcp.tolist(),
+            "t": traj.t.tolist(),
+            "q": traj.q.tolist(),
+            "tcp": traj.tcp.tolist(),
         }
         return atomic_write_text(p, json.dumps(doc, indent=None, separators=(",", ":")) + "\n")
     if fmt == "npz":
         buf = io.BytesIO()
-        np.savez_compressed(buf, t=t, q=q, tcp=tcp, comments=np.array(traj.comments, dtype=str))
+        np.savez_compressed(buf, t=traj.t, q=traj.q, tcp=traj.tcp,
+                            meta=np.array(json.dumps(meta_to_dict(traj.meta))))  # fmt: skip
         return atomic_write_bytes(p, buf.getvalue())
     if fmt == "urscript":
-        return atomic_write_text(p, urscript_program(traj, model, **urscript_options))  # type: ignore[arg-type]
+        return atomic_write_text(p, urscript_program(traj, **urscript_options))  # type: ignore[arg-type]
     raise ValueError(f"fmt: expected 'csv', 'json', 'npz' or 'urscript', got {fmt!r}")

@@ -1,117 +1,344 @@
-"""Joint trajectory files: CSV ``t,q1,q2,q3,q4,q5,q6,x,y,z,rx,ry,rz``.
+"""Trajectory files: a plain CSV and its JSON sidecar (``docs/trajectory.md``).
 
-One row per controller period (500 Hz on e-Series, 125 Hz on CB3): time from
-the start (s), joint positions (rad), TCP pose in the robot base frame as a UR
-pose vector (m, rotation vector in rad).  Lines starting with ``#`` are
-comments (the writer records the robot model and period there).
+``trajectory.csv`` — header ``t,q1,q2,q3,q4,q5,q6,x,y,z,rx,ry,rz`` on the first
+line, then one row per controller period, and nothing else (``csv.reader`` and
+``pandas.read_csv`` read it as it is).  Time from the start (s), joint positions
+(rad), the TCP pose in the robot base frame as a UR pose vector (m, rad).
+
+``trajectory.json`` — the sidecar, same stem, required by every reader::
+
+    {"format": "ruledrobot.trajectory-meta/1",
+     "robot": "ur5e", "control_period_s": 0.002,
+     "tcp_offset": [x, y, z, rx, ry, rz],           # TCP in the flange frame
+     "payload": {"mass_kg": 1.0, "cog_m": [cx, cy, cz]},
+     "kinematics": {"source": "nominal", "checksum": "sha256:...",
+                    "dh": {"theta_offset": [...], "a": [...], "d": [...], "alpha": [...]}},
+     "base": [...],                                   # robot base in the job's world
+     "phases": [{"name": "approach", "start": 0, "stop": 812}, ...],
+     "in_stock": [[1200, 9800]],
+     "job": {"path": "job.toml", "sha256": "..."}, "source": "ruledrobot plan",
+     "csv": "trajectory.csv", "csv_sha256": "...", "samples": 12925}
+
+Required: ``format``, ``robot``, ``tcp_offset``, ``payload``; the rest defaults
+(period and kinematics: the catalogue model's).  The reader checks the CSV's
+checksum when the sidecar has one (a CSV from another plan next to this sidecar
+is refused), the period, and that the TCP column is FK(q) · tcp_offset — the
+column and the metadata describe the same TCP.
 """
 
 from __future__ import annotations
 
+import hashlib
 import io
+import json
 import os
-from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
-from numpy.typing import ArrayLike
 
-from ..geometry._arrays import FloatArray, as_float_array
-from ..geometry.se3 import pose_from_ur_vector, ur_vector_from_pose
+from ..robot.trajectory import KinematicsRef, Payload, Phase, Trajectory, TrajectoryMeta
 from .atomic import atomic_write_text
 from .text import read_user_text
 
-__all__ = ["HEADER", "Trajectory", "read_trajectory", "write_trajectory"]
+__all__ = [
+    "HEADER",
+    "META_FORMAT",
+    "TCP_TOLERANCE",
+    "TRAJECTORY_FORMAT",
+    "meta_from_dict",
+    "meta_to_dict",
+    "read_trajectory",
+    "sidecar_path",
+    "write_trajectory",
+]
 
 HEADER = ["t", "q1", "q2", "q3", "q4", "q5", "q6", "x", "y", "z", "rx", "ry", "rz"]
+META_FORMAT = "ruledrobot.trajectory-meta/1"
+#: Format of a whole trajectory in one JSON file (``ruledrobot export --format json``).
+TRAJECTORY_FORMAT = "ruledrobot.trajectory/1"
+#: Largest mismatch (m, rad) between the TCP column and FK(q) · tcp_offset that a
+#: reader accepts (the CSV holds 10 significant digits).
+TCP_TOLERANCE = 1e-6
+
+_DH_COLUMNS = ("theta_offset", "a", "d", "alpha")
 
 
-@dataclass(frozen=True)
-class Trajectory:
-    """A sampled joint trajectory: ``t`` (M,) s, ``q`` (M, 6) rad, ``tcp`` (M, 6) UR vectors."""
-
-    t: FloatArray
-    q: FloatArray = field(repr=False)
-    tcp: FloatArray = field(repr=False)
-    comments: tuple[str, ...] = ()
-
-    @property
-    def period(self) -> float:
-        """The median sampling period (s)."""
-        return float(np.median(np.diff(self.t))) if self.t.size > 1 else 0.0
-
-    @property
-    def duration(self) -> float:
-        return float(self.t[-1] - self.t[0]) if self.t.size else 0.0
-
-    def tcp_poses(self) -> FloatArray:
-        """TCP poses (M, 4, 4)."""
-        return pose_from_ur_vector(self.tcp)
+def sidecar_path(path: str | os.PathLike[str]) -> Path:
+    """``cut.csv`` -> ``cut.json`` beside it."""
+    return Path(path).with_suffix(".json")
 
 
-def write_trajectory(
-    path: str | os.PathLike[str],
-    t: ArrayLike,
-    q: ArrayLike,
-    tcp: ArrayLike,
-    comments: tuple[str, ...] | list[str] = (),
-) -> Path:
-    """Write a trajectory CSV atomically.  ``tcp``: (M, 4, 4) poses or (M, 6) UR vectors."""
-    t = as_float_array(t, "t")
-    q = as_float_array(q, "q", (6,))
-    tcp = np.asarray(tcp, dtype=np.float64)
-    if tcp.shape[-2:] == (4, 4):
-        tcp = ur_vector_from_pose(tcp)
-    tcp = as_float_array(tcp, "tcp", (6,))
-    if t.ndim != 1 or q.shape[0] != t.size or tcp.shape[0] != t.size:
-        raise ValueError(
-            f"trajectory: t {t.shape}, q {q.shape} and tcp {tcp.shape} must have the same length"
-        )
-    if t.size > 1 and np.any(np.diff(t) <= 0):
-        k = int(np.flatnonzero(np.diff(t) <= 0)[0]) + 1
-        raise ValueError(f"t[{k}]: times must increase strictly")
-    buf = io.StringIO()
-    for c in comments:
-        buf.write(f"# {c}\n")
-    buf.write(",".join(HEADER) + "\n")
-    data = np.concatenate([t[:, None], q, tcp], axis=1)
-    np.savetxt(buf, data, delimiter=",", fmt="%.10g")
-    return atomic_write_text(path, buf.getvalue())
+def _ur(T: np.ndarray) -> list[float]:
+    from ..geometry.se3 import ur_vector_from_pose
+
+    return [float(x) for x in ur_vector_from_pose(T)]
 
 
-def read_trajectory(path: str | os.PathLike[str]) -> Trajectory:
-    """Read a trajectory CSV; ValueError names the file and line of any problem."""
-    p, text = read_user_text(path, "trajectory file")
-    comments: list[str] = []
-    rows: list[list[float]] = []
-    header_seen = False
-    for lineno, raw in enumerate(text.splitlines(), start=1):
-        s = raw.strip()
-        if not s:
-            continue
-        if s.startswith("#"):
-            comments.append(s[1:].strip())
-            continue
-        cells = [c.strip() for c in s.split(",")]
-        if not header_seen:
-            if [c.lower() for c in cells] != HEADER:
-                raise ValueError(f"{p}: line {lineno}: expected the header {','.join(HEADER)}")
-            header_seen = True
-            continue
-        if len(cells) != len(HEADER):
-            raise ValueError(f"{p}: line {lineno}: expected {len(HEADER)} values, got {len(cells)}")
+def meta_to_dict(meta: TrajectoryMeta) -> dict[str, Any]:
+    """The sidecar fields of ``meta`` (JSON-ready)."""
+    dh = meta.kinematics.dh
+    return {
+        "format": META_FORMAT,
+        "robot": meta.robot,
+        "control_period_s": meta.control_period,
+        "tcp_offset": _ur(meta.tcp_offset),
+        "payload": {"mass_kg": meta.payload.mass, "cog_m": meta.payload.cog.tolist()},
+        "kinematics": {
+            "source": meta.kinematics.source,
+            "checksum": meta.kinematics.checksum,
+            "dh": {c: dh[:, i].tolist() for i, c in enumerate(_DH_COLUMNS)},
+        },
+        "base": _ur(meta.base),
+        "phases": [{"name": p.name, "start": p.start, "stop": p.stop} for p in meta.phases],
+        "in_stock": [list(r) for r in meta.in_stock],
+        "job": meta.job,
+        "source": meta.source,
+    }
+
+
+class _Doc:
+    """Field access with errors naming the file and the field."""
+
+    def __init__(self, doc: Any, where: str) -> None:
+        if not isinstance(doc, dict):
+            raise ValueError(f"{where}: expected a JSON object")
+        self.doc, self.where = doc, where
+
+    def fail(self, key: str, msg: str) -> ValueError:
+        return ValueError(f"{self.where}: field {key!r}: {msg}")
+
+    def get(self, key: str, required: bool = False, default: Any = None) -> Any:
+        if key not in self.doc:
+            if required:
+                raise self.fail(key, "missing (required)")
+            return default
+        return self.doc[key]
+
+    def numbers(self, key: str, value: Any, n: int | None) -> np.ndarray:
         try:
-            values = [float(c) for c in cells]
-        except ValueError:
-            raise ValueError(f"{p}: line {lineno}: not a number in {s!r}") from None
-        if not np.all(np.isfinite(values)):
-            raise ValueError(f"{p}: line {lineno}: contains NaN or infinity")
-        if rows and values[0] <= rows[-1][0]:
-            raise ValueError(f"{p}: line {lineno}: time {values[0]} does not increase")
-        rows.append(values)
-    if not header_seen:
-        raise ValueError(f"{p}: empty file; expected the header {','.join(HEADER)}")
-    if not rows:
+            arr = np.asarray(value, dtype=np.float64)
+        except (TypeError, ValueError):
+            raise self.fail(key, f"expected numbers, got {value!r}") from None
+        if arr.ndim != 1 or (n is not None and arr.size != n) or not np.isfinite(arr).all():
+            want = f"{n} finite numbers" if n else "a list of finite numbers"
+            raise self.fail(key, f"expected {want}, got {value!r}")
+        return arr
+
+
+def meta_from_dict(doc: Any, where: str = "trajectory metadata") -> TrajectoryMeta:
+    """Parse sidecar fields; ValueError names ``where`` and the field."""
+    from ..robot import MODEL_NAMES, load
+
+    d = _Doc(doc, where)
+    fmt = d.get("format", required=True)
+    if fmt != META_FORMAT:
+        raise d.fail("format", f"expected {META_FORMAT!r}, got {fmt!r}")
+    robot = d.get("robot", required=True)
+    if not isinstance(robot, str) or robot.lower() not in MODEL_NAMES:
+        raise d.fail("robot", f"expected one of {', '.join(MODEL_NAMES)}, got {robot!r}")
+    model = load(robot)
+    tcp = d.numbers("tcp_offset", d.get("tcp_offset", required=True), 6)
+    pay = d.get("payload", required=True)
+    if not isinstance(pay, dict) or "mass_kg" not in pay:
+        raise d.fail("payload", 'expected {"mass_kg": m, "cog_m": [x, y, z]}')
+    try:
+        mass = float(pay["mass_kg"])
+    except (TypeError, ValueError):
+        raise d.fail("payload.mass_kg", f"expected a number, got {pay['mass_kg']!r}") from None
+    cog = d.numbers("payload.cog_m", pay.get("cog_m", [0.0, 0.0, 0.0]), 3)
+    period = d.get("control_period_s", default=model.control_period)
+    if not isinstance(period, (int, float)) or isinstance(period, bool):
+        raise d.fail("control_period_s", f"expected a number of seconds, got {period!r}")
+    kin = d.get("kinematics")
+    if kin is None:
+        kinematics = KinematicsRef.of(model)
+    else:
+        if not isinstance(kin, dict) or not isinstance(kin.get("dh"), dict):
+            raise d.fail("kinematics", 'expected {"source": ..., "checksum": ..., "dh": {...}}')
+        cols = [d.numbers(f"kinematics.dh.{c}", kin["dh"].get(c), model.n_joints)
+                for c in _DH_COLUMNS]  # fmt: skip
+        try:
+            kinematics = KinematicsRef(np.stack(cols, axis=1), str(kin.get("source", "?")),
+                                       str(kin.get("checksum", "")))  # fmt: skip
+        except ValueError as exc:
+            raise ValueError(f"{where}: {exc}") from None
+    phases = []
+    for i, p in enumerate(d.get("phases", default=[]) or []):
+        try:
+            phases.append(Phase(str(p["name"]), int(p["start"]), int(p["stop"])))
+        except (KeyError, TypeError, ValueError) as exc:
+            raise d.fail(f"phases[{i}]", f"expected {{name, start, stop}}: {exc}") from None
+    stock = []
+    for i, r in enumerate(d.get("in_stock", default=[]) or []):
+        if not (isinstance(r, list) and len(r) == 2 and all(isinstance(x, int) for x in r)):
+            raise d.fail(f"in_stock[{i}]", f"expected [start, stop] sample indices, got {r!r}")
+        stock.append((r[0], r[1]))
+    base = d.numbers("base", d.get("base", default=[0.0] * 6), 6)
+    job = d.get("job")
+    if job is not None and not isinstance(job, dict):
+        raise d.fail("job", f"expected an object or null, got {job!r}")
+    try:
+        return TrajectoryMeta(
+            robot=model.name, control_period=float(period), tcp_offset=tcp,
+            payload=Payload(mass, cog), kinematics=kinematics, base=base,
+            phases=tuple(phases), in_stock=tuple(stock), job=job,
+            source=str(d.get("source", default="")),
+        )  # fmt: skip
+    except ValueError as exc:
+        raise ValueError(f"{where}: {exc}") from None
+
+
+def csv_text(traj: Trajectory) -> str:
+    """The CSV of ``traj``: the header line, then one row per sample."""
+    buf = io.StringIO()
+    buf.write(",".join(HEADER) + "\n")
+    data = np.concatenate([traj.t[:, None], traj.q, traj.tcp], axis=1)
+    np.savetxt(buf, data, delimiter=",", fmt="%.10g")
+    return buf.getvalue()
+
+
+def write_trajectory(path: str | os.PathLike[str], traj: Trajectory) -> Path:
+    """Write ``traj`` as ``path`` (CSV) and its sidecar (``.json``), each atomically;
+    the sidecar, written last, holds the CSV's SHA-256.  Returns the CSV path."""
+    p = Path(path)
+    if p.suffix.lower() != ".csv":
+        raise ValueError(f"{p}: a trajectory CSV needs the suffix .csv")
+    text = csv_text(traj)
+    doc = meta_to_dict(traj.meta)
+    doc.update(
+        csv=p.name,
+        csv_sha256=hashlib.sha256(text.encode()).hexdigest(),
+        samples=traj.n,
+        duration_s=traj.duration,
+    )
+    atomic_write_text(p, text)
+    atomic_write_text(sidecar_path(p), json.dumps(doc, indent=1) + "\n")
+    return p
+
+
+def _parse_csv(p: Path, text: str) -> np.ndarray:
+    lines = text.splitlines()
+    if not lines or not lines[0].strip():
+        raise ValueError(f"{p}: line 1: expected the header {','.join(HEADER)}")
+    head = [c.strip().lower() for c in lines[0].split(",")]
+    if head != HEADER:
+        raise ValueError(f"{p}: line 1: expected the header {','.join(HEADER)}, got "
+                         f"{lines[0][:80]!r}")  # fmt: skip
+    body = [s for s in lines[1:] if s.strip()]
+    if not body:
         raise ValueError(f"{p}: no samples after the header")
-    data = np.asarray(rows)
-    return Trajectory(data[:, 0], data[:, 1:7], data[:, 7:], tuple(comments))
+    try:
+        data = np.loadtxt(io.StringIO("\n".join(body)), delimiter=",", ndmin=2)
+    except ValueError:
+        data = None
+    if data is None or data.shape[1] != len(HEADER):
+        # find the offending line for the message
+        for lineno, s in enumerate(lines[1:], start=2):
+            if not s.strip():
+                continue
+            cells = s.split(",")
+            if len(cells) != len(HEADER):
+                raise ValueError(f"{p}: line {lineno}: expected {len(HEADER)} values, "
+                                 f"got {len(cells)}")  # fmt: skip
+            try:
+                [float(c) for c in cells]
+            except ValueError:
+                raise ValueError(f"{p}: line {lineno}: not a number in {s[:80]!r}") from None
+        raise ValueError(f"{p}: could not read the samples")  # pragma: no cover
+    lineno = np.flatnonzero([bool(s.strip()) for s in lines[1:]]) + 2
+    bad = ~np.isfinite(data).all(axis=1)
+    if bad.any():
+        raise ValueError(f"{p}: line {lineno[np.argmax(bad)]}: contains NaN or infinity")
+    dt = np.diff(data[:, 0])
+    if np.any(dt <= 0):
+        k = int(np.argmax(dt <= 0)) + 1
+        raise ValueError(f"{p}: line {lineno[k]}: time {data[k, 0]} does not increase")
+    return data
+
+
+def _check_tcp(traj: Trajectory, where: str, line_offset: int) -> None:
+    dp, da, k = traj.tcp_error()
+    if dp > TCP_TOLERANCE or da > TCP_TOLERANCE:
+        raise ValueError(
+            f"{where}: {'line' if line_offset else 'sample'} {k + line_offset}: the TCP columns "
+            f"differ from FK(q) · tcp_offset by {dp * 1e3:.4g} mm / {np.degrees(da):.4g} deg: "
+            "the TCP is not the TCP its metadata names (or the kinematics differ)"
+        )
+
+
+def _read_bundle(p: Path, check_tcp: bool) -> Trajectory:
+    """A whole trajectory in one JSON or NPZ export."""
+    if p.suffix.lower() == ".npz":
+        try:
+            with np.load(p, allow_pickle=False) as z:
+                arrays = {k: z[k] for k in ("t", "q", "tcp", "meta")}
+        except (OSError, ValueError, KeyError) as exc:
+            raise ValueError(f"{p}: not a ruledrobot trajectory NPZ (t, q, tcp, meta): {exc}"
+                             ) from None  # fmt: skip
+        try:
+            meta_doc = json.loads(str(arrays["meta"]))
+        except ValueError:
+            raise ValueError(f"{p}: array 'meta' is not JSON text") from None
+        t, q, tcp = arrays["t"], arrays["q"], arrays["tcp"]
+    else:
+        _, text = read_user_text(p, "trajectory file")
+        try:
+            doc = json.loads(text)
+        except json.JSONDecodeError as exc:
+            raise ValueError(f"{p}: line {exc.lineno}: not valid JSON ({exc.msg})") from None
+        if not isinstance(doc, dict) or doc.get("format") != TRAJECTORY_FORMAT:
+            raise ValueError(f"{p}: expected format {TRAJECTORY_FORMAT!r} (a trajectory CSV "
+                             "has a .csv name)")  # fmt: skip
+        for key in ("meta", "t", "q", "tcp"):
+            if key not in doc:
+                raise ValueError(f"{p}: field {key!r} missing")
+        meta_doc, t, q, tcp = doc["meta"], doc["t"], doc["q"], doc["tcp"]
+    meta = meta_from_dict(meta_doc, f"{p}: meta")
+    try:
+        traj = Trajectory(np.asarray(t, float), np.asarray(q, float), np.asarray(tcp, float),
+                          meta)  # fmt: skip
+    except (ValueError, TypeError) as exc:
+        raise ValueError(f"{p}: {exc}") from None
+    if check_tcp:
+        _check_tcp(traj, str(p), 0)
+    return traj
+
+
+def read_trajectory(path: str | os.PathLike[str], check_tcp: bool = True) -> Trajectory:
+    """Read a trajectory: a CSV and its required sidecar, or a JSON / NPZ export.
+
+    ValueError names the file and the line or field of any problem (see the module
+    doc for what is checked)."""
+    if Path(path).suffix.lower() in (".json", ".npz"):
+        return _read_bundle(Path(path), check_tcp)
+    p, text = read_user_text(path, "trajectory file")
+    side = sidecar_path(p)
+    if not side.is_file():
+        raise ValueError(
+            f"{p}: its metadata file {side.name} is missing beside it. Every trajectory CSV "
+            "needs one: robot, TCP offset and payload at least, e.g. "
+            '{"format": "ruledrobot.trajectory-meta/1", "robot": "ur5e", '
+            '"tcp_offset": [0, 0, 0, 0, 0, 0], "payload": {"mass_kg": 0, "cog_m": [0, 0, 0]}} '
+            "(docs/trajectory.md)"
+        )
+    sp, stext = read_user_text(side, "trajectory metadata file")
+    try:
+        doc = json.loads(stext)
+    except json.JSONDecodeError as exc:
+        raise ValueError(f"{sp}: line {exc.lineno}: not valid JSON ({exc.msg})") from None
+    meta = meta_from_dict(doc, str(sp))
+    want = doc.get("csv_sha256") if isinstance(doc, dict) else None
+    if want is not None and hashlib.sha256(text.encode()).hexdigest() != want:
+        raise ValueError(
+            f"{p}: does not match its metadata {sp.name} (checksum differs): the CSV was "
+            "changed or comes from another plan; plan again or fix the pair"
+        )
+    data = _parse_csv(p, text)
+    try:
+        traj = Trajectory(data[:, 0], data[:, 1:7], data[:, 7:], meta)
+    except ValueError as exc:
+        raise ValueError(f"{p} with {sp.name}: {exc}") from None
+    if check_tcp:
+        _check_tcp(traj, f"{p} with {sp.name}", 2)
+    return traj

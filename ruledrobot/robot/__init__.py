@@ -23,18 +23,25 @@ from .analytic_ik import IKSolutions, URGeometry, wrap_angle
 from .catalogue import MODEL_NAMES, load
 from .model import DEFAULT_ACCELERATION, RobotModel
 from .path import PathIKResult, PathStatus, path_ik
+from .trajectory import KinematicsRef, Payload, Phase, Trajectory, TrajectoryMeta, model_for
 
 __all__ = [
     "DEFAULT_ACCELERATION",
     "MODEL_NAMES",
     "IKSolutions",
+    "KinematicsRef",
     "PathIKResult",
     "PathStatus",
+    "Payload",
+    "Phase",
     "RobotModel",
+    "Trajectory",
+    "TrajectoryMeta",
     "URGeometry",
     "fk",
     "ik",
     "load",
+    "model_for",
     "path_ik",
     "wrap_angle",
 ]

@@ -45,7 +45,6 @@ _LAZY = {
     "play": ("playback", "play"),
     "play_file": ("playback", "play_file"),
     "simulate": ("playback", "simulate"),
-    "infer_tool": ("playback", "infer_tool"),
     "PlaybackResult": ("playback", "PlaybackResult"),
     "Collision": ("playback", "Collision"),
     "Renderer": ("render", "Renderer"),

@@ -56,7 +56,6 @@ __all__ = [
     "Collision",
     "PlaybackResult",
     "ProgressCallback",
-    "infer_tool",
     "play",
     "play_file",
     "simulate",
@@ -266,8 +265,8 @@ class PlaybackResult:
     def write(
         self, out_dir: str | os.PathLike[str], *, plots: bool = True, trajectory: bool = True
     ) -> dict[str, Path]:
-        """Write ``report.json``, ``tracking.png``, ``limits.png`` and ``actual.csv``
-        (the simulated trajectory, the CSV format of the design) into ``out_dir``;
+        """Write ``report.json``, ``tracking.png``, ``limits.png`` and ``simulated.csv``
+        (the simulated trajectory with its sidecar, ``ruledrobot.io.trajectory``) into ``out_dir``;
         returns ``{name: path}``.  Every file is written atomically."""
         out = Path(out_dir)
         out.mkdir(parents=True, exist_ok=True)
@@ -278,17 +277,14 @@ class PlaybackResult:
             paths.update(self.plot(out))
         if trajectory and self.robot.n_joints == 6:
             from ..io.trajectory import write_trajectory
+            from ..robot.trajectory import Trajectory, TrajectoryMeta
 
             base_inv = se3.inverse(np.asarray(self.robot.base))
-            paths["actual"] = write_trajectory(
-                out / "actual.csv",
-                self.t,
-                self.q,
-                base_inv @ self.tcp,
-                comments=[
-                    f"robot: {self.robot.name}",
-                    "simulated by ruledrobot.sim.playback (MuJoCo)",
-                ],
+            meta = TrajectoryMeta.for_model(
+                self.robot, source="simulated by ruledrobot.sim.playback (MuJoCo)"
+            )
+            paths["simulated"] = write_trajectory(
+                out / "simulated.csv", Trajectory(self.t, self.q, base_inv @ self.tcp, meta)
             )
         return paths
 
@@ -750,39 +746,6 @@ def _wire(
 # ---------------------------------------------------------------------------------------
 
 
-def infer_tool(
-    robot: RobotModel, q: ArrayLike, tcp_base: ArrayLike, tol: float = 1e-5
-) -> FloatArray | None:
-    """The TCP offset (4, 4) in the flange frame that explains TCP poses in the base frame.
-
-    ``tcp_base`` (M, 4, 4) are the TCP poses of joint positions ``q`` (M, J) in
-    the robot base frame (the trajectory CSV's columns).  Returns
-    ``inv(flange(q_k)) @ tcp_k`` of the first sample when every sample agrees
-    with it to ``tol`` [m, rad]; None when they disagree (the file's TCP
-    columns are then not of one fixed tool).
-    """
-    q = np.asarray(q, dtype=np.float64)
-    P = np.asarray(tcp_base, dtype=np.float64)
-    flange = dataclasses.replace(robot, base=np.eye(4), tool=np.eye(4)).fk(q)
-    X = se3.inverse(flange) @ P
-    d = np.abs(X - X[0]).max()
-    if not d <= tol:
-        return None
-    tool = X[0].copy()
-    U, _, Vt = np.linalg.svd(tool[:3, :3])
-    tool[:3, :3] = U @ Vt
-    tool[3] = [0.0, 0.0, 0.0, 1.0]
-    return tool
-
-
-def _robot_from_comments(comments: tuple[str, ...]) -> str | None:
-    for c in comments:
-        key, _, value = c.partition(":")
-        if key.strip().lower() in ("robot", "model") and value.strip():
-            return value.strip().split()[0].lower()
-    return None
-
-
 def _with_tool(model_or_scene: RobotModel | Scene, tool: FloatArray) -> RobotModel | Scene:
     if isinstance(model_or_scene, Scene):
         return dataclasses.replace(model_or_scene, robot=model_or_scene.robot.with_tool(tool))
@@ -796,39 +759,34 @@ def _robot_of(model_or_scene: RobotModel | Scene) -> RobotModel:
 def play_file(
     path: str | os.PathLike[str],
     model_or_scene: RobotModel | Scene | None = None,
-    *,
-    infer_tcp: bool = True,
     **options: Any,
 ) -> PlaybackResult:
-    """Play a trajectory CSV (``t,q1..q6,x,y,z,rx,ry,rz``, ``ruledrobot.io.trajectory``).
+    """Play a trajectory file (CSV and its sidecar, ``ruledrobot.io.trajectory``).
 
-    Without ``model_or_scene`` the robot is the catalogue model named by the
-    file's ``# robot: NAME`` comment (default ``ur5e``).  With ``infer_tcp``
-    the TCP offset is taken from the file's pose columns (:func:`infer_tool`)
-    when they are those of one fixed tool, so that the TCP errors refer to the
-    file's TCP; otherwise the model's ``tool`` is kept.  ``options`` go to
-    :func:`play`.  ValueError names the file on bad content.
+    Without ``model_or_scene`` the robot is the one the trajectory was planned for
+    (:func:`ruledrobot.robot.model_for`: its model, kinematics, TCP offset and
+    payload).  A model or scene given must be of the trajectory's robot and
+    kinematics; its tool is replaced by the trajectory's TCP offset, so the TCP
+    errors refer to the file's TCP.  ``options`` go to :func:`play`.  ValueError
+    names the file on bad content or a mismatched robot.
     """
     from ..io.trajectory import read_trajectory
-    from ..robot import load
+    from ..robot import model_for
+    from ..robot.trajectory import KinematicsRef
 
     traj = read_trajectory(path)
+    planned = model_for(traj.meta)
     if model_or_scene is None:
-        name = _robot_from_comments(traj.comments) or "ur5e"
-        try:
-            model_or_scene = load(name)
-        except ValueError as exc:
-            raise ValueError(f"{path}: {exc}") from None
+        model_or_scene = planned
     robot = _robot_of(model_or_scene)
-    if robot.n_joints != traj.q.shape[1]:
+    if robot.name != planned.name or (
+        KinematicsRef.of(robot).checksum != traj.meta.kinematics.checksum
+    ):
         raise ValueError(
-            f"{path}: {traj.q.shape[1]} joints in the file, "
-            f"the robot {robot.name!r} has {robot.n_joints}"
+            f"{path}: planned for a {planned.name} ({traj.meta.kinematics.source} kinematics), "
+            f"not for the {robot.name} given"
         )
-    if infer_tcp:
-        tool = infer_tool(robot, traj.q, traj.tcp_poses())
-        if tool is not None:
-            model_or_scene = _with_tool(model_or_scene, tool)
+    model_or_scene = _with_tool(model_or_scene, planned.tool)
     return play(model_or_scene, traj.t, traj.q, **options)
 
 
@@ -848,7 +806,7 @@ def simulate(
 
     Plays the trajectory file (:func:`play_file`) in the scene given, else in
     a :class:`~ruledrobot.sim.scene.Scene` of the file's robot on a table;
-    writes ``report.json``, ``tracking.png``, ``limits.png`` and ``actual.csv``
+    writes ``report.json``, ``tracking.png``, ``limits.png`` and ``simulated.csv``
     into ``out_dir`` and, with ``video``, ``video.mp4`` and ``strip.png`` of
     the simulated motion (raises
     :class:`~ruledrobot.sim.render.RenderUnavailable`, after writing the
@@ -856,14 +814,10 @@ def simulate(
     """
     if model_or_scene is None:
         from ..io.trajectory import read_trajectory
-        from ..robot import load
+        from ..robot import model_for
 
         traj = read_trajectory(trajectory)
-        name = _robot_from_comments(traj.comments) or "ur5e"
-        try:
-            model_or_scene = Scene(load(name), width=width, height=height)
-        except ValueError as exc:
-            raise ValueError(f"{trajectory}: {exc}") from None
+        model_or_scene = Scene(model_for(traj.meta), width=width, height=height)
     result = play_file(trajectory, model_or_scene, progress=progress, **options)
     paths = result.write(out_dir)
     if video:

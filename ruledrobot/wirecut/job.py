@@ -36,6 +36,8 @@ A job describes, in the robot base frame (metres, radians, seconds)::
     lead_out = 0.02
     approach_speed = 0.3       # fraction of joint speed limits for approach/retract
     kerf = 0.0008              # m, reported; the wire path is the surface itself
+    wire_tolerance = 0.0005    # m, largest wire deviation from the rulings (a check)
+    feed_tolerance = 0.05      # fraction: feed inside the stock within +-5 % (a check)
 
 :func:`load_job` validates every field and raises ValueError naming the file,
 the section and the field.
@@ -113,6 +115,8 @@ class CutSpec:
     lead_out: float = 0.02
     approach_speed: float = 0.3
     kerf: float = 0.0008
+    wire_tolerance: float = 0.0005
+    feed_tolerance: float = 0.05
 
 
 @dataclass(frozen=True)
@@ -324,6 +328,7 @@ def parse_job(doc: dict, where: str = "job", base_dir: Path | None = None) -> Jo
         base=_pose(r, "base"),
         speed_scale=r.number("speed_scale", 1.0, lo=0.0, hi=1.0, strict_lo=True),
         acceleration=acceleration,
+        home=r.vector("home", 6) if r.get("home") is not None else None,
     )
     r.done()
 
@@ -350,6 +355,8 @@ def parse_job(doc: dict, where: str = "job", base_dir: Path | None = None) -> Jo
         lead_out=c.number("lead_out", 0.02, lo=0.0),
         approach_speed=c.number("approach_speed", 0.3, lo=0.0, hi=1.0, strict_lo=True),
         kerf=c.number("kerf", 0.0008, lo=0.0),
+        wire_tolerance=c.number("wire_tolerance", 0.0005, lo=0.0, strict_lo=True),
+        feed_tolerance=c.number("feed_tolerance", 0.05, lo=0.0, hi=1.0, strict_lo=True),
     )
     c.done()
     return Job(surface, stock, robot, tool, cut)

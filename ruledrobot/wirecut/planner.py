@@ -17,6 +17,7 @@ in the report is measured on the *sampled* joints through forward kinematics.
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import time
 from collections.abc import Callable
@@ -31,6 +32,9 @@ from ..io.atomic import atomic_write_bytes, atomic_write_text
 from ..io.lines import save_lines
 from ..io.trajectory import write_trajectory
 from ..robot import load, wrap_angle
+from ..robot.trajectory import Trajectory
+from ..robot.verdict import Check, Verdict
+from .checks import Measurements, collision_sentence, plan_verdict
 from .job import Job
 from .measure import feed_speeds, wire_points
 from .path import CutPath, chord_ends_in_flange, cut_path
@@ -50,8 +54,9 @@ class PlanResult:
     feasible: bool
     report: dict
     files: dict[str, Path] = field(default_factory=dict)
-    trajectory: TimedPath | None = field(default=None, repr=False)
+    trajectory: Trajectory | None = field(default=None, repr=False)
     path: CutPath | None = field(default=None, repr=False)
+    verdict: Verdict | None = None
 
 
 def _wrap_near(q: FloatArray, ref: FloatArray) -> FloatArray:
@@ -90,53 +95,12 @@ def _interp_rows(x: FloatArray, xp: FloatArray, fp: FloatArray) -> FloatArray:
     return out.reshape(len(x), *fp.shape[1:])
 
 
-def plan(
-    job: Job,
-    out_dir: str | Path,
-    progress: Callable[[str], None] | None = None,
-    simulate: bool = True,
-    video: bool = False,
-) -> PlanResult:
-    """Plan ``job`` and write its files into ``out_dir`` (see the module doc).
-
-    ``simulate``: play the trajectory in MuJoCo (the job's cell: arm, bow, stock,
-    table) and report, from the *simulated* joints, the wire's deviation from the
-    target rulings inside the stock, the TCP tracking error and the collisions
-    (the playback report goes to ``simulation/``).  ``video``: also render
-    ``video.mp4`` (needs an OpenGL backend: EGL or OSMesa).
-
-    An infeasible job still gets ``report.json`` (``feasible: false`` and the
-    reasons) and returns ``PlanResult(feasible=False)``; nothing else is written.
-    """
-    say = progress or (lambda msg: None)
-    out = Path(out_dir)
-    t0 = time.perf_counter()
-    timings: dict[str, float] = {}
-    model = load(job.robot.model).with_base(job.robot.base)
+def _timed_motion(job: Job, model, cp: CutPath) -> tuple[TimedPath, int]:
+    """Approach, cut, retract as one timed path; returns it and the cut's segment index."""
     dt = float(model.control_period)
     vel = model.max_velocity * job.robot.speed_scale
     acc = model.max_acceleration if job.robot.acceleration is None else job.robot.acceleration
-
-    say("refining the rulings and choosing the wire motion")
-    cp = cut_path(job, model)
-    timings["path_s"] = time.perf_counter() - t0
     m = cp.motion
-    report: dict = {
-        "feasible": bool(cp.feasible),
-        "robot": job.robot.model,
-        "input_rulings": cp.input_rulings,
-        "refinement_steps": cp.steps,
-        "path_rulings": len(cp.frames),
-        "rulings_in_stock": int(m.hit.sum()),
-        "reasons": list(m.reasons),
-        "unreachable": [r for r in m.reasons if not cp.feasible],
-    }
-    if not cp.feasible:
-        files = {"report": atomic_write_text(out / "report.json", json.dumps(report, indent=1))}
-        return PlanResult(False, report, files, None, cp)
-
-    say("timing the cut")
-    t1 = time.perf_counter()
     s = np.arange(len(cp.frames), dtype=np.float64)
     ends = chord_ends_in_flange(cp)
     sf = speed_factor(m.flange, s, ends, m.hit)
@@ -162,123 +126,305 @@ def plan(
     if job.robot.home is not None:
         last = end if above_end is None else above_end
         parts.append(joint_move(last, _wrap_near(job.robot.home, last), vel, acc, dt, slow))
-    traj = concatenate(parts, dt) if len(parts) > 1 else cut
-    timings["timing_s"] = time.perf_counter() - t1
+    return (concatenate(parts, dt) if len(parts) > 1 else cut), n_before
 
-    say("measuring and writing the results")
-    t2 = time.perf_counter()
-    in_cut = traj.segment == n_before
-    W = wire_frame(job.tool)
-    flange = model.fk(traj.q)
-    s_t = np.clip(traj.s_of_t - traj.s_of_t[in_cut][0], 0.0, s[-1])
-    i0 = np.clip(np.floor(s_t).astype(int), 0, len(s) - 2)
-    # inside the stock: both neighbouring rulings cross it
-    hit_t = in_cut & m.hit[i0] & m.hit[i0 + 1]
-    ends_t = _interp_rows(s_t, s, _fill_nearest(ends, m.hit))
-    feed = feed_speeds(traj.t, flange, ends_t, hit_t)
-    ratios = trajectory_limits_report(traj.t, traj.q, model.max_velocity, model.max_acceleration)
-    # bow clearance along the whole sampled motion (approach and retract too)
-    segs = bow_segments(job.tool)
-    world = wire_points(flange, segs.reshape(1, 6, 3).repeat(len(flange), 0)).reshape(-1, 3, 2, 3)
-    bow_hits = job.stock.segment_hits(world[:, :, 0], world[:, :, 1]).any(axis=1) & ~in_cut
-    collisions = []
-    if bow_hits.any():
-        k = np.flatnonzero(bow_hits)
-        collisions.append(
+
+def _phase_labels(in_cut: np.ndarray, hit_t: np.ndarray) -> np.ndarray:
+    """(M,) phase names: approach, lead_in, cut, lead_out, retract."""
+    k = np.arange(in_cut.size)
+    c = np.flatnonzero(in_cut)
+    h = np.flatnonzero(hit_t)
+    first_hit, last_hit = (h[0], h[-1]) if h.size else (c[-1] + 1, c[-1])
+    labels = np.full(in_cut.size, "move", dtype=object)
+    labels[k < c[0]] = "approach"
+    labels[k > c[-1]] = "retract"
+    labels[in_cut & (k < first_hit)] = "lead_in"
+    labels[in_cut & (k >= first_hit) & (k <= last_hit)] = "cut"
+    labels[in_cut & (k > last_hit)] = "lead_out"
+    return labels
+
+
+def _job_ref(job: Job) -> dict[str, str] | None:
+    if job.source is None:
+        return None
+    import hashlib
+
+    data = Path(job.source).read_bytes()
+    return {"path": str(job.source), "sha256": hashlib.sha256(data).hexdigest()}
+
+
+def plan(
+    job: Job,
+    out_dir: str | Path | None,
+    progress: Callable[[str], None] | None = None,
+    simulate: bool = True,
+    video: bool = False,
+) -> PlanResult:
+    """Plan ``job`` and write its files into ``out_dir`` (see the module doc).
+
+    ``simulate``: play the trajectory in MuJoCo (the job's cell: arm, bow, stock,
+    table) and measure, from the *simulated* joints, the wire's deviation from the
+    target rulings inside the stock, the TCP tracking error and the collisions
+    (the playback report goes to ``simulation/``); without it the ``verified``
+    check fails.  ``video``: also render ``video.mp4`` (skipped, with a note in
+    the report, when no OpenGL backend works).
+
+    The verdict (``report["verdict"]``, ``PlanResult.verdict``) is the conjunction of
+    every check (:mod:`.checks`).  The files are written into a staging folder and
+    replace ``out_dir`` as a whole (:class:`ruledrobot.io.outdir.StagedFolder`):
+    a plan whose verdict fails leaves ``report.json`` and the plots, and no
+    trajectory.  ``out_dir=None`` writes nothing.
+    """
+    from ..io.outdir import StagedFolder
+    from ..robot.trajectory import Trajectory, phases_from_labels, runs
+
+    say = progress or (lambda msg: None)
+    stage = StagedFolder(out_dir) if out_dir is not None else None
+    try:
+        t0 = time.perf_counter()
+        timings: dict[str, float] = {}
+        model = load(job.robot.model).with_base(job.robot.base)
+        dt = float(model.control_period)
+
+        say("refining the rulings and choosing the wire motion")
+        cp = cut_path(job, model)
+        timings["path_s"] = time.perf_counter() - t0
+        m = cp.motion
+        report: dict = {
+            "format": "ruledrobot.plan-report/1",
+            "robot": job.robot.model,
+            "job": _job_ref(job),
+            "input_rulings": cp.input_rulings,
+            "refinement_steps": cp.steps,
+            "path_rulings": len(cp.frames),
+            "rulings_in_stock": int(m.hit.sum()),
+            "reasons": list(m.reasons),
+        }
+        if not cp.feasible:
+            verdict = Verdict((Check("reach", "every ruling reachable, clear of stock and table",
+                                     "no", "yes", relation="==", ok=False,
+                                     detail="; ".join(m.reasons)),))  # fmt: skip
+            report["feasible"] = False
+            report["verdict"] = verdict.as_dict()
+            files = {}
+            if stage is not None:
+                files["report"] = atomic_write_text(stage.path / "report.json",
+                                                    json.dumps(report, indent=1) + "\n")
+            return _finish(stage, PlanResult(False, report, files, None, cp, verdict), job)
+
+        say("timing the cut")
+        t1 = time.perf_counter()
+        s = np.arange(len(cp.frames), dtype=np.float64)
+        ends = chord_ends_in_flange(cp)
+        traj, n_before = _timed_motion(job, model, cp)
+        timings["timing_s"] = time.perf_counter() - t1
+
+        say("measuring the planned motion")
+        t2 = time.perf_counter()
+        in_cut = traj.segment == n_before
+        W = wire_frame(job.tool)
+        flange = model.fk(traj.q)
+        s_t = np.clip(traj.s_of_t - traj.s_of_t[in_cut][0], 0.0, s[-1])
+        i0 = np.clip(np.floor(s_t).astype(int), 0, len(s) - 2)
+        # inside the stock: both neighbouring rulings cross it
+        hit_t = in_cut & m.hit[i0] & m.hit[i0 + 1]
+        ends_t = _interp_rows(s_t, s, _fill_nearest(ends, m.hit))
+        feed = feed_speeds(traj.t, flange, ends_t, hit_t)
+        ratios = trajectory_limits_report(traj.t, traj.q, model.max_velocity,
+                                          model.max_acceleration)  # fmt: skip
+        labels = _phase_labels(in_cut, hit_t)
+        # bow clearance along the whole sampled motion (approach and retract too)
+        segs = bow_segments(job.tool)
+        world = wire_points(flange, segs.reshape(1, 6, 3).repeat(len(flange), 0)).reshape(
+            -1, 3, 2, 3
+        )
+        bow_hits = job.stock.segment_hits(world[:, :, 0], world[:, :, 1]).any(axis=1) & ~in_cut
+        collisions: list[dict] = []
+        sentences: list[str] = []
+        if bow_hits.any():
+            k = np.flatnonzero(bow_hits)
+            collisions.append({"what": "bow vs stock outside the cut",
+                               "first_t": float(traj.t[k[0]]), "samples": int(k.size)})  # fmt: skip
+            sentences.append(f"the bow (planner's model) is in the stock outside the cut at "
+                             f"{k.size} samples from t = {traj.t[k[0]]:.2f} s "
+                             f"({labels[k[0]]})")  # fmt: skip
+        # planned wire deviation: distance of the sampled wire's chord ends from the target
+        # ruling at the same path parameter — the z axis of the refined frame motion there
+        # (the screw geodesic between the neighbouring refined frames)
+        target = se3.geodesic(cp.frames[i0], cp.frames[i0 + 1], s_t - i0)
+
+        def deviation(fl: FloatArray) -> FloatArray:
+            off = wire_points(fl, ends_t) - target[:, None, :3, 3]
+            return np.linalg.norm(np.cross(off, target[:, None, :3, 2]), axis=-1).max(axis=1)
+
+        dev = deviation(flange)
+        timings["measure_s"] = time.perf_counter() - t2
+        pb = None
+        dev_sim_mm = tracking_mm = None
+        if simulate:
+            say("verifying in MuJoCo")
+            t3 = time.perf_counter()
+            from ..sim import Scene, play
+
+            scene = Scene.from_job(job, robot=model)
+            pb = play(scene, traj.t, traj.q, traj.qd)
+            sim = pb.report()
+            dev_sim = deviation(model.fk(pb.q))
+            dev_sim_mm = float(dev_sim[hit_t].max() * 1e3) if hit_t.any() else 0.0
+            tracking_mm = sim["tcp_position_error_mm"]["max"]
+            report["simulation_realtime_factor"] = sim.get("realtime_factor")
+            for c in pb.collisions:
+                d = c.as_dict()
+                k = int(np.clip(np.searchsorted(traj.t, c.start), 0, len(traj.t) - 1))
+                d["phase"] = str(labels[k])
+                collisions.append(d)
+                sentences.append(collision_sentence(d, d["phase"]))
+            timings["simulation_s"] = time.perf_counter() - t3
+
+        cut_feed = feed[hit_t]
+        interior = hit_t & ~traj.feed_limited
+        pos_ratio = _position_ratio(model, traj.q)
+        meas = Measurements(
+            reach_ok=True, reach_detail="", rulings=len(cp.frames), simulated=simulate,
+            collisions=tuple(sentences), wire_deviation_mm=dev_sim_mm,
+            planned_wire_deviation_mm=float(dev[hit_t].max() * 1e3) if hit_t.any() else 0.0,
+            feed_set_mm_s=job.cut.feed_speed * 1e3,
+            feed_max_mm_s=float(cut_feed.max() * 1e3) if cut_feed.size else None,
+            feed_min_mm_s=float(cut_feed.min() * 1e3) if cut_feed.size else None,
+            feed_within_1pct=float(np.mean(np.abs(feed[interior] / job.cut.feed_speed - 1.0)
+                                           <= 0.01)) if interior.any() else None,
+            position_ratio=pos_ratio, speed_ratio=ratios["max_speed_ratio"],
+            acc_ratio=ratios["max_acc_ratio"],
+            singularity_min=float(model.singularity_measure(traj.q[in_cut]).min()),
+            tracking_error_mm=tracking_mm, kerf_mm=job.cut.kerf * 1e3,
+            duration_s=float(traj.t[-1]),
+        )  # fmt: skip
+        verdict = plan_verdict(meas, wire_tolerance_mm=job.cut.wire_tolerance * 1e3,
+                               feed_tolerance=job.cut.feed_tolerance,
+                               singularity_margin=SINGULARITY_MARGIN)  # fmt: skip
+        if not cut_feed.size:
+            missing = Check("in_stock", "the wire passes through the stock", "no", "yes",
+                            relation="==", ok=False,
+                            detail="no sample has the wire inside the stock")  # fmt: skip
+            verdict = Verdict((*verdict.checks, missing))
+        report.update(
             {
-                "what": "bow vs stock outside the cut",
-                "first_t": float(traj.t[k[0]]),
-                "samples": int(k.size),
+                "feasible": verdict.ok,
+                "verdict": verdict.as_dict(),
+                "duration_s": float(traj.t[-1]),
+                "cut_duration_s": float(traj.t[in_cut][-1] - traj.t[in_cut][0]),
+                "samples": len(traj.t),
+                "control_period_s": dt,
+                "feed_speed_mm_s": job.cut.feed_speed * 1e3,
+                "max_feed_speed_mm_s": meas.feed_max_mm_s,
+                "min_feed_speed_mm_s": meas.feed_min_mm_s,
+                "feed_within_1pct_fraction": meas.feed_within_1pct,
+                "max_joint_position_ratio": pos_ratio,
+                "max_joint_speed_ratio": ratios["max_speed_ratio"],
+                "max_joint_accel_ratio": ratios["max_acc_ratio"],
+                "min_singularity_measure": meas.singularity_min,
+                "max_planned_wire_deviation_mm": meas.planned_wire_deviation_mm,
+                "max_wire_deviation_mm": dev_sim_mm,
+                "max_tcp_tracking_error_mm": tracking_mm,
+                "collisions": collisions,
+                "roll_deg": float(np.degrees(m.roll[0])),
+                "constant_roll": bool(np.ptp(m.roll) < 1e-12),
+                "slide_m": float(m.slide[0]),
+                "wire_reversed": bool(m.reverse),
+                "kerf_mm": job.cut.kerf * 1e3,
             }
         )
-    # planned wire deviation: distance of the sampled wire's chord ends from the target
-    # ruling at the same path parameter — the z axis of the refined frame motion there
-    # (the screw geodesic between the neighbouring refined frames)
-    target = se3.geodesic(cp.frames[i0], cp.frames[i0 + 1], s_t - i0)
-    G = flange @ W
-    ends_w = wire_points(flange, ends_t)
-    off = ends_w - target[:, None, :3, 3]
-    dev = np.linalg.norm(np.cross(off, target[:, None, :3, 2]), axis=-1).max(axis=1)
-    sim_files: dict[str, Path] = {}
-    if simulate:
-        say("verifying in MuJoCo")
-        t3 = time.perf_counter()
-        from ..sim import Scene, play
+        robot = model.with_tool(W).with_base(np.eye(4))
+        robot = dataclasses.replace(robot, tool_mass=job.tool.mass, tool_com=_bow_cog(job))
+        trajectory = Trajectory.from_joints(
+            traj.t, traj.q, robot, base=job.robot.base, phases=phases_from_labels(labels),
+            in_stock=runs(hit_t), job=report["job"], source="ruledrobot plan",
+        )  # fmt: skip
+        result = PlanResult(verdict.ok, report, {}, trajectory, cp, verdict)
+        if stage is None:
+            return result
+        say("writing the results")
+        t4 = time.perf_counter()
+        files = _write(stage.path, job, cp, traj, trajectory, feed, hit_t, model, W, pb,
+                       verdict.ok, video, report)  # fmt: skip
+        timings["write_s"] = time.perf_counter() - t4
+        timings["total_s"] = time.perf_counter() - t0
+        report["timings"] = timings
+        files["report"] = atomic_write_text(stage.path / "report.json",
+                                            json.dumps(report, indent=1) + "\n")  # fmt: skip
+        return _finish(stage, PlanResult(verdict.ok, report, files, trajectory, cp, verdict), job)
+    except BaseException:
+        if stage is not None:
+            stage.abort()
+        raise
 
-        scene = Scene.from_job(job, robot=model)
-        pb = play(scene, traj.t, traj.q, traj.qd)
-        sim = pb.report()
-        w_sim = wire_points(model.fk(pb.q), ends_t)
-        off_sim = w_sim - target[:, None, :3, 3]
-        dev_sim = np.linalg.norm(np.cross(off_sim, target[:, None, :3, 2]), axis=-1).max(axis=1)
-        report["max_wire_deviation_mm"] = float(dev_sim[hit_t].max() * 1e3) if hit_t.any() else 0.0
-        report["max_tcp_tracking_error_mm"] = sim["tcp_position_error_mm"]["max"]
-        report["simulation_realtime_factor"] = sim.get("realtime_factor")
-        collisions.extend(c.as_dict() for c in pb.collisions)
-        sim_files = {f"simulation_{k}": v for k, v in pb.write(out / "simulation").items()}
-        if video:
-            from ..sim import render_video
 
-            sim_files["video"] = render_video(scene, out / "video.mp4", traj.t, pb.q)
-        timings["simulation_s"] = time.perf_counter() - t3
-    cut_feed = feed[hit_t]
-    interior = hit_t & ~traj.feed_limited
-    report.setdefault("max_wire_deviation_mm", None)
-    report.setdefault("max_tcp_tracking_error_mm", None)
-    report.update(
-        {
-            "duration_s": float(traj.t[-1]),
-            "cut_duration_s": float(traj.t[in_cut][-1] - traj.t[in_cut][0]),
-            "samples": len(traj.t),
-            "control_period_s": dt,
-            "feed_speed_mm_s": job.cut.feed_speed * 1e3,
-            "max_feed_speed_mm_s": float(cut_feed.max() * 1e3) if cut_feed.size else 0.0,
-            "feed_within_1pct_fraction": float(
-                np.mean(np.abs(feed[interior] / job.cut.feed_speed - 1.0) <= 0.01)
-            )
-            if interior.any()
-            else 0.0,
-            "max_joint_speed_ratio": ratios["max_speed_ratio"],
-            "max_joint_accel_ratio": ratios["max_acc_ratio"],
-            "min_singularity_measure": float(model.singularity_measure(traj.q[in_cut]).min()),
-            "max_planned_wire_deviation_mm": float(dev[hit_t].max() * 1e3) if hit_t.any() else 0.0,
-            "collisions": collisions,
-            "roll_deg": float(np.degrees(m.roll[0])),
-            "constant_roll": bool(np.ptp(m.roll) < 1e-12),
-            "slide_m": float(m.slide[0]),
-            "wire_reversed": bool(m.reverse),
-            "kerf_mm": job.cut.kerf * 1e3,
-        }
-    )
+SINGULARITY_MARGIN = 0.02  # the redundancy search's own threshold (solve_redundancy)
+
+
+def _position_ratio(model, q: FloatArray) -> float:
+    """Largest |q - centre| / half-range over joints with finite limits (1 = at a limit)."""
+    lo, hi = np.asarray(model.lower), np.asarray(model.upper)
+    fin = np.isfinite(lo) & np.isfinite(hi)
+    if not fin.any():
+        return 0.0
+    lo, hi = lo[fin], hi[fin]
+    mid, half = 0.5 * (lo + hi), 0.5 * (hi - lo)
+    return float((np.abs(q[:, fin] - mid) / half).max())
+
+
+def _bow_cog(job: Job) -> FloatArray:
+    from ..sim.scene import BowTool
+
+    return BowTool.from_spec(job.tool).inertia()[0]
+
+
+def _finish(stage, result: PlanResult, job: Job) -> PlanResult:
+    """Copy the job, commit the staging folder, map the files to their final place."""
+    if stage is None:
+        return result
+    if job.source is not None:
+        result.files["job"] = atomic_write_bytes(stage.path / "job.toml",
+                                                 Path(job.source).read_bytes())  # fmt: skip
+    target = stage.commit({"kind": "plan", "feasible": result.feasible,
+                           "verdict": result.verdict.summary() if result.verdict else None})
+    files = {k: target / Path(v).relative_to(stage.path) for k, v in result.files.items()}
+    return dataclasses.replace(result, files=files)
+
+
+def _write(
+    folder: Path, job: Job, cp: CutPath, traj: TimedPath, trajectory, feed: FloatArray,
+    hit_t: np.ndarray, model, W: FloatArray, pb, ok: bool, video: bool, report: dict,
+) -> dict[str, Path]:
+    """The files of a plan into ``folder``; no trajectory when the verdict fails."""
     files: dict[str, Path] = {}
-    files["trajectory"] = write_trajectory(
-        out / "trajectory.csv",
-        traj.t,
-        traj.q,
-        G,
-        comments=[
-            f"robot: {job.robot.model}",
-            f"period: {dt} s",
-            "tcp: wire frame (midpoint of the wire, z along it)",
-        ],
-    )
+    if ok:
+        files["trajectory"] = write_trajectory(folder / "trajectory.csv", trajectory)
+        files["trajectory_meta"] = folder / "trajectory.json"
     from ..geometry.lines import Lines
     from ..geometry.mesh import box_clipped_mesh
     from ..io.mesh import write_stl
 
     z, o = cp.frames[:, :3, 2], cp.frames[:, :3, 3]
     lines = Lines(np.concatenate([z, np.cross(o, z)], axis=1))
-    files["refined"] = save_lines(out / "refined.json", lines, frames=cp.frames)
+    files["refined"] = save_lines(folder / "refined.json", lines, frames=cp.frames)
     mesh = box_clipped_mesh(lines, job.stock.centre, job.stock.size, job.stock.rotation)
     if len(mesh.faces):
-        files["surface"] = write_stl(out / "surface.stl", mesh.vertices, mesh.faces)
-    files["plots"] = _plots(out / "plots.png", job, cp, traj, feed, hit_t, model, flange, W)
-    files.update(sim_files)
-    timings["write_s"] = time.perf_counter() - t2 - timings.get("simulation_s", 0.0)
-    timings["total_s"] = time.perf_counter() - t0
-    report["timings"] = timings
-    files["report"] = atomic_write_text(out / "report.json", json.dumps(report, indent=1) + "\n")
-    return PlanResult(True, report, files, traj, cp)
+        files["surface"] = write_stl(folder / "surface.stl", mesh.vertices, mesh.faces)
+    flange = model.fk(traj.q)
+    files["plots"] = _plots(folder / "plots.png", job, cp, traj, feed, hit_t, model, flange, W)
+    if pb is not None:
+        sim = pb.write(folder / "simulation", trajectory=ok)
+        files.update({f"simulation_{k}": v for k, v in sim.items()})
+        if video and ok:
+            from ..sim import RenderUnavailable, Scene, render_video
+
+            try:
+                scene = Scene.from_job(job, robot=model)
+                files["video"] = render_video(scene, folder / "video.mp4", traj.t, pb.q)
+            except RenderUnavailable as exc:
+                report.setdefault("notes", []).append(f"no video: {exc}")
+    return files
 
 
 def _plots(

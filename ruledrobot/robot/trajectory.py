@@ -1,0 +1,340 @@
+"""The one joint-trajectory type of the project, with everything a controller needs.
+
+A :class:`Trajectory` is what the planner writes and what export, run and
+simulate read: samples ``t`` (M,) s, joint positions ``q`` (M, 6) rad and the
+TCP pose in the **robot base frame** ``tcp`` (M, 6) as UR pose vectors
+``[x, y, z, rx, ry, rz]`` (m, rad), plus :class:`TrajectoryMeta`:
+
+* ``robot`` — the catalogue model it was planned for (``"ur5e"``);
+* ``control_period`` — the controller period it is sampled at [s];
+* ``tcp_offset`` — the TCP in the flange frame (4, 4): UR's "TCP offset", what
+  ``set_tcp`` must be set to so that the controller's TCP is the ``tcp`` column;
+* ``payload`` — mass [kg] and centre of gravity in the flange frame [m]
+  (``set_payload``);
+* ``kinematics`` — the DH table it was planned with and its checksum;
+* ``base`` — the robot base in the job's world frame (information: where the
+  simulation puts the robot);
+* ``phases`` — named sample ranges (approach, lead_in, cut, lead_out, retract,
+  move) and ``in_stock`` — sample ranges with the wire inside the stock;
+* ``job`` — the job file it came from (path and SHA-256), ``source`` — what
+  produced it.
+
+The invariant every consumer may rely on (and :meth:`Trajectory.tcp_error`
+measures): ``tcp[k] = FK(q[k]) · tcp_offset`` with FK the model of
+``kinematics`` and no base, i.e. the TCP column is what the controller reports
+as ``actual_TCP_pose`` once its TCP is set to ``tcp_offset``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from ..geometry.se3 import pose_from_ur_vector, ur_vector_from_pose
+from ._checks import FloatArray, as_array, as_pose_or_vector, readonly
+from .model import RobotModel
+from .rates import finite_difference_rates
+
+__all__ = [
+    "PHASE_NAMES",
+    "KinematicsRef",
+    "Payload",
+    "Phase",
+    "Trajectory",
+    "TrajectoryMeta",
+    "kinematics_checksum",
+    "model_for",
+    "phases_from_labels",
+    "runs",
+]
+
+#: Names of trajectory phases, in the order a cut meets them.
+PHASE_NAMES = ("approach", "lead_in", "cut", "lead_out", "retract", "transit", "move")
+
+
+def kinematics_checksum(dh: ArrayLike) -> str:
+    """``"sha256:<hex>"`` of a DH table (J, 4) ``[theta_offset, a, d, alpha]`` per joint.
+
+    The numbers are hashed as their shortest round-trip decimal text, so the same
+    table read back from JSON gives the same checksum.
+    """
+    table = np.asarray(dh, dtype=np.float64)
+    text = ";".join(",".join(repr(float(x)) for x in row) for row in table)
+    return "sha256:" + hashlib.sha256(text.encode()).hexdigest()
+
+
+@dataclass(frozen=True)
+class KinematicsRef:
+    """The kinematics a trajectory was planned with.
+
+    ``dh`` (J, 4): per joint ``[theta_offset, a, d, alpha]`` (standard DH, m and
+    rad); ``source``: ``"nominal"`` (the catalogue table) or where a calibration
+    came from; ``checksum``: :func:`kinematics_checksum` of ``dh``.
+    """
+
+    dh: FloatArray
+    source: str = "nominal"
+    checksum: str = ""
+
+    def __post_init__(self) -> None:
+        dh = as_array(self.dh, "kinematics.dh", (4,))
+        if dh.ndim != 2:
+            raise ValueError(f"kinematics.dh: expected (J, 4), got shape {dh.shape}")
+        object.__setattr__(self, "dh", readonly(dh))
+        expected = kinematics_checksum(dh)
+        if self.checksum and self.checksum != expected:
+            raise ValueError(
+                f"kinematics.checksum: {self.checksum} does not match its DH table ({expected})"
+            )
+        object.__setattr__(self, "checksum", expected)
+
+    @classmethod
+    def of(cls, model: RobotModel, source: str = "nominal") -> KinematicsRef:
+        dh = np.stack([model.theta_offset, model.a, model.d, model.alpha], axis=1)
+        return cls(dh, source)
+
+
+@dataclass(frozen=True)
+class Payload:
+    """The tool's mass [kg] and centre of gravity (3,) in the flange frame [m]."""
+
+    mass: float = 0.0
+    cog: FloatArray = field(default_factory=lambda: readonly(np.zeros(3)))
+
+    def __post_init__(self) -> None:
+        mass = float(as_array(self.mass, "payload.mass"))
+        if not mass >= 0.0:
+            raise ValueError(f"payload.mass: expected a mass >= 0 kg, got {mass}")
+        object.__setattr__(self, "mass", mass)
+        object.__setattr__(self, "cog", readonly(as_array(self.cog, "payload.cog", (3,))))
+
+
+@dataclass(frozen=True)
+class Phase:
+    """Samples ``start <= k < stop`` of a trajectory are in phase ``name``."""
+
+    name: str
+    start: int
+    stop: int
+
+    def __post_init__(self) -> None:
+        if self.name not in PHASE_NAMES:
+            raise ValueError(f"phase name: expected one of {', '.join(PHASE_NAMES)}, "
+                             f"got {self.name!r}")  # fmt: skip
+        if not 0 <= self.start < self.stop:
+            raise ValueError(f"phase {self.name}: expected 0 <= start < stop, got "
+                             f"{self.start}, {self.stop}")  # fmt: skip
+
+
+@dataclass(frozen=True)
+class TrajectoryMeta:
+    """Metadata of a :class:`Trajectory` (see the module doc)."""
+
+    robot: str
+    control_period: float
+    tcp_offset: FloatArray
+    payload: Payload
+    kinematics: KinematicsRef
+    base: FloatArray = field(default_factory=lambda: readonly(np.eye(4)))
+    phases: tuple[Phase, ...] = ()
+    in_stock: tuple[tuple[int, int], ...] = ()
+    job: dict[str, str] | None = None
+    source: str = ""
+
+    def __post_init__(self) -> None:
+        put = object.__setattr__
+        put(self, "tcp_offset", readonly(as_pose_or_vector(self.tcp_offset, "tcp_offset")))
+        put(self, "base", readonly(as_pose_or_vector(self.base, "base")))
+        period = float(self.control_period)
+        if not (np.isfinite(period) and period > 0):
+            raise ValueError(f"control_period: expected a positive period (s), got {period}")
+        put(self, "control_period", period)
+        put(self, "phases", tuple(self.phases))
+        put(self, "in_stock", tuple((int(a), int(b)) for a, b in self.in_stock))
+        for a, b in self.in_stock:
+            if not 0 <= a < b:
+                raise ValueError(f"in_stock: expected ranges 0 <= start < stop, got [{a}, {b}]")
+
+    @classmethod
+    def for_model(cls, model: RobotModel, **fields: object) -> TrajectoryMeta:
+        """Metadata for a trajectory of ``model``: its name, period, tool (as TCP
+        offset), tool mass and COM (as payload) and nominal kinematics; ``fields``
+        override any of them."""
+        kw: dict[str, object] = {
+            "robot": model.name,
+            "control_period": model.control_period,
+            "tcp_offset": model.tool,
+            "payload": Payload(model.tool_mass, model.tool_com),
+            "kinematics": KinematicsRef.of(model),
+            "base": model.base,
+        }
+        kw.update(fields)
+        return cls(**kw)  # type: ignore[arg-type]
+
+    def replace(self, **changes: object) -> TrajectoryMeta:
+        return dataclasses.replace(self, **changes)  # type: ignore[arg-type]
+
+
+def model_for(meta: TrajectoryMeta) -> RobotModel:
+    """The robot a trajectory was planned for: the catalogue model ``meta.robot`` with
+    the trajectory's kinematics, its TCP offset as tool and its payload; no base (the
+    trajectory's poses are in the robot base frame)."""
+    from .catalogue import load
+
+    model = load(meta.robot)
+    dh = meta.kinematics.dh
+    if dh.shape != (model.n_joints, 4):
+        raise ValueError(f"kinematics.dh: {meta.robot} has {model.n_joints} joints, the "
+                         f"trajectory's table has shape {dh.shape}")  # fmt: skip
+    nominal = KinematicsRef.of(model)
+    if meta.kinematics.checksum != nominal.checksum:
+        model = dataclasses.replace(
+            model, theta_offset=dh[:, 0], a=dh[:, 1], d=dh[:, 2], alpha=dh[:, 3]
+        )
+    if abs(meta.control_period - model.control_period) > 1e-12:
+        raise ValueError(f"control_period: {meta.control_period} s, but a {meta.robot} runs at "
+                         f"{model.control_period} s")  # fmt: skip
+    return dataclasses.replace(
+        model, tool=meta.tcp_offset, tool_mass=meta.payload.mass, tool_com=meta.payload.cog
+    )
+
+
+@dataclass(frozen=True)
+class Trajectory:
+    """A sampled joint trajectory with its metadata (see the module doc).
+
+    ``t`` (M,) s from the start, strictly increasing; ``q`` (M, 6) rad; ``tcp``
+    (M, 6) UR pose vectors of the TCP in the robot base frame; ``meta``.
+    """
+
+    t: FloatArray
+    q: FloatArray = field(repr=False)
+    tcp: FloatArray = field(repr=False)
+    meta: TrajectoryMeta = field(repr=False)
+
+    def __post_init__(self) -> None:
+        t = as_array(self.t, "t")
+        q = as_array(self.q, "q", (6,))
+        tcp = np.asarray(self.tcp, dtype=np.float64)
+        if tcp.shape[-2:] == (4, 4):
+            tcp = ur_vector_from_pose(tcp)
+        tcp = as_array(tcp, "tcp", (6,))
+        if t.ndim != 1 or q.shape[0] != t.size or tcp.shape[0] != t.size or t.size < 1:
+            raise ValueError(f"trajectory: t {t.shape}, q {q.shape} and tcp {tcp.shape} must "
+                             "have the same (non-zero) length")  # fmt: skip
+        if t.size > 1 and np.any(np.diff(t) <= 0):
+            k = int(np.flatnonzero(np.diff(t) <= 0)[0]) + 1
+            raise ValueError(f"t[{k}]: times must increase strictly")
+        for name, arr in (("t", t), ("q", q), ("tcp", tcp)):
+            object.__setattr__(self, name, readonly(arr))
+        m = t.size
+        for p in self.meta.phases:
+            if p.stop > m:
+                raise ValueError(f"phase {p.name}: stop {p.stop} beyond the {m} samples")
+        for a, b in self.meta.in_stock:
+            if b > m:
+                raise ValueError(f"in_stock: range [{a}, {b}) beyond the {m} samples")
+
+    @classmethod
+    def from_joints(
+        cls, t: ArrayLike, q: ArrayLike, model: RobotModel, **meta_fields: object
+    ) -> Trajectory:
+        """Samples of ``model`` with the TCP column computed as FK(q) · tool in the
+        robot base frame (``model.base`` is recorded in the metadata, not applied)."""
+        meta = TrajectoryMeta.for_model(model, **meta_fields)
+        robot = model.with_base(np.eye(4))
+        q = as_array(q, "q", (6,))
+        return cls(as_array(t, "t"), q, ur_vector_from_pose(robot.fk(q)), meta)
+
+    @property
+    def n(self) -> int:
+        return int(self.t.size)
+
+    @property
+    def period(self) -> float:
+        """The median sampling period (s)."""
+        return float(np.median(np.diff(self.t))) if self.t.size > 1 else 0.0
+
+    @property
+    def duration(self) -> float:
+        return float(self.t[-1] - self.t[0])
+
+    def tcp_poses(self) -> FloatArray:
+        """TCP poses (M, 4, 4) in the robot base frame."""
+        return pose_from_ur_vector(self.tcp)
+
+    def rates(self) -> tuple[FloatArray, FloatArray]:
+        """Finite-difference joint speeds (M-1, 6) and accelerations (M-2, 6)."""
+        return finite_difference_rates(self.t, self.q)
+
+    def inside_stock(self) -> np.ndarray:
+        """(M,) bool: the wire is inside the stock at sample k."""
+        mask = np.zeros(self.n, dtype=bool)
+        for a, b in self.meta.in_stock:
+            mask[a:b] = True
+        return mask
+
+    def phase_at(self, k: int) -> str:
+        """The name of the phase sample ``k`` belongs to (``"move"`` if none is named)."""
+        for p in self.meta.phases:
+            if p.start <= k < p.stop:
+                return p.name
+        return "move"
+
+    def tcp_error(self, model: RobotModel | None = None) -> tuple[float, float, int]:
+        """Largest distance between the TCP column and FK(q) · tcp_offset: (metres,
+        radians, the sample where the position error is largest).  ``model``
+        defaults to :func:`model_for` of the metadata."""
+        robot = (model_for(self.meta) if model is None else model).with_base(np.eye(4))
+        T = robot.fk(self.q)
+        P = self.tcp_poses()
+        dp = np.linalg.norm(T[:, :3, 3] - P[:, :3, 3], axis=1)
+        R = np.einsum("kji,kjl->kil", T[:, :3, :3], P[:, :3, :3])
+        cos = np.clip((np.trace(R, axis1=1, axis2=2) - 1.0) / 2.0, -1.0, 1.0)
+        # arccos loses precision near 0: use the skew part as well
+        skew = np.stack([R[:, 2, 1] - R[:, 1, 2], R[:, 0, 2] - R[:, 2, 0],
+                         R[:, 1, 0] - R[:, 0, 1]], axis=1)  # fmt: skip
+        ang = np.arctan2(0.5 * np.linalg.norm(skew, axis=1), cos)
+        k = int(np.argmax(dp))
+        return float(dp[k]), float(ang.max()), k
+
+    def sliced(self, start: int, stop: int | None = None) -> Trajectory:
+        """Samples ``start:stop`` with times from 0 and phases clipped to them."""
+        stop = self.n if stop is None else stop
+        if not 0 <= start < stop <= self.n:
+            raise ValueError(f"slice [{start}, {stop}) outside the {self.n} samples")
+
+        def clip(a: int, b: int) -> tuple[int, int] | None:
+            a, b = max(a, start) - start, min(b, stop) - start
+            return (a, b) if a < b else None
+
+        phases = tuple(
+            Phase(p.name, *c) for p in self.meta.phases if (c := clip(p.start, p.stop))
+        )
+        stock = tuple(c for a, b in self.meta.in_stock if (c := clip(a, b)))
+        meta = self.meta.replace(phases=phases, in_stock=stock)
+        return Trajectory(self.t[start:stop] - self.t[start], self.q[start:stop],
+                          self.tcp[start:stop], meta)  # fmt: skip
+
+
+def phases_from_labels(labels: ArrayLike) -> tuple[Phase, ...]:
+    """Runs of equal labels (M,) (phase names) as :class:`Phase` ranges."""
+    lab = np.asarray(labels)
+    if lab.size == 0:
+        return ()
+    cut = np.flatnonzero(lab[1:] != lab[:-1]) + 1
+    starts = np.r_[0, cut]
+    stops = np.r_[cut, lab.size]
+    return tuple(Phase(str(lab[a]), int(a), int(b)) for a, b in zip(starts, stops, strict=True))
+
+
+def runs(mask: ArrayLike) -> tuple[tuple[int, int], ...]:
+    """Half-open ranges ``(start, stop)`` of the True runs of a boolean mask (M,)."""
+    m = np.asarray(mask, dtype=bool).astype(np.int8)
+    d = np.diff(np.r_[0, m, 0])
+    return tuple(zip(np.flatnonzero(d == 1).tolist(), np.flatnonzero(d == -1).tolist(),
+                     strict=True))  # fmt: skip
