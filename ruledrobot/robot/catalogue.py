@@ -12,9 +12,21 @@ Sources (collected in the project's research notes, ``mujoco.md`` section 1):
   (UR3e/UR5e/UR10e/UR20/UR30) and the ROS2 description's
   ``physical_parameters.yaml`` converted to DH frames.  UR20 link 6 uses the
   ROS value 0.926 kg (UR's article gives 0.846 kg @ [0, -0.0003, -0.0318]).
-* Speed and torque limits: ROS2 description ``joint_limits.yaml`` (citing
-  the UR manuals).  Position limits +-2 pi on every joint; wrist 3 of UR3 and
-  UR3e is unlimited ("infinite" in the manuals) and is stored as +-inf.
+* Speed and torque limits: ROS2 description ``config/<model>/
+  joint_limits.yaml`` (citing the UR manuals and UR's "Max. joint torques"
+  article), snapshot of 2024-10-14, tag 2.4.5, commit ``2221ec0f``; every
+  figure in ``_LIMITS`` equals it.  The torques are those of its PR #195
+  ("Update dynamic properties", 2024-09-20), which lowered the UR3e to
+  54/54/28/9/9/9 and the UR10e/UR16e wrists to 54 and raised the UR20/UR30
+  to 738/738/433/107 N m; versions before that PR read 56/56/28/12/12/12,
+  56 and 730/430/100 instead.
+* Position limits: +-2 pi on every joint except the elbow (joint 3), which
+  is +-pi: the shoulder lift gets in the way beyond about +-pi (the same
+  ``joint_limits.yaml`` files, ros-industrial/universal_robot issue 265, and
+  MuJoCo Menagerie's ``universal_robots_ur5e``/``ur10e`` class
+  ``size3_limited``, +-3.1415).  Wrist 3 of UR3 and UR3e is unlimited
+  ("infinite" in the manuals; ``has_position_limits: false`` in the ROS
+  description since its PR #196) and is stored as +-inf.
 * Acceleration limits are not published by UR: the default is the URScript
   ``movej`` default, 1.4 rad/s^2, on every joint (see ``docs/robot.md``).
 * Control period: 2 ms (500 Hz) on e-Series, 8 ms (125 Hz) on CB3.
@@ -29,6 +41,9 @@ import numpy as np
 from .model import DEFAULT_ACCELERATION, RobotModel
 
 _DEG = np.pi / 180.0
+# Elbow (joint 3) position limit [rad] of every catalogue model: the arm
+# collides with itself beyond about +-pi (see the module docstring).
+_ELBOW_LIMIT = np.pi
 _ALPHA = (np.pi / 2, 0.0, 0.0, np.pi / 2, -np.pi / 2, 0.0)
 
 # name: (d1, a2, a3, d4, d5, d6)  [m]
@@ -126,6 +141,7 @@ def load(name: str) -> RobotModel:
     masses, coms = _MASS[key]
     torque, speed_deg, j6_free, period, payload, reach = _LIMITS[key]
     limit = np.full(6, 2.0 * np.pi)
+    limit[2] = _ELBOW_LIMIT
     if j6_free:
         limit[5] = np.inf
     return RobotModel(

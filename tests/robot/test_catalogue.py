@@ -30,7 +30,11 @@ def test_every_model_is_consistent(name: str) -> None:
     assert np.all(m.a[1:3] < 0) and np.all(m.d[[0, 3, 4, 5]] > 0)
     assert np.all(m.theta_offset == 0.0)
     assert m.control_period == (0.002 if name in E_SERIES else 0.008)
-    assert np.all(m.upper[:5] == 2 * np.pi) and np.all(m.lower[:5] == -2 * np.pi)
+    for j in (0, 1, 3, 4):
+        assert m.upper[j] == 2 * np.pi and m.lower[j] == -2 * np.pi
+    assert m.upper[2] == np.pi and m.lower[2] == -np.pi  # the elbow
+    assert m.upper[5] == (np.inf if name in ("ur3", "ur3e") else 2 * np.pi)
+    np.testing.assert_array_equal(m.lower, -m.upper)
     assert np.all(m.max_velocity >= np.pi * 2 / 3 - 1e-12)  # slowest UR joint: 120 deg/s
     assert np.all(m.max_velocity <= 2 * np.pi + 1e-12)
     assert np.all(m.max_acceleration == rr_robot.DEFAULT_ACCELERATION)
@@ -49,6 +53,55 @@ def test_ur5e_numbers_match_the_published_table() -> None:
     np.testing.assert_allclose(m.max_torque, [150, 150, 150, 28, 28, 28])
     np.testing.assert_allclose(m.max_velocity, np.pi)
     assert m.payload == 5.0
+
+
+# UniversalRobots/Universal_Robots_ROS2_Description config/<model>/joint_limits.yaml,
+# snapshot of 2024-10-14 (tag 2.4.5, commit 2221ec0f): max_effort [N m] and
+# max_velocity [deg/s] of joints 1..6.  The e-Series torques are those of its
+# PR #195 (2024-09-20); older copies of the files differ (UR3e 56/56/28/12/12/12,
+# UR10e wrists 56, UR20/UR30 730/730/430/100/100/100).
+ROS2_JOINT_LIMITS: dict[str, tuple[tuple[float, ...], tuple[float, ...]]] = {
+    "ur3": ((56, 56, 28, 12, 12, 12), (180, 180, 180, 360, 360, 360)),
+    "ur5": ((150, 150, 150, 28, 28, 28), (180, 180, 180, 180, 180, 180)),
+    "ur10": ((330, 330, 150, 56, 56, 56), (120, 120, 180, 180, 180, 180)),
+    "ur3e": ((54, 54, 28, 9, 9, 9), (180, 180, 180, 360, 360, 360)),
+    "ur5e": ((150, 150, 150, 28, 28, 28), (180, 180, 180, 180, 180, 180)),
+    "ur10e": ((330, 330, 150, 54, 54, 54), (120, 120, 180, 180, 180, 180)),
+    "ur16e": ((330, 330, 150, 54, 54, 54), (120, 120, 180, 180, 180, 180)),
+    "ur20": ((738, 738, 433, 107, 107, 107), (120, 120, 150, 210, 210, 210)),
+    "ur30": ((738, 738, 433, 107, 107, 107), (120, 120, 150, 210, 210, 210)),
+}
+
+
+def test_limit_table_covers_the_catalogue() -> None:
+    assert set(ROS2_JOINT_LIMITS) == set(MODEL_NAMES)
+
+
+@pytest.mark.parametrize("name", MODEL_NAMES)
+def test_torques_and_speeds_match_the_ros2_description(name: str) -> None:
+    torque, speed_deg = ROS2_JOINT_LIMITS[name]
+    m = load(name)
+    np.testing.assert_array_equal(m.max_torque, torque)
+    np.testing.assert_allclose(m.max_velocity, np.radians(speed_deg), rtol=1e-15)
+
+
+@pytest.mark.parametrize("name", MODEL_NAMES)
+def test_elbow_is_limited_to_half_a_turn(name: str) -> None:
+    """Joint 3 is +-pi on every model (ROS joint_limits.yaml, Menagerie, universal_robot#265)."""
+    m = load(name)
+    assert m.lower[2] == -np.pi and m.upper[2] == np.pi
+    q = np.zeros(6)
+    for q3, inside in ((np.pi, True), (-np.pi, True), (np.pi + 1e-9, False), (-4.0, False)):
+        q[2] = q3
+        assert bool(m.within_limits(q)) is inside, q3
+    # the analytic IK's elbow angle lies in [-pi, pi], so its solutions stay inside
+    rng = np.random.default_rng(3)
+    qs = rng.uniform(-np.pi, np.pi, (50, 6))
+    sols = m.ik(m.fk(qs))
+    ok = ~np.isnan(sols[..., 0])
+    assert ok.any(axis=-1).all()
+    assert np.all(np.abs(sols[..., 2][ok]) <= np.pi)
+    assert np.all(m.within_limits(sols[ok]))
 
 
 def test_ur3_wrist3_is_unlimited() -> None:
@@ -95,7 +148,7 @@ def test_with_tool_base_limits_return_copies() -> None:
     np.testing.assert_allclose(mb.base[:3, 3], [1, 2, 3])
     ml = m.with_limits(lower=-np.pi, upper=np.pi, acceleration=[3, 3, 3, 5, 5, 5])
     assert np.all(ml.upper == np.pi) and ml.max_acceleration[5] == 5
-    assert np.all(m.upper == 2 * np.pi)
+    np.testing.assert_array_equal(m.upper, [2 * np.pi, 2 * np.pi, np.pi] + [2 * np.pi] * 3)
     assert "tool set" in repr(mt) and "base set" in repr(mb)
 
 
