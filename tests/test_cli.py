@@ -93,11 +93,12 @@ def test_chain_command_writes_mjcf_whose_axes_are_the_lines(tmp_path, rng):
 
 def test_simulate_command_reports_tracking(tmp_path):
     from ruledrobot.io.trajectory import write_trajectory
+    from ruledrobot.robot.trajectory import Trajectory
 
     model = rr.robot.load("ur5e")
     t = np.arange(0, 1.0, 0.002)
     q = np.array([3.0, -1.2, 1.4, -1.8, -1.57, 0.0]) + 0.05 * np.sin(2 * np.pi * t)[:, None]
-    traj = write_trajectory(tmp_path / "t.csv", t, q, model.fk(q), comments=["robot: ur5e"])
+    traj = write_trajectory(tmp_path / "t.csv", Trajectory.from_joints(t, q, model))
     result = runner.invoke(app, ["simulate", str(traj), "--out", str(tmp_path / "sim")])
     assert result.exit_code == 0, result.output
     assert "TCP position error" in result.output
@@ -106,11 +107,12 @@ def test_simulate_command_reports_tracking(tmp_path):
 
 def _small_trajectory(tmp_path):
     from ruledrobot.io.trajectory import write_trajectory
+    from ruledrobot.robot.trajectory import Trajectory
 
-    model = rr.robot.load("ur5e")
+    model = rr.robot.load("ur5e").with_tool([0, 0, 0.1, 0, 0, 0])
     t = np.arange(0, 0.6, 0.002)
     q = np.array([3.0, -1.2, 1.4, -1.8, -1.57, 0.0]) + 0.02 * (1 - np.cos(np.pi * t / 0.6))[:, None]
-    return write_trajectory(tmp_path / "t.csv", t, q, model.fk(q), comments=["robot: ur5e"])
+    return write_trajectory(tmp_path / "t.csv", Trajectory.from_joints(t, q, model))
 
 
 def test_export_urscript_and_dry_run(tmp_path):

@@ -21,13 +21,18 @@ import numpy as np
 
 from ..geometry import se3
 from ..geometry._arrays import FloatArray, cross
-from ..geometry.lines import Lines, plucker_from_point_direction
+from ..geometry.lines import (
+    Lines,
+    coincident_neighbours,
+    neighbour_gaps,
+    plucker_from_point_direction,
+)
 from ..geometry.ruled import RuledSurface
 from ..subdivision import check_length, check_steps, get_scheme, refine_plucker
 from ..subdivision.engine import refine_sequence
 from ..subdivision.spaces import EuclideanSpace, SE3Space, SphereSpace
 
-__all__ = ["ALGORITHMS", "RefineResult", "refine"]
+__all__ = ["ALGORITHMS", "RefineResult", "check_distinct_neighbours", "refine"]
 
 ALGORITHMS = ("projection", "combined", "dh")
 Algorithm = Literal["projection", "combined", "dh"]
@@ -57,6 +62,21 @@ class RefineResult:
     def surface(self) -> RuledSurface:
         """The refined rulings as a :class:`RuledSurface`."""
         return RuledSurface(self.lines, closed=self.closed, flip=self.flip if self.closed else None)
+
+
+def check_distinct_neighbours(plucker: FloatArray, closed: bool, what: str = "lines") -> None:
+    """ValueError naming consecutive lines that coincide (a duplicated ruling: its DH
+    frame is undefined and the refined surface kinks there; remove one of them)."""
+    bad = coincident_neighbours(plucker, closed)
+    if bad.size:
+        n = len(plucker)
+        gaps = neighbour_gaps(plucker, closed)
+        pairs = ", ".join(f"{i} and {(i + 1) % n} (gap {gaps[i]:.2g} m)" for i in bad[:6])
+        more = f" and {bad.size - 6} more" if bad.size > 6 else ""
+        raise ValueError(
+            f"{what}: consecutive rulings coincide: {pairs}{more}; the median gap is "
+            f"{np.median(gaps):.2g} m. Remove the duplicates (indices from 0)"
+        )
 
 
 def refine(
@@ -89,6 +109,7 @@ def refine(
         raise ValueError(f"algorithm: expected one of {', '.join(ALGORITHMS)}, got {algorithm!r}")
     sch = get_scheme(scheme, **params)
     steps = check_steps(steps)
+    check_distinct_neighbours(surf.lines.plucker, surf.closed)
     check_length(sch, len(surf.lines), "lines")
     flip = bool(surf.flip)
     common = dict(closed=surf.closed, flip=flip, algorithm=algorithm, scheme=scheme, steps=steps)

@@ -40,8 +40,9 @@ from typing import Any
 
 import numpy as np
 
-from ..io.trajectory import Trajectory, read_trajectory, write_trajectory
-from ..robot import RobotModel, load
+from ..io.trajectory import read_trajectory, write_trajectory
+from ..robot import RobotModel, load, model_for
+from ..robot.trajectory import Trajectory, TrajectoryMeta
 from .decimate import decimate_tcp_path
 from .limits import check_trajectory
 
@@ -121,10 +122,10 @@ class _Recorder:
         self.tcp.append(tcp)
         return True
 
-    def trajectory(self, comments: tuple[str, ...]) -> Trajectory | None:
+    def trajectory(self, meta: TrajectoryMeta) -> Trajectory | None:
         if len(self.t) < 2:
             return None
-        return Trajectory(np.array(self.t), np.array(self.q), np.array(self.tcp), comments)
+        return Trajectory(np.array(self.t), np.array(self.q), np.array(self.tcp), meta)
 
 
 class _Stop(Exception):
@@ -390,7 +391,7 @@ def _path_waypoints(
 def run_trajectory(
     traj: Trajectory | str | os.PathLike[str],
     host: str = "127.0.0.1",
-    model: RobotModel | str = "ur5e",
+    model: RobotModel | str | None = None,
     *,
     mode: str = "servoj",
     lookahead: float = 0.1,
@@ -408,7 +409,6 @@ def run_trajectory(
     path_blend: float = 0.002,
     path_acceleration: float = 1.0,
     actual_path: str | os.PathLike[str] | None = None,
-    set_tcp: bool = True,
     watchdog: float = 2.0,
 ) -> RunResult:
     """Run a joint trajectory on the UR controller at ``host`` (ur_rtde), monitored.
@@ -417,7 +417,8 @@ def run_trajectory(
     ----------
     traj : the trajectory, or a trajectory CSV path (the recording goes beside it).
     host : controller address (a robot, URSim, or :class:`~.emulator.Emulator`).
-    model : the robot model (limits, control period, TCP) or its name.
+    model : the robot model (limits, control period) or its name; default, and it
+        must agree with, the trajectory's metadata (:func:`ruledrobot.robot.model_for`).
     mode : ``"servoj"`` (stream one servoJ per controller period) or ``"path"``
         (one blended moveL path through the TCP samples decimated to
         ``path_tolerance`` m, blend radius ``path_blend`` m).
@@ -435,7 +436,6 @@ def run_trajectory(
     max_latency : how much later than normal the controller's data may arrive [s].
     actual_path : where to write the recording (default ``<name>.actual.csv``
         beside an input file; none for an in-memory trajectory).
-    set_tcp : set the controller's TCP to the model's tool before moving.
     watchdog : RTDE watchdog frequency [Hz] on the command register (the
         controller stops the program if this process falls silent for
         ``1/watchdog`` s); 0 disables it.
@@ -450,7 +450,11 @@ def run_trajectory(
     if not isinstance(traj, Trajectory):
         source = Path(traj)
         traj = read_trajectory(source)
-    robot = load(model) if isinstance(model, str) else model
+    planned = model_for(traj.meta)
+    robot = planned if model is None else (load(model) if isinstance(model, str) else model)
+    if robot.name != planned.name:
+        raise ValueError(f"trajectory planned for a {planned.name}, not for the {robot.name} "
+                         "given")  # fmt: skip
     if mode not in ("servoj", "path"):
         raise ValueError(f"mode: expected 'servoj' or 'path', got {mode!r}")
     if not 0.03 <= lookahead <= 0.2:
@@ -499,10 +503,12 @@ def run_trajectory(
             )
             return result
         sess.connect_control()
-        if set_tcp:
-            from ..geometry.se3 import ur_vector_from_pose
+        # the controller's TCP and payload are the trajectory's: the recording's TCP
+        # column is then the same frame as the plan's
+        from ..geometry.se3 import ur_vector_from_pose
 
-            sess.c.setTcp([float(x) for x in ur_vector_from_pose(robot.tool)])
+        sess.c.setTcp([float(x) for x in ur_vector_from_pose(traj.meta.tcp_offset)])
+        sess.c.setPayload(traj.meta.payload.mass, [float(x) for x in traj.meta.payload.cog])
         sess.arm_watchdog()
         stop = _execute(
             sess, mode, q_in, ts_in, t_grid, q_grid, traj, start_index, result,
@@ -544,14 +550,14 @@ def run_trajectory(
         result.max_deviation = sess.max_dev
     finally:
         sess.disconnect()
-    rec = sess.rec.trajectory(
-        (f"actual trajectory recorded by ruledrobot.export.run_trajectory on {host}",
-         f"robot {robot.name}, mode {mode}, status {result.status}",
-         f"input samples {start_index}..{result.stop_index} of {n}")
+    rec_meta = traj.meta.replace(
+        phases=(), in_stock=(), source=f"recorded by ruledrobot run on {host}: mode {mode}, "
+        f"status {result.status}, input samples {start_index}..{result.stop_index} of {n}",
     )  # fmt: skip
+    rec = sess.rec.trajectory(rec_meta)
     result.actual = rec
     if rec is not None and actual_path is not None:
-        result.actual_path = write_trajectory(actual_path, rec.t, rec.q, rec.tcp, rec.comments)
+        result.actual_path = write_trajectory(actual_path, rec)
     return result
 
 

@@ -26,7 +26,9 @@ from ._arrays import FloatArray, as_float_array, cross, cross3, dot, dot3, first
 __all__ = [
     "CommonNormal",
     "Lines",
+    "coincident_neighbours",
     "common_normal",
+    "neighbour_gaps",
     "plucker_from_point_direction",
     "plucker_from_two_points",
     "plucker_nearest",
@@ -184,6 +186,46 @@ def plucker_transform(T: ArrayLike, plucker: ArrayLike) -> FloatArray:
     l = np.einsum("...ij,...j->...i", R, x[..., :3])
     m = np.einsum("...ij,...j->...i", R, x[..., 3:]) + cross(t, l)
     return np.concatenate([l, m], axis=-1)
+
+
+#: Consecutive lines whose gap (:func:`neighbour_gaps`) is below this fraction of the
+#: sequence's median gap, or below :data:`COINCIDENT_ABS` m, count as coincident.
+COINCIDENT_REL = 1e-3
+COINCIDENT_ABS = 1e-9
+
+
+def neighbour_gaps(plucker: ArrayLike, closed: bool = False) -> FloatArray:
+    """How far apart consecutive lines are over the region they occupy (N-1,) or (N,) m.
+
+    The region is the segment of half-length ``L`` (the RMS spread of the lines'
+    points nearest their centroid, at least 1e-3 m) centred on line i's point
+    nearest the centroid; the gap is the largest distance from its ends and middle
+    to line i+1 (``|p x l - m|``).  Orientation does not count (a line and its
+    reverse have gap 0).  ``closed`` adds the gap from the last line to the first.
+    """
+    x = np.asarray(plucker, dtype=np.float64)
+    l, m = x[:, :3], x[:, 3:]
+    foot0 = cross(l, m)
+    c = foot0.mean(axis=0)
+    foot = foot0 + dot(c - foot0, l)[:, None] * l  # point of each line nearest the centroid
+    L = max(float(np.sqrt(((foot - c) ** 2).sum(axis=1).mean())), 1e-3)
+    nxt = np.r_[np.arange(1, len(x)), 0] if closed else np.arange(1, len(x))
+    a = np.arange(len(nxt))
+    gap = np.zeros(len(nxt))
+    for k in (-1.0, 0.0, 1.0):
+        p = foot[a] + k * L * l[a]
+        gap = np.maximum(gap, norm(cross(p, l[nxt]) - m[nxt]))
+    return gap
+
+
+def coincident_neighbours(plucker: ArrayLike, closed: bool = False) -> np.ndarray:
+    """Indices i (K,) whose line coincides with line i+1 (mod N when ``closed``):
+    gap below ``COINCIDENT_REL`` x the median gap or below ``COINCIDENT_ABS``."""
+    gap = neighbour_gaps(plucker, closed)
+    if gap.size == 0:
+        return np.zeros(0, dtype=int)
+    limit = max(COINCIDENT_ABS, COINCIDENT_REL * float(np.median(gap)))
+    return np.flatnonzero(gap < limit)
 
 
 @dataclass(frozen=True)

@@ -150,6 +150,9 @@ def meta_from_dict(doc: Any, where: str = "trajectory metadata") -> TrajectoryMe
     period = d.get("control_period_s", default=model.control_period)
     if not isinstance(period, (int, float)) or isinstance(period, bool):
         raise d.fail("control_period_s", f"expected a number of seconds, got {period!r}")
+    if abs(period - model.control_period) > 1e-12:
+        raise d.fail("control_period_s", f"{period} s, but a {model.name} runs at "
+                     f"{model.control_period} s")  # fmt: skip
     kin = d.get("kinematics")
     if kin is None:
         kinematics = KinematicsRef.of(model)

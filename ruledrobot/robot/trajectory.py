@@ -67,7 +67,7 @@ def kinematics_checksum(dh: ArrayLike) -> str:
     return "sha256:" + hashlib.sha256(text.encode()).hexdigest()
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class KinematicsRef:
     """The kinematics a trajectory was planned with.
 
@@ -98,7 +98,7 @@ class KinematicsRef:
         return cls(dh, source)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Payload:
     """The tool's mass [kg] and centre of gravity (3,) in the flange frame [m]."""
 
@@ -130,7 +130,7 @@ class Phase:
                              f"{self.start}, {self.stop}")  # fmt: skip
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class TrajectoryMeta:
     """Metadata of a :class:`Trajectory` (see the module doc)."""
 
@@ -203,7 +203,7 @@ def model_for(meta: TrajectoryMeta) -> RobotModel:
     )
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Trajectory:
     """A sampled joint trajectory with its metadata (see the module doc).
 

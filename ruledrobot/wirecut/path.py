@@ -2,7 +2,8 @@
 
 1. The input rulings are refined (``job.surface``: algorithm, scheme, and either
    a number of steps or a target ``spacing`` — the largest gap between
-   consecutive chord midpoints — for which steps are added until it holds).
+   consecutive rulings inside the stock, the distance from the chord ends of one
+   to the next — for which the fewest steps that meet it are taken).
 2. The frame motion (the refined DH frames of ``dh``; sign-continuous DH frames
    of the refined rulings otherwise) is kept between the first and the last
    ruling that meets the stock grown by the lead distance on every side, and
@@ -19,7 +20,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..algorithms import refine
+from ..algorithms import check_distinct_neighbours, refine
 from ..geometry import se3
 from ..geometry._arrays import FloatArray
 from ..geometry.box import Box
@@ -49,12 +50,22 @@ class CutPath:
 
 
 def _gaps(frames: FloatArray, stock: Box) -> float:
+    """Largest gap (m) between consecutive rulings inside the stock: the distance from
+    the chord ends of ruling i to ruling i+1, and back, where both cross the stock."""
     c0, c1, hit = chords(frames, stock)
-    mid = frames[:, :3, 3] + (0.5 * (c0 + c1))[:, None] * frames[:, :3, 2]
+    o, z = frames[:, :3, 3], frames[:, :3, 2]
     both = hit[:-1] & hit[1:]
     if not both.any():
         return np.inf
-    return float(np.linalg.norm(np.diff(mid, axis=0), axis=1)[both].max())
+
+    def to_line(p: FloatArray, k: slice) -> FloatArray:
+        d = p - o[k]
+        return np.linalg.norm(d - (d * z[k]).sum(axis=1, keepdims=True) * z[k], axis=1)
+
+    gaps = [to_line(o[a] + c[a, None] * z[a], b)
+            for a, b in ((slice(0, -1), slice(1, None)), (slice(1, None), slice(0, -1)))
+            for c in (c0, c1)]  # fmt: skip
+    return float(np.max(gaps, axis=0)[both].max())
 
 
 def _frames(job: Job, steps: int) -> FloatArray:
@@ -67,7 +78,11 @@ def _frames(job: Job, steps: int) -> FloatArray:
 
 
 def refine_for_job(job: Job) -> tuple[FloatArray, int]:
-    """Refined frames (M, 4, 4) and the number of steps used (see the module doc)."""
+    """Refined frames (M, 4, 4) and the number of steps used (see the module doc):
+    ``spacing`` takes the fewest steps whose largest gap inside the stock meets it."""
+    where = f"{job.source or 'job'}: [surface]"
+    check_distinct_neighbours(job.input_lines().plucker, False,
+                              f"{where} {job.surface.file or job.surface.builtin}")  # fmt: skip
     if job.surface.steps is not None:
         return _frames(job, job.surface.steps), job.surface.steps
     for steps in range(MAX_STEPS + 1):
@@ -75,7 +90,7 @@ def refine_for_job(job: Job) -> tuple[FloatArray, int]:
         if _gaps(F, job.stock) <= job.surface.spacing:
             return F, steps
     raise ValueError(
-        f"[surface] spacing: {job.surface.spacing} m not reached after {MAX_STEPS} steps "
+        f"{where} spacing: {job.surface.spacing} m not reached after {MAX_STEPS} steps "
         f"({len(F)} rulings, largest gap {_gaps(F, job.stock):.3g} m)"
     )
 

@@ -19,8 +19,7 @@ import numpy as np
 import pytest
 
 from ruledrobot.export.emulator import DEFAULT_Q, Emulator
-from ruledrobot.geometry.se3 import ur_vector_from_pose
-from ruledrobot.io.trajectory import Trajectory
+from ruledrobot.robot.trajectory import Trajectory
 from ruledrobot.robot import load
 
 #: hard limit per test [s]
@@ -155,5 +154,4 @@ def smooth_trajectory(
     t = np.arange(0.0, duration + 1e-9, period)
     s = np.sin(np.pi * t / duration) ** 2
     q = np.asarray(q0) + np.asarray(amplitude) * s[:, None]
-    tcp = ur_vector_from_pose(load(model).fk(q))
-    return Trajectory(t, q, tcp, ("synthetic test trajectory",))
+    return Trajectory.from_joints(t, q, load(model), source="synthetic test trajectory")

@@ -10,7 +10,7 @@ import pytest
 
 from ruledrobot.io.trajectory import read_trajectory, write_trajectory
 from ruledrobot.robot import load
-from ruledrobot.sim import PlaybackResult, Scene, infer_tool, play, play_file, simulate
+from ruledrobot.sim import PlaybackResult, Scene, play, play_file, simulate
 from ruledrobot.sim.scene import example_scene
 
 from .helpers import cartesian_move, smooth_trajectory, wire_pose
@@ -91,14 +91,14 @@ def test_report_keys_and_files(smooth_run, tmp_path):
     assert rep["samples"] == smooth_run.t.size == 1501
     assert rep["realtime_factor"] > 1.0
     paths = smooth_run.write(tmp_path / "out")
-    assert set(paths) == {"report", "tracking_plot", "limits_plot", "actual"}
+    assert set(paths) == {"report", "tracking_plot", "limits_plot", "simulated"}
     loaded = json.loads(paths["report"].read_text())
     assert loaded["tcp_position_error_mm"] == rep["tcp_position_error_mm"]
     for key in ("tracking_plot", "limits_plot"):
         assert paths[key].read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
-    actual = read_trajectory(paths["actual"])
+    actual = read_trajectory(paths["simulated"])
     np.testing.assert_allclose(actual.q, smooth_run.q, atol=1e-9)
-    assert actual.comments[0] == "robot: ur5e"
+    assert actual.meta.robot == "ur5e" and "MuJoCo" in actual.meta.source
 
 
 def test_wire_in_stock_is_reported_not_a_collision():
@@ -186,25 +186,22 @@ def test_progress_and_errors():
 
 
 def test_trajectory_file_and_simulate(tmp_path):
-    """A trajectory CSV of a robot with a TCP: the TCP is read back from its pose columns,
+    """A trajectory file of a robot with a TCP: the robot and TCP come from its metadata,
     and simulate() writes the report and plots (the CLI's `ruledrobot simulate`)."""
+    from ruledrobot.robot.trajectory import Trajectory
+
     robot = load("ur10e").with_tool([0.02, 0.0, 0.2, 0.0, 0.3, 0.0])
     t, q, _ = smooth_trajectory(1.0, q0=(0.0, -1.4, 1.2, -1.4, -1.57, 0.0))
-    path = write_trajectory(tmp_path / "traj.csv", t, q, robot.fk(q), comments=["robot: ur10e"])
-    tool = infer_tool(load("ur10e"), q, robot.fk(q))
-    np.testing.assert_allclose(tool, robot.tool, atol=1e-9)
+    path = write_trajectory(tmp_path / "traj.csv", Trajectory.from_joints(t, q, robot))
     res = play_file(path)
     assert res.robot.name == "ur10e"
     np.testing.assert_allclose(res.robot.tool, robot.tool, atol=1e-9)
     assert res.report()["tcp_position_error_mm"]["max"] < 0.5
     paths = simulate(path, tmp_path / "sim")
-    assert {"report", "tracking_plot", "limits_plot", "actual"} <= set(paths)
+    assert {"report", "tracking_plot", "limits_plot", "simulated"} <= set(paths)
     assert json.loads(paths["report"].read_text())["robot"] == "ur10e"
-    assert infer_tool(load("ur10e"), q, robot.fk(q[::-1])) is None
-    bad = tmp_path / "bad.csv"
-    bad.write_text("# robot: ur99\n" + path.read_text().split("\n", 1)[1])
-    with pytest.raises(ValueError, match=r"bad\.csv.*ur99"):
-        play_file(bad)
+    with pytest.raises(ValueError, match=r"planned for a ur10e.*not for the ur5e"):
+        play_file(path, load("ur5e"))
 
 
 def test_scene_gains_override():

@@ -45,10 +45,13 @@ def test_spacing_adds_steps_until_the_gap_holds(job):
     Ff, sf = refine_for_job(fine)
     assert sf > sc
     for F, spacing in ((Fc, 0.01), (Ff, 0.002)):
+        # the gap between rulings: distance of ruling i's chord ends to ruling i+1
         c0, c1, hit = chords(F, job.stock)
-        mid = F[:, :3, 3] + (0.5 * (c0 + c1))[:, None] * F[:, :3, 2]
-        gaps = np.linalg.norm(np.diff(mid, axis=0), axis=1)[hit[:-1] & hit[1:]]
-        assert gaps.max() <= spacing
+        o, z = F[:, :3, 3], F[:, :3, 2]
+        for c in (c0, c1):
+            d = o[:-1] + c[:-1, None] * z[:-1] - o[1:]
+            dist = np.linalg.norm(d - (d * z[1:]).sum(1, keepdims=True) * z[1:], axis=1)
+            assert dist[hit[:-1] & hit[1:]].max() <= spacing
 
 
 def test_surface_far_from_stock_is_reported(job):

@@ -41,11 +41,12 @@ def test_demo_plan_writes_every_file(demo):
         "max_joint_accel_ratio",
         "min_singularity_measure",
         "collisions",
-        "unreachable",
+        "verdict",
         "max_tcp_tracking_error_mm",
     ):
         assert key in report
-    assert report["collisions"] == [] and report["unreachable"] == []
+    assert report["collisions"] == [] and report["verdict"]["ok"] is True
+    assert report["verdict"]["failed"] == [] and len(report["verdict"]["checks"]) >= 11
     # verified in MuJoCo: the simulated wire stays on the target rulings inside the stock
     assert report["max_wire_deviation_mm"] <= 0.5
     assert report["max_tcp_tracking_error_mm"] <= 0.5
@@ -68,6 +69,8 @@ def test_trajectory_respects_limits_and_period(demo):
     from ruledrobot.wirecut.toolpath import wire_frame
 
     np.testing.assert_allclose(model.fk(traj.q) @ wire_frame(job.tool), traj.tcp_poses(), atol=1e-7)
+    np.testing.assert_allclose(traj.meta.tcp_offset, wire_frame(job.tool), atol=1e-12)
+    assert traj.meta.payload.mass == job.tool.mass and traj.meta.robot == "ur5e"
 
 
 def test_wire_lies_on_the_surface_and_moves_at_the_feed_speed(demo):
@@ -113,7 +116,7 @@ def test_cli_plan_and_infeasible_job(tmp_path):
     result = runner.invoke(app, ["plan", str(job), "--out", str(tmp_path / "far")])
     assert result.exit_code == 1
     text = " ".join(result.output.split())  # rich wraps long lines
-    assert "infeasible job" in text and "no continuous IK" in text
+    assert "verdict: FAIL" in text and "no continuous IK" in text
     report = json.loads((tmp_path / "far" / "report.json").read_text())
     assert report["feasible"] is False and report["reasons"]
     assert not (tmp_path / "far" / "trajectory.csv").exists()
