@@ -151,6 +151,7 @@ def runner_latency(host: str, model_name: str, physics: str) -> dict:
     from ruledrobot.export import run_trajectory
     from ruledrobot.io.trajectory import read_trajectory, write_trajectory
     from ruledrobot.robot import load
+    from ruledrobot.robot.trajectory import Trajectory
 
     model = load(model_name)
     t = np.arange(0.0, 3.0, model.control_period)
@@ -160,7 +161,7 @@ def runner_latency(host: str, model_name: str, physics: str) -> dict:
         tempfile.TemporaryDirectory() as tmp,
         Emulator(host, model_name, q0=q[0], backend=_backend(physics), unlock_delay=0.0) as emu,
     ):
-        src = write_trajectory(Path(tmp) / "cut.csv", t, q, model.fk(q))
+        src = write_trajectory(Path(tmp) / "cut.csv", Trajectory.from_joints(t, q, model))
         t0 = time.perf_counter()
         res = run_trajectory(src, emu.host, model_name)
         wall = time.perf_counter() - t0

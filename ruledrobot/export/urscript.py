@@ -15,7 +15,9 @@
 
 Sent to port 30003 (or 30001/30002) the ``def`` runs as a program; in a Script
 node of PolyScope the file only defines ``ruledrobot_cut()``, which a second
-node must call (``docs/rtde.md``).  Every mode sets the TCP and the payload from the trajectory's metadata, so the
+node must call (``docs/rtde.md``).
+
+Every mode sets the TCP and the payload from the trajectory's metadata, so the
 poses of ``movel``/``movep`` (the trajectory's TCP column) are the controller's
 TCP poses, and FK(q) · TCP equals them.  ``mode="servoj"`` streams every sample
 (``t`` = the time to the next sample; the last one holds for ``5 * lookahead``

@@ -19,8 +19,8 @@ import numpy as np
 import pytest
 
 from ruledrobot.export.emulator import DEFAULT_Q, Emulator
-from ruledrobot.robot.trajectory import Trajectory
 from ruledrobot.robot import load
+from ruledrobot.robot.trajectory import Trajectory
 
 #: hard limit per test [s]
 TEST_DEADLINE = float(os.environ.get("RULEDROBOT_EXPORT_TEST_DEADLINE", "45"))

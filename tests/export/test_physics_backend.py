@@ -10,6 +10,7 @@ import pytest
 from ruledrobot.export import run_trajectory
 from ruledrobot.export.emulator.physics import MujocoBackend
 from ruledrobot.io.trajectory import read_trajectory, write_trajectory
+from ruledrobot.robot.trajectory import Trajectory
 from ruledrobot.robot import load
 
 from .conftest import start_emulator
@@ -35,7 +36,7 @@ def test_runner_streams_to_the_mujoco_backed_emulator(request, tmp_path: Path) -
     t = np.arange(0.0, 1.5, 0.002)
     q0 = np.array([3.0, -1.2, 1.4, -1.8, -1.57, 0.0])
     q = q0 + 0.1 * (1 - np.cos(np.pi * t / 1.5))[:, None] * np.array([1, -0.5, 0.5, 1, 0, 1])
-    src = write_trajectory(tmp_path / "cut.csv", t, q, model.fk(q), comments=["robot: ur5e"])
+    src = write_trajectory(tmp_path / "cut.csv", Trajectory.from_joints(t, q, model))
     emu = start_emulator(request.node.nodeid, model=MODEL, unlock_delay=0.0, q0=q0,
                          backend=MujocoBackend)  # fmt: skip
     try:

@@ -11,7 +11,8 @@ import pytest
 
 from ruledrobot.export import ControllerError, RunResult, run_trajectory
 from ruledrobot.export.emulator import DEFAULT_Q, Emulator, KinematicBackend
-from ruledrobot.io.trajectory import Trajectory, read_trajectory, write_trajectory
+from ruledrobot.io.trajectory import read_trajectory, write_trajectory
+from ruledrobot.robot.trajectory import Trajectory
 from ruledrobot.robot import load
 
 from .conftest import smooth_trajectory, start_emulator
@@ -43,7 +44,7 @@ def _at_rest(emu: Emulator, wait: float = 0.15) -> bool:
 
 def test_servoj_run_follows_the_plan_and_records(emulator: Emulator, tmp_path: Path) -> None:
     traj = smooth_trajectory(q0=np.array(DEFAULT_Q) + 0.05)
-    src = write_trajectory(tmp_path / "cut.csv", traj.t, traj.q, traj.tcp)
+    src = write_trajectory(tmp_path / "cut.csv", traj)
     calls: list[tuple[int, int]] = []
     res = run_trajectory(src, emulator.host, MODEL, progress=lambda d, n: calls.append((d, n)),
                          approach_speed=1.0, approach_acceleration=4.0)  # fmt: skip
@@ -91,7 +92,7 @@ def test_limit_violations_are_refused_before_motion(emulator: Emulator) -> None:
     traj = smooth_trajectory()
     q = traj.q.copy()
     q[300:, 2] += 0.05  # a 0.05 rad step at sample 300 on joint 3: 25 rad/s
-    bad = Trajectory(traj.t, q, traj.tcp)
+    bad = Trajectory(traj.t, q, traj.tcp, traj.meta)
     with pytest.raises(ValueError, match=r"sample 300 .*joint q3 speed"):
         run_trajectory(bad, emulator.host, MODEL)
     with pytest.raises(ValueError, match=r"joint q1 acceleration .* at speed_scale 3"):
@@ -99,7 +100,7 @@ def test_limit_violations_are_refused_before_motion(emulator: Emulator) -> None:
     q = traj.q.copy()
     q[10, 4] = 7.0
     with pytest.raises(ValueError, match=r"sample 10 .*joint q5 position 7"):
-        run_trajectory(Trajectory(traj.t, q, traj.tcp), emulator.host, MODEL)
+        run_trajectory(Trajectory(traj.t, q, traj.tcp, traj.meta), emulator.host, MODEL)
     np.testing.assert_allclose(emulator.actual_q, DEFAULT_Q, atol=0)
     assert emulator.stats()["programs_received"] == 0
 
