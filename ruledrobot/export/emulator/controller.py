@@ -19,6 +19,11 @@ State machine (the parts clients see):
   arm brakes, power goes off; :meth:`release_emergency_stop`, then power on
   and brake release).
 * ``runtime_state``: STOPPED / PLAYING / PAUSED of the current program.
+* programs are compiled before they start (:mod:`.script_functions`): one line
+  the emulator cannot run refuses the whole program, nothing of it runs, the
+  running program is stopped, the compile error is logged at error level and
+  shown as the pendant's popup (:attr:`Controller.popup`, closed by the
+  dashboard's ``close popup``).
 
 Thread safety: every public method takes ``lock`` (re-entrant); the RTDE,
 dashboard and script-port threads call in concurrently with the clock thread.
@@ -28,6 +33,7 @@ from __future__ import annotations
 
 import logging
 import math
+import re
 import time
 from collections import deque
 from collections.abc import Sequence
@@ -42,8 +48,9 @@ from .backend import ArmBackend, KinematicBackend
 from .handshake import ControlScript
 from .kinematics import ArmKinematics
 from .motion import MotionError, PathMotion, Segment, StopMotion, joint_segment, linear_segment
-from .program import PathWaypoint, Program, parse_program
-from .script_runner import ScriptRunner
+from .program import CompileError, PathWaypoint, Program, parse_program
+from .script_functions import compile_program
+from .script_runner import ScriptRunner, run_io_statement
 from .states import JointMode, RobotMode, RuntimeState, SafetyMode, SafetyStatusBit
 
 __all__ = ["DEFAULT_Q", "Controller", "Event"]
@@ -138,11 +145,12 @@ class Controller:
         self.time = 0.0
         self.ticks = 0
         self.speed_fraction = 1.0
-        self.freedrive = False
         self.std_do = 0
         self.conf_do = 0
         self.tool_do = 0
         self.analog_out = [0.0, 0.0]
+        self.popup: str | None = None  # the pendant's popup (compile errors, popup())
+        self.compile_error: CompileError | None = None  # the last program refused
         self.last_input_names: frozenset[str] = frozenset()
         self.history: deque[list[float]] = deque(maxlen=1024)
         self.events: deque[Event] = deque(maxlen=2000)
@@ -211,6 +219,15 @@ class Controller:
                 "euromap67_output_bits": 0,
                 "euromap67_24V_voltage": 0.0,
                 "euromap67_24V_current": 0.0,
+                # no encoders on the tool flange / configurable inputs, the default
+                # tool I/O set-up of a UR installation (set_tool_output_mode(0),
+                # set_tool_digital_output_mode(n, 1))
+                "actual_configurable_digital_input_bits": 0,
+                "encoder0_raw": 0,
+                "encoder1_raw": 0,
+                "tool_output_mode": 0,
+                "tool_digital_output0_mode": 1,
+                "tool_digital_output1_mode": 1,
             }
         )
 
@@ -264,6 +281,7 @@ class Controller:
                 "actual_digital_output_bits": self.std_do
                 | (self.conf_do << 8)
                 | (self.tool_do << 16),
+                "actual_configurable_digital_output_bits": self.conf_do,
                 "standard_analog_output0": self.analog_out[0],
                 "standard_analog_output1": self.analog_out[1],
                 "tcp_offset": self.kin.tcp_offset,
@@ -329,20 +347,50 @@ class Controller:
                         self.analog_out[k] = min(max(x, 0.0), 1.0)
 
     def set_digital_out(self, kind: str, n: int, value: bool) -> None:
-        """URScript ``set_standard_digital_out`` / ``set_configurable_digital_out`` / tool."""
+        """A digital output: ``kind`` ``"standard"`` (pins 0-7), ``"configurable"`` (0-7)
+        or ``"tool"`` (0-1); ValueError for another kind or pin."""
+        top = {"standard": 7, "configurable": 7, "tool": 1}.get(kind)
+        if top is None:
+            raise ValueError(f"digital output kind: expected standard, configurable or tool, "
+                             f"got {kind!r}")  # fmt: skip
+        if isinstance(n, bool) or not isinstance(n, int) or not 0 <= n <= top:
+            raise ValueError(f"{kind} digital output: pin must be 0..{top}, got {n!r}")
         with self.lock:
             bit = 1 << n
-            if kind == "set_configurable_digital_out":
+            if kind == "configurable":
                 self.conf_do = (self.conf_do | bit) if value else (self.conf_do & ~bit)
-            elif kind == "set_tool_digital_out":
+            elif kind == "tool":
                 self.tool_do = (self.tool_do | bit) if value else (self.tool_do & ~bit)
             else:
                 self.std_do = (self.std_do | bit) if value else (self.std_do & ~bit)
 
-    def set_payload(self, mass: float, cog: ArrayLike) -> None:
+    def set_analog_out(self, n: int, fraction: float) -> None:
+        """Standard analog output ``n`` (0-1) to ``fraction`` (0..1 of its range)."""
+        if isinstance(n, bool) or not isinstance(n, int) or not 0 <= n <= 1:
+            raise ValueError(f"standard analog output: pin must be 0..1, got {n!r}")
+        f = float(fraction)
+        if not 0.0 <= f <= 1.0:
+            raise ValueError(f"standard analog output {n}: value must be in [0, 1], got {f!r}")
         with self.lock:
-            self.values["payload"] = float(mass)
-            self.values["payload_cog"] = tuple(float(x) for x in np.asarray(cog).reshape(3))
+            self.analog_out[n] = f
+
+    def set_payload(self, mass: float | None, cog: ArrayLike | None) -> None:
+        """Payload mass [kg] and centre of gravity [m] (flange frame); None keeps the value."""
+        with self.lock:
+            if mass is not None:
+                self.values["payload"] = float(mass)
+            if cog is not None:
+                self.values["payload_cog"] = tuple(float(x) for x in np.asarray(cog).reshape(3))
+
+    def show_popup(self, text: str) -> None:
+        """The pendant shows a popup (a compile error, URScript ``popup``)."""
+        with self.lock:
+            self.popup = text
+
+    def close_popup(self) -> None:
+        """Dashboard ``close popup``."""
+        with self.lock:
+            self.popup = None
 
     def set_watchdog(self, name: str, min_frequency: float, action: str = "stop") -> None:
         """URScript ``rtde_set_watchdog``: act when input ``name`` is not updated in time.
@@ -445,15 +493,47 @@ class Controller:
 
     # ------------------------------------------------------------ programs
 
+    def compile(self, text: str) -> Program:
+        """Parse and check a program as the controller compiles it (CompileError if not)."""
+        prog = parse_program(text)
+        if prog.kind != "rtde_control":
+            compile_program(prog, max_payload=self.model.payload)
+        return prog
+
+    def refuse(self, error: CompileError, name: str = "") -> None:
+        """A program failed to compile: it does not run; the running one stops; log and popup."""
+        with self.lock:
+            self.compile_error = error
+            if self.runner is not None:
+                self.stop_program("a new program arrived", decelerate=True)
+            what = f"program {name}" if name else "program"
+            self.log(f"compile error: {what} refused, nothing of it runs: {error}", level=1)
+            self.show_popup(f"Compile error in line {error.line}: {error.text}: {error.reason}")
+
     def load_script(self, text: str) -> bool:
-        """A program arrived on the script port: it replaces the running one and starts."""
+        """A program arrived on the script port: compiled, then it replaces the running one.
+
+        A ``sec`` (secondary) program runs at once beside the primary program.
+        Returns False when the program was refused (compile error) or cannot start.
+        """
         try:
-            prog = parse_program(text)
-        except (ValueError, MotionError) as exc:
-            with self.lock:
-                self.log(f"script port: cannot parse program: {exc}", level=1)
+            prog = self.compile(text)
+        except CompileError as exc:
+            first = next((ln for ln in text.splitlines() if ln.strip()), "")
+            m = re.match(r"\s*(?:def|sec)\s+([A-Za-z_]\w*)", first)
+            self.refuse(exc, m.group(1) if m else "")
             return False
+        if prog.kind == "sec":
+            return self.run_secondary(prog)
         return self.start_program(prog)
+
+    def run_secondary(self, prog: Program) -> bool:
+        """A secondary program: its statements (no motion) run now, the primary goes on."""
+        with self.lock:
+            for st in prog.statements:
+                run_io_statement(self, st)
+            self.log(f"secondary program {prog.name} finished")
+            return True
 
     def start_program(self, prog: Program) -> bool:
         with self.lock:
@@ -529,21 +609,32 @@ class Controller:
             prog = self._loaded_script or Program(Path(self.loaded_program).stem, "", "idle")
             return self.start_program(prog)
 
-    def load(self, path: str) -> bool:
-        """Dashboard ``load``: a ``.script`` file is parsed and run by ``play``; ``.urp`` idles."""
+    def load(self, path: str) -> str:
+        """Dashboard ``load``: ``"ok"``, ``"not found"`` or ``"error"`` (a ``.script`` that
+        does not compile: logged and shown as a popup).  A ``.script`` is run by
+        ``play``; a ``.urp`` idles (the emulator cannot run PolyScope programs)."""
         p = Path(path)
         if not p.is_file():
-            return False
+            return "not found"
+        script: Program | None = None
+        if p.suffix == ".script":
+            try:
+                text = p.read_text(encoding="utf-8")
+            except (OSError, UnicodeDecodeError) as exc:
+                self.log(f"load {p}: {exc}", level=1)
+                return "error"
+            try:
+                script = self.compile(text)
+            except CompileError as exc:
+                with self.lock:
+                    self.compile_error = exc
+                    self.log(f"compile error: {p.name} not loaded: {exc}", level=1)
+                    self.show_popup(f"Compile error in line {exc.line}: {exc.text}: {exc.reason}")
+                return "error"
         with self.lock:
             self.loaded_program = str(p)
-            self._loaded_script = None
-            if p.suffix == ".script":
-                try:
-                    self._loaded_script = parse_program(p.read_text(encoding="utf-8"))
-                except (OSError, ValueError) as exc:
-                    self.log(f"load {p}: {exc}", level=1)
-                    return False
-            return True
+            self._loaded_script = script
+        return "ok"
 
     # ------------------------------------------------------------ power and safety
 
@@ -632,8 +723,8 @@ class Controller:
         """Advance one control period; returns ``values`` (do not modify)."""
         t0 = time.perf_counter()
         with self.lock:
-            self.time += self.period
             self.ticks += 1
+            self.time = self.ticks * self.period
             self._check_watchdog()
             runner = self.runner
             if runner is not None and self.runtime_state == RuntimeState.PLAYING:

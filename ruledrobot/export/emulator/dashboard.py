@@ -104,8 +104,10 @@ class DashboardServer(TcpServer):
         if low == "close safety popup":
             return "closing safety popup"
         if low == "close popup":
+            c.close_popup()
             return "closing popup"
         if low.startswith("popup"):
+            c.show_popup(cmd[5:].strip())
             return "showing popup"
         if low.startswith("addtolog"):
             c.log(f"dashboard: {cmd[8:].strip()}")
@@ -114,8 +116,11 @@ class DashboardServer(TcpServer):
             path = cmd[5:].strip()
             if path.endswith(".installation"):
                 return f"Loading installation: {path}"
-            if c.load(path):
+            result = c.load(path)
+            if result == "ok":
                 return f"Loading program: {path}"
+            if result == "error":
+                return f"Error while loading program: {path}"
             return f"File not found: {path}"
         if low == "get loaded program":
             return (

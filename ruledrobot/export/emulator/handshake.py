@@ -16,6 +16,17 @@ Each control period the script reads the command: real-time commands
 0 -> N edge (the latch), blocking the loop until it completes, then signals
 done.  :class:`ControlScript` does the same, one :meth:`~ControlScript.step`
 per control period.
+
+Commands whose effect the emulator cannot produce (:data:`NOT_EMULATED`:
+force mode, contact detection, the force/torque sensor, teach and freedrive
+mode, direct torque and the dynamics queries) are not acknowledged: they raise
+a runtime error, the control script stops (runtime state STOPPED), as the
+script does on a robot when a command fails, so the client's call returns
+False (or raises, for calls that return a value).  Real-time commands
+(forceMode, toolContact, ...) are never waited for by ur_rtde, so that very
+call returns True in the client; the program has stopped by the next one.
+Command ids the script does not know are acknowledged without effect, as the
+script does.
 """
 
 from __future__ import annotations
@@ -34,7 +45,7 @@ from .program import Program
 if TYPE_CHECKING:
     from .controller import Controller
 
-__all__ = ["RT_COMMANDS", "Command", "ControlScript"]
+__all__ = ["NOT_EMULATED", "RT_COMMANDS", "Command", "ControlScript", "NotEmulatedError"]
 
 log = logging.getLogger("ruledrobot.export.emulator")
 
@@ -121,8 +132,47 @@ class Command(IntEnum):
 #: the client sends without waiting for "done" either.
 RT_COMMANDS = frozenset({24, 11, 9, 10, 6, 25, 26, 27, 38, 58, 66, 67, 68, 69, 70, 71, 12, 55})
 
+#: ur_rtde commands the emulator cannot carry out, with the client method and the
+#: URScript function behind them: a runtime error stops the control script.
+NOT_EMULATED: dict[int, str] = {
+    Command.FORCE_MODE: "forceMode (force_mode)",
+    Command.FORCE_MODE_STOP: "forceModeStop (end_force_mode)",
+    Command.ZERO_FT_SENSOR: "zeroFtSensor (zero_ftsensor)",
+    Command.TEACH_MODE: "teachMode (teach_mode)",
+    Command.END_TEACH_MODE: "endTeachMode (end_teach_mode)",
+    Command.FORCE_MODE_SET_DAMPING: "forceModeSetDamping (force_mode_set_damping)",
+    Command.FORCE_MODE_SET_GAIN_SCALING: "forceModeSetGainScaling (force_mode_set_gain_scaling)",
+    Command.TOOL_CONTACT: "toolContact (tool_contact)",
+    Command.MOVE_UNTIL_CONTACT: "moveUntilContact (tool_contact + speedl)",
+    Command.FREEDRIVE_MODE: "freedriveMode (freedrive_mode)",
+    Command.END_FREEDRIVE_MODE: "endFreedriveMode (end_freedrive_mode)",
+    Command.GET_FREEDRIVE_STATUS: "getFreedriveStatus (get_freedrive_status)",
+    Command.SET_EXTERNAL_FORCE_TORQUE: "setExternalForceTorque (external F/T input)",
+    Command.FT_RTDE_INPUT_ENABLE: "ftRtdeInputEnable (ft_rtde_input_enable)",
+    Command.ENABLE_EXTERNAL_FT_SENSOR: "enableExternalFtSensor (enable_external_ft_sensor)",
+    Command.SET_GRAVITY: "setGravity (set_gravity)",
+    Command.START_CONTACT_DETECTION: "startContactDetection (tool_contact)",
+    Command.STOP_CONTACT_DETECTION: "stopContactDetection (tool_contact)",
+    Command.READ_CONTACT_DETECTION: "readContactDetection (tool_contact)",
+    Command.DIRECT_TORQUE: "directTorque (direct_torque)",
+    Command.GET_MASS_MATRIX: "getMassMatrix (get_mass_matrix)",
+    Command.GET_CORIOLIS_AND_CENTRIFUGAL_TORQUES: "getCoriolisAndCentrifugalTorques",
+    Command.GET_JACOBIAN_TIME_DERIVATIVE: "getJacobianTimeDerivative",
+}
+
 READY = 1
 DONE = 2
+
+
+class NotEmulatedError(MotionError):
+    """A command the emulator cannot carry out: a runtime error that stops the program."""
+
+    def __init__(self, cmd: int) -> None:
+        super().__init__(
+            f"command {cmd}: {NOT_EMULATED[cmd]} is not emulated (the emulated arm has no "
+            "force control, contact sensing, F/T sensor, hand guiding or dynamics model)"
+        )
+
 
 Waiter = Callable[[], bool]
 
@@ -210,6 +260,9 @@ class ControlScript:
             self.out_int(0, DONE)
             return
         cmd = self.in_int(0)
+        if cmd in NOT_EMULATED and (cmd in RT_COMMANDS or not self.executing):
+            self.executing = True
+            raise NotEmulatedError(cmd)
         if cmd in RT_COMMANDS:
             self.realtime(cmd)
             self.out_int(0, READY)
@@ -297,8 +350,6 @@ class ControlScript:
             self.out_vec(q)
         elif cmd == Command.GET_JOINT_TORQUES:
             self.out_vec(c.backend.state().current)
-        elif cmd == Command.TOOL_CONTACT:
-            self.out_int(1, 0)
         elif cmd == Command.GET_ACTUAL_TOOL_FLANGE_POSE:
             q = c.backend.state().q
             flange = c.model.with_tool(np.eye(4)).fk(q)
@@ -310,8 +361,7 @@ class ControlScript:
             for col in range(6):
                 base = col * 6 if col < 4 else 36 + (col - 4) * 6
                 self.out_vec(J[:, col], base)
-        # FORCE_MODE, DIRECT_TORQUE, SET_EXTERNAL_FORCE_TORQUE and the dynamics
-        # queries are accepted without effect on the kinematic arm.
+        # the rest of NOT_EMULATED never gets here (step raises NotEmulatedError)
 
     def _apply_speedl(self) -> None:
         assert self._speedl is not None
@@ -409,26 +459,13 @@ class ControlScript:
         if cmd in (Command.SET_PAYLOAD, Command.SET_TARGET_PAYLOAD):
             c.set_payload(self.in_d(0), self.in_vec(1, 3))
             return None
-        if cmd == Command.TEACH_MODE or cmd == Command.FREEDRIVE_MODE:
-            c.freedrive = True
-            return None
-        if cmd == Command.END_TEACH_MODE or cmd == Command.END_FREEDRIVE_MODE:
-            c.freedrive = False
-            return None
         if cmd == Command.SET_WATCHDOG:
             c.set_watchdog(f"input_int_register_{self.off}", self.in_d(0), "stop")
-            return None
-        if cmd == Command.GET_FREEDRIVE_STATUS:
-            self.out_int(1, int(c.freedrive))
-            return None
-        if cmd == Command.READ_CONTACT_DETECTION:
-            self.out_int(1, 0)
             return None
         if cmd == Command.JOG_START:
             self._speedl = (self.in_vec(0), 1.0)
             self._apply_speedl()
             return None
-        # everything else (force mode, watchdog, payload/gravity, contact
-        # detection setup, ...) is accepted without effect
-        log.debug("rtde_control: command %d accepted without effect", cmd)
+        # ids the script does not know: acknowledged without effect, as the script does
+        log.debug("rtde_control: unknown command %d acknowledged", cmd)
         return None

@@ -52,7 +52,16 @@ _CALLS = frozenset(
     }
 )
 _PROPS = frozenset(
-    {"actual_q", "tcp_pose", "robot_mode", "safety_mode", "runtime_state", "events", "ports"}
+    {
+        "actual_q",
+        "tcp_pose",
+        "robot_mode",
+        "safety_mode",
+        "runtime_state",
+        "events",
+        "ports",
+        "popup",
+    }
 )
 
 
@@ -308,6 +317,11 @@ class Emulator:
     @property
     def runtime_state(self) -> RuntimeState:
         return RuntimeState(self._call("runtime_state"))
+
+    @property
+    def popup(self) -> str | None:
+        """The popup the pendant shows (a compile error, URScript ``popup``), or None."""
+        return self._call("popup")
 
     @property
     def events(self) -> list[tuple[float, int, str]]:

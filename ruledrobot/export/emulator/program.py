@@ -13,18 +13,26 @@ Two kinds of program matter:
 * any other program — e.g. the standalone programs
   :mod:`ruledrobot.export.urscript` writes — is parsed into its top-level
   statements, which :class:`~.controller.Controller` runs with a small
-  interpreter (motion, servoj, sleep, textmsg, set_tcp, register writes).
-  Control flow (``if``/``while``/``thread``) is not supported: such lines are
-  listed in ``Program.skipped``.
+  interpreter (:mod:`.script_runner`; the functions and their argument checks
+  are in :mod:`.script_functions`).  A ``sec`` program is a secondary program:
+  it runs beside the primary one (no motion, no waiting).
+
+The emulator has no variables and no control flow.  A line it cannot run
+(``if``/``while``/``thread``, an assignment, a variable, a syntax error, an
+unknown function, a bad argument) makes the whole program fail to compile:
+:class:`CompileError` names the line and its text, and nothing of the program
+runs — as a controller refuses a program that does not compile.
 """
 
 from __future__ import annotations
 
+import math
 import re
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 
 __all__ = [
+    "CompileError",
     "PathWaypoint",
     "Pose",
     "Program",
@@ -40,6 +48,20 @@ class ScriptSyntaxError(ValueError):
     """A statement the emulator cannot parse."""
 
 
+class CompileError(ScriptSyntaxError):
+    """A program line the emulator cannot run: the whole program is refused.
+
+    ``line`` is 1-based in the program text, ``text`` the line (stripped,
+    shortened to 80 characters), ``reason`` what is wrong with it.
+    """
+
+    def __init__(self, line: int, text: str, reason: str) -> None:
+        self.line = int(line)
+        self.text = text.strip()[:80]
+        self.reason = reason
+        super().__init__(f"line {self.line}: {self.text!r}: {reason}")
+
+
 @dataclass(frozen=True)
 class Pose:
     """A URScript pose literal ``p[x, y, z, rx, ry, rz]``."""
@@ -49,12 +71,18 @@ class Pose:
 
 @dataclass
 class Statement:
-    """A top-level call ``name(args..., key=value...)`` and its 1-based line number."""
+    """A top-level call ``name(args..., key=value...)``, its 1-based line number and text.
+
+    ``params``: the checked arguments by name (filled by
+    :func:`~.script_functions.compile_program`).
+    """
 
     name: str
     args: list
     kwargs: dict
     line: int
+    text: str = ""
+    params: dict = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -71,7 +99,7 @@ class PathWaypoint:
 
 @dataclass
 class Program:
-    """A parsed program; ``kind`` is ``"rtde_control"`` or ``"script"``."""
+    """A parsed program; ``kind`` is ``"rtde_control"``, ``"script"`` or ``"sec"``."""
 
     name: str
     text: str
@@ -79,7 +107,6 @@ class Program:
     register_offset: int = 0
     path: list[PathWaypoint] = field(default_factory=list)
     statements: list[Statement] = field(default_factory=list)
-    skipped: list[str] = field(default_factory=list)
 
 
 # ------------------------------------------------------------------ tokenizer / parser
@@ -90,6 +117,7 @@ _TOKEN = re.compile(
       | (?P<str>"(?:[^"\\]|\\.)*"|'(?:[^'\\]|\\.)*')
       | (?P<name>[A-Za-z_][A-Za-z_0-9]*)
       | (?P<op>[\[\](),=])
+      | (?P<comment>\#.*)
     )""",
     re.VERBOSE,
 )
@@ -106,6 +134,8 @@ def _tokens(text: str) -> list[tuple[str, str]]:
         if m is None or m.end() == pos:
             raise ScriptSyntaxError(f"unexpected text {text[pos : pos + 20]!r}")
         kind = m.lastgroup or ""
+        if kind == "comment":
+            break
         out.append((kind, m.group(kind)))
         pos = m.end()
     return out
@@ -145,7 +175,7 @@ class _Parser:
                 return True
             if text in ("False", "false"):
                 return False
-            raise ScriptSyntaxError(f"variables are not supported ({text!r})")
+            raise ScriptSyntaxError(f"variables are not emulated ({text!r})")
         raise ScriptSyntaxError(f"unexpected {text!r}")
 
     def list_(self) -> list:
@@ -170,7 +200,9 @@ def parse_call(text: str, line: int = 0) -> Statement:
     p = _Parser(toks)
     kind, name = p.take()
     if kind != "name":
-        raise ScriptSyntaxError(f"line {line}: expected a function call, got {text.strip()[:40]!r}")
+        raise ScriptSyntaxError(f"expected a function call, got {text.strip()[:40]!r}")
+    if p.peek()[1] == "=":
+        raise ScriptSyntaxError("assignments (variables) are not emulated")
     p.take("(")
     args: list = []
     kwargs: dict = {}
@@ -181,89 +213,116 @@ def parse_call(text: str, line: int = 0) -> Statement:
             kwargs[key] = p.value()
         else:
             if kwargs:
-                raise ScriptSyntaxError(f"line {line}: positional argument after keyword")
+                raise ScriptSyntaxError("positional argument after keyword")
             args.append(p.value())
         if p.peek()[1] == ",":
             p.take()
         elif p.peek()[1] != ")":
-            raise ScriptSyntaxError(f"line {line}: expected ',' or ')', got {p.peek()[1]!r}")
+            raise ScriptSyntaxError(f"expected ',' or ')', got {p.peek()[1]!r}")
     p.take(")")
     if p.peek()[0] != "end":
-        raise ScriptSyntaxError(f"line {line}: text after the call: {p.peek()[1]!r}")
-    return Statement(name, args, kwargs, line)
+        raise ScriptSyntaxError(f"text after the call: {p.peek()[1]!r}")
+    return Statement(name, args, kwargs, line, text.strip())
 
 
 # ------------------------------------------------------------------ programs
 
-_DEF = re.compile(r"^(def|sec)\s+([A-Za-z_][A-Za-z_0-9]*)\s*\(\s*\)\s*:")
+_DEF = re.compile(r"^(def|sec)\s+([A-Za-z_][A-Za-z_0-9]*)\s*\(\s*\)\s*:\s*(#.*)?$")
 _OFFSET = re.compile(r"# float register offset\n\s*(\d+)")
 _INJECT = "# inject move path\n"
 _MOVES = ("movej", "movel", "movep")
+#: words that start a control-flow or declaration line (not emulated)
+_KEYWORDS = frozenset({"if", "elif", "else", "while", "for", "thread", "def", "sec", "end",
+                       "return", "global", "local", "run", "join", "kill", "halt", "break",
+                       "continue", "enter_critical", "exit_critical"})  # fmt: skip
+_FIRST_WORD = re.compile(r"[A-Za-z_][A-Za-z_0-9]*")
 
 
 def _waypoint(st: Statement) -> PathWaypoint:
     if st.name not in _MOVES or len(st.args) != 1:
-        raise ScriptSyntaxError(f"line {st.line}: not a path move")
+        raise CompileError(st.line, st.text, "not a path move")
     target = st.args[0]
     pose = isinstance(target, Pose)
     values = target.values if isinstance(target, Pose) else tuple(target)
     if len(values) != 6:
-        raise ScriptSyntaxError(f"line {st.line}: expected 6 values, got {len(values)}")
+        raise CompileError(st.line, st.text, f"expected 6 values, got {len(values)}")
 
     def num(key: str, default: float) -> float:
         v = st.kwargs.get(key, default)
-        if not isinstance(v, float):
-            raise ScriptSyntaxError(f"line {st.line}: {key} must be a number")
+        if not isinstance(v, float) or not math.isfinite(v):
+            raise CompileError(st.line, st.text, f"{key} must be a finite number")
         return v
 
     return PathWaypoint(st.name, tuple(values), pose, num("a", 1.2), num("v", 0.25), num("r", 0.0))
 
 
+def _call(line: str, lineno: int) -> Statement:
+    """One statement line as a call; CompileError naming the line otherwise."""
+    word = _FIRST_WORD.match(line)
+    if word is not None and word.group(0) in _KEYWORDS:
+        raise CompileError(lineno, line, f"{word.group(0)!r}: control flow and declarations "
+                           "are not emulated")  # fmt: skip
+    try:
+        return parse_call(line, lineno)
+    except CompileError:
+        raise
+    except ScriptSyntaxError as exc:
+        raise CompileError(lineno, line, str(exc)) from None
+
+
+def _rtde_control(text: str) -> Program:
+    prog = Program("rtde_control", text, "rtde_control")
+    mo = _OFFSET.search(text)
+    if mo:
+        prog.register_offset = int(mo.group(1))
+    k = text.find(_INJECT)
+    if k >= 0:
+        lineno = text.count("\n", 0, k + len(_INJECT)) + 1
+        for raw in text[k + len(_INJECT) :].splitlines():
+            s = raw.strip()
+            if not s or s.startswith("signal_async_progress("):
+                lineno += 1
+                continue
+            if not s.startswith(_MOVES):
+                break
+            prog.path.append(_waypoint(_call(s, lineno)))
+            lineno += 1
+    return prog
+
+
 def parse_program(text: str) -> Program:
-    """Classify and parse one complete program (``def name(): ... end`` or one statement)."""
+    """Classify and parse one complete program (``def name(): ... end``, or lines).
+
+    Raises :class:`CompileError` (line, text, reason) when a line cannot be
+    run; arguments are checked by :func:`~.script_functions.compile_program`.
+    """
     lines = text.splitlines()
-    first = next((ln for ln in lines if ln.strip()), "")
-    m = _DEF.match(first.strip())
+    first_i = next((i for i, ln in enumerate(lines) if ln.strip()), None)
+    if first_i is None:
+        raise CompileError(1, "", "empty program")
+    first = lines[first_i]
+    m = _DEF.match(first.rstrip()) if not first[:1].isspace() else None
+    if m is None and first.lstrip().startswith(("def ", "sec ")):
+        raise CompileError(first_i + 1, first, "expected 'def name():' at column 0")
     name = m.group(2) if m else ""
     if name == "rtde_control":
-        prog = Program(name, text, "rtde_control")
-        mo = _OFFSET.search(text)
-        if mo:
-            prog.register_offset = int(mo.group(1))
-        k = text.find(_INJECT)
-        if k >= 0:
-            lineno = text.count("\n", 0, k + len(_INJECT)) + 1
-            for raw in text[k + len(_INJECT) :].splitlines():
-                s = raw.strip()
-                if not s or s.startswith("signal_async_progress("):
-                    lineno += 1
-                    continue
-                if not s.startswith(_MOVES):
-                    break
-                prog.path.append(_waypoint(parse_call(s, lineno)))
-                lineno += 1
-        return prog
-    prog = Program(name, text, "script")
-    body = lines
+        return _rtde_control(text)
+    prog = Program(name, text, "sec" if m and m.group(1) == "sec" else "script")
+    body: list[tuple[int, str]]
     if m:
-        start = lines.index(first) + 1
-        body = lines[start:]
-        # drop the closing 'end' at column 0
-        while body and not body[-1].strip():
-            body.pop()
-        if body and body[-1].rstrip() == "end":
-            body.pop()
-        offset = start
+        close = next((i for i in range(len(lines) - 1, first_i, -1)
+                      if lines[i].strip()), None)  # fmt: skip
+        if close is None or lines[close].rstrip() != "end":
+            raise CompileError(len(lines), lines[-1] if lines else "",
+                               "the program has no closing 'end' at column 0")  # fmt: skip
+        body = list(enumerate(lines[first_i + 1 : close], start=first_i + 2))
     else:
-        offset = 0
-    for i, raw in enumerate(body, start=offset + 1):
+        body = list(enumerate(lines, start=1))
+    for i, raw in body:
         s = raw.strip()
         if not s or s.startswith("#"):
             continue
-        try:
-            prog.statements.append(parse_call(s, i))
-        except ScriptSyntaxError:
-            prog.skipped.append(f"line {i}: {s[:80]}")
+        prog.statements.append(_call(s, i))
     return prog
 
 

@@ -10,7 +10,10 @@ is started (ur_rtde's IO interface never sends ``S``).
 
 Streaming: the controller's clock thread calls :meth:`RTDEServer.publish`
 once per control period; each started connection gets a data package when its
-own frequency is due (e.g. every 4th period for 125 Hz at 500 Hz).  Sends
+own frequency is due, on the decimation grid of the controller clock: a
+125 Hz stream on a 500 Hz controller gets the ticks that are multiples of 4
+(timestamps multiples of 8 ms), from its first package on, whenever it was
+started (:func:`due`).  Sends
 never block the clock: a connection that does not drain its socket
 accumulates a backlog and is closed beyond ``max_backlog`` bytes, as a real
 controller drops clients that do not read.  The ``slow controller`` fault
@@ -24,6 +27,7 @@ other connections are not affected.
 from __future__ import annotations
 
 import logging
+import math
 import random
 import socket
 import struct
@@ -51,9 +55,18 @@ from .protocol import (
 )
 from .tcp import Connection, TcpServer
 
-__all__ = ["RTDEConnection", "RTDEServer", "StreamStats"]
+__all__ = ["RTDEConnection", "RTDEServer", "StreamStats", "due"]
 
 log = logging.getLogger("ruledrobot.export.emulator")
+
+
+def due(tick: int, ratio: float) -> bool:
+    """Is a stream of ``ratio`` = frequency / controller frequency due at controller ``tick``?
+
+    True at the ticks where ``floor(tick * ratio)`` steps: every tick for
+    ratio 1, the multiples of 4 for 1/4 (125 Hz on 500 Hz), of 5 for 1/5.
+    """
+    return math.floor(tick * ratio + 1e-9) != math.floor((tick - 1) * ratio + 1e-9)
 
 
 class StreamStats:
@@ -74,7 +87,6 @@ class RTDEConnection(Connection):
         self.output: OutputRecipe | None = None
         self.inputs: dict[int, InputRecipe] = {}
         self.started = False
-        self.phase = 0.0
         self.backlog = bytearray()
         self.delayed: deque[tuple[float, bytes]] = deque()
         self.stats = StreamStats()
@@ -197,7 +209,6 @@ class RTDEServer(TcpServer):
             recipe = OutputRecipe(1, names, freq)
             if recipe.ok:
                 conn.output = recipe
-                conn.phase = 1.0  # first package on the next period
             else:
                 missing = [n for n, t in zip(names, recipe.types, strict=True) if t == "NOT_FOUND"]
                 log.info("rtde: %s asked for unknown outputs %s", conn.peer, missing)
@@ -244,18 +255,21 @@ class RTDEServer(TcpServer):
 
     # ------------------------------------------------------------ streaming
 
-    def publish(self, state: Mapping[str, object], now: float) -> None:
-        """Send a data package to each started connection whose frequency is due."""
+    def publish(self, state: Mapping[str, object], now: float, tick: int | None = None) -> None:
+        """Send a data package to each started connection whose frequency is due at ``tick``.
+
+        ``tick``: the controller tick ``state`` belongs to (default: the
+        controller's tick count); ``now``: the clock's time [s] (for the slow fault).
+        """
         period = self.controller.period
+        if tick is None:
+            tick = self.controller.ticks
         delay = self.delay
         for conn in self.connections():
             if not isinstance(conn, RTDEConnection) or conn.closed:
                 continue
             if conn.started and conn.output is not None:
-                conn.phase += conn.output.frequency * period
-                if conn.phase >= 1.0 - 1e-9:
-                    conn.phase -= 1.0
-                    conn.phase = min(conn.phase, 1.0)
+                if due(tick, conn.output.frequency * period):
                     data = conn.output.pack(state)
                     conn.stats.packages += 1
                     conn.stats.bytes += len(data)

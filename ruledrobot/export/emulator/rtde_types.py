@@ -1,10 +1,13 @@
 """RTDE variable names and their official types (protocol v2).
 
 The table follows Universal Robots' RTDE guide as mirrored by the Universal
-Robots Client Library (``src/rtde/data_package.cpp``) and the names the
-``ur_rtde`` 1.6 client asks for.  Clients decode data packages with their own
-hard-coded copy of this table, so every variable must be packed with exactly
-its official type: a wrong size silently shifts everything after it.
+Robots Client Library (``src/rtde/data_package.cpp``, whose list marks the
+two tool-output inputs ur_rtde uses as "not in official docs") and the names
+the ``ur_rtde`` 1.6 client asks for.  Names ur_rtde knows but UR's table does
+not (``actual_qdd``, ``actual_moment``) are ``NOT_FOUND``, as on a controller.
+Clients decode data packages with their own hard-coded copy of this table, so
+every variable must be packed with exactly its official type: a wrong size
+silently shifts everything after it.
 
 Names not in the table are answered ``NOT_FOUND`` in a recipe reply, as a real
 controller does.
@@ -64,6 +67,7 @@ OUTPUT_TYPES: dict[str, str] = {
     "target_TCP_pose": _V6,
     "target_TCP_speed": _V6,
     "actual_digital_input_bits": "UINT64",
+    "actual_configurable_digital_input_bits": "UINT64",
     "joint_temperatures": _V6,
     "actual_execution_time": _D,
     "robot_mode": "INT32",
@@ -79,6 +83,7 @@ OUTPUT_TYPES: dict[str, str] = {
     "actual_robot_current": _D,
     "actual_joint_voltage": _V6,
     "actual_digital_output_bits": "UINT64",
+    "actual_configurable_digital_output_bits": "UINT64",
     "runtime_state": "UINT32",
     "elbow_position": "VECTOR3D",
     "elbow_velocity": "VECTOR3D",
@@ -101,6 +106,11 @@ OUTPUT_TYPES: dict[str, str] = {
     "tool_output_voltage": "INT32",
     "tool_output_current": _D,
     "tool_temperature": _D,
+    "tool_output_mode": "UINT8",
+    "tool_digital_output0_mode": "UINT8",
+    "tool_digital_output1_mode": "UINT8",
+    "encoder0_raw": "INT32",
+    "encoder1_raw": "INT32",
     "tcp_force_scalar": _D,
     "output_bit_registers0_to_31": "UINT32",
     "output_bit_registers32_to_63": "UINT32",
@@ -127,9 +137,6 @@ INPUT_TYPES: dict[str, str] = {
     "configurable_digital_output": "UINT8",
     "tool_digital_output_mask": "UINT8",
     "tool_digital_output": "UINT8",
-    "tool_output_mode": "UINT8",
-    "tool_digital_output0_mode": "UINT8",
-    "tool_digital_output1_mode": "UINT8",
     "standard_analog_output_mask": "UINT8",
     "standard_analog_output_type": "UINT8",
     "standard_analog_output_0": _D,

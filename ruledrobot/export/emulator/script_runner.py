@@ -1,7 +1,9 @@
 """A small interpreter for standalone URScript programs (one statement list, no control flow).
 
 It runs the programs :mod:`ruledrobot.export.urscript` writes and similar
-hand-written ones, one step per control period:
+hand-written ones, one step per control period.  Programs arrive compiled
+(:func:`~.script_functions.compile_program`: every statement a known function
+with checked arguments in ``Statement.params``), so nothing is skipped:
 
 * ``movej``/``movel``/``movep`` (joint vector or ``p[...]`` pose; ``a``,
   ``v``, ``r``): consecutive moves with a blend radius ``r > 0`` form one
@@ -9,15 +11,18 @@ hand-written ones, one step per control period:
 * ``servoj(q, t=, lookahead_time=, gain=)``: sets the servo target and
   blocks for ``t`` (one control period when ``t = 0``);
 * ``speedj(qd, a, t)``, ``stopj(a)``, ``stopl(a)``, ``sleep(t)``, ``sync()``;
-* ``textmsg``, ``popup``, ``set_tcp(p[...])``, ``set_payload(m, cog)``,
-  ``write_output_integer_register``, ``write_output_float_register``,
-  ``write_output_boolean_register``, ``set_standard_digital_out``,
-  ``set_configurable_digital_out``, ``set_tool_digital_out``,
-  ``set_speed_slider_fraction`` (ignored: the slider belongs to the pendant).
+* ``textmsg``, ``popup`` (non-blocking; the pendant's popup), ``set_tcp(p[...])``,
+  ``set_payload(m, cog)``, ``set_target_payload``, ``set_payload_mass``,
+  ``set_payload_cog``, ``write_output_integer_register``,
+  ``write_output_float_register``, ``write_output_boolean_register``,
+  ``set_standard_digital_out``, ``set_configurable_digital_out``,
+  ``set_tool_digital_out``, ``set_digital_out`` (8, 9: tool),
+  ``set_standard_analog_out`` / ``set_analog_out``.
 
-Anything else is logged and skipped.  When the statements run out the program
-ends (runtime state STOPPED) and a servo or speed motion still in force is
-stopped with ``stopj(4)``.
+Motion can still fail while the program runs (a pose out of reach): that is a
+runtime error, the program stops (:meth:`~.controller.Controller.program_error`).
+When the statements run out the program ends (runtime state STOPPED) and a
+servo or speed motion still in force is stopped with ``stopj(4)``.
 """
 
 from __future__ import annotations
@@ -33,30 +38,57 @@ from .program import Pose, Program, Statement
 if TYPE_CHECKING:
     from .controller import Controller
 
-__all__ = ["ScriptRunner"]
+__all__ = ["ScriptRunner", "run_io_statement"]
 
 _MOVES = ("movej", "movel", "movep")
 
 
-def _num(st: Statement, key: str, pos: int | None, default: float) -> float:
-    if pos is not None and pos < len(st.args):
-        v = st.args[pos]
+def _target(v: object) -> tuple[np.ndarray, bool]:
+    """A checked move target: (6 values, is it a pose)."""
+    if isinstance(v, Pose):
+        return np.asarray(v.values, dtype=float), True
+    return np.asarray(v, dtype=float), False
+
+
+def _float(st: Statement, key: str) -> float:
+    return float(st.params[key])  # type: ignore[arg-type]
+
+
+def run_io_statement(c: Controller, st: Statement) -> bool:
+    """Run a non-motion statement (I/O, registers, TCP, payload, messages); False if not one."""
+    name, a = st.name, st.params
+    if name in ("textmsg", "popup"):
+        text = " ".join(str(x) for x in (a.get("s1", a.get("s")), a.get("s2", "")) if x != "")
+        c.log(text, level=1 if a.get("error") else 2 if a.get("warning") else 3)
+        if name == "popup":
+            c.show_popup(f"{a['title']}: {text}")
+    elif name == "set_tcp":
+        pose, _ = _target(a["pose"])
+        c.kin.set_tcp(pose)
+    elif name in ("set_payload", "set_target_payload", "set_payload_mass"):
+        cog = a.get("cog")
+        c.set_payload(_float(st, "m"), None if cog is None else np.asarray(cog, dtype=float))
+    elif name == "set_payload_cog":
+        c.set_payload(None, np.asarray(a["CoG"], dtype=float))
+    elif name == "write_output_integer_register":
+        c.set_out_int(int(a["address"]), int(a["value"]))  # type: ignore[call-overload]
+    elif name == "write_output_float_register":
+        c.set_out_double(int(a["address"]), _float(st, "value"))  # type: ignore[call-overload]
+    elif name == "write_output_boolean_register":
+        c.set_out_bit(int(a["address"]), bool(a["value"]))  # type: ignore[call-overload]
+    elif name in ("set_standard_digital_out", "set_configurable_digital_out",
+                  "set_tool_digital_out", "set_digital_out"):  # fmt: skip
+        n = int(a["n"])  # type: ignore[call-overload]
+        kind = {"set_standard_digital_out": "standard", "set_configurable_digital_out":
+                "configurable", "set_tool_digital_out": "tool"}.get(name)  # fmt: skip
+        if kind is None:  # set_digital_out: 0-7 standard, 8-9 tool
+            kind, n = ("tool", n - 8) if n >= 8 else ("standard", n)
+        c.set_digital_out(kind, n, bool(a["b"]))
+    elif name in ("set_standard_analog_out", "set_analog_out"):
+        c.set_analog_out(int(a["n"]), _float(st, "f"))  # type: ignore[call-overload]
     else:
-        v = st.kwargs.get(key, default)
-    if isinstance(v, bool) or not isinstance(v, float):
-        raise MotionError(f"line {st.line}: {st.name}: {key} must be a number")
-    return v
-
-
-def _vec(st: Statement, pos: int = 0) -> tuple[np.ndarray, bool]:
-    if pos >= len(st.args):
-        raise MotionError(f"line {st.line}: {st.name}: missing target")
-    v = st.args[pos]
-    pose = isinstance(v, Pose)
-    vals = v.values if isinstance(v, Pose) else v
-    if not isinstance(vals, (list, tuple)) or len(vals) != 6:
-        raise MotionError(f"line {st.line}: {st.name}: expected 6 values")
-    return np.asarray(vals, dtype=float), pose
+        return False
+    return True
 
 
 class ScriptRunner:
@@ -68,10 +100,6 @@ class ScriptRunner:
         self.pc = 0
         self.wait_ticks = 0
         self.waiting_motion: PathMotion | StopMotion | None = None
-        if program.skipped:
-            first = program.skipped[0][:60]
-            ctrl.log(f"program {program.name or '<line>'}: {len(program.skipped)} unsupported "
-                     f"line(s) skipped, the first: {first!r}", level=2)  # fmt: skip
 
     @property
     def line(self) -> int:
@@ -115,11 +143,9 @@ class ScriptRunner:
         while self.pc < len(stmts) and stmts[self.pc].name in _MOVES:
             st = stmts[self.pc]
             self.pc += 1
-            target, pose = _vec(st)
             linear = st.name != "movej"
-            a = _num(st, "a", None, 1.2 if linear else 1.4)
-            v = _num(st, "v", None, 0.25 if linear else 1.05)
-            r = _num(st, "r", None, 0.0)
+            target, pose = _target(st.params["q" if not linear else "pose"])
+            a, v, r = _float(st, "a"), _float(st, "v"), _float(st, "r")
             if linear:
                 if not pose:
                     target = np.asarray(c.kin.tcp_vector(target.tolist()))
@@ -142,56 +168,26 @@ class ScriptRunner:
     def _statement(self, st: Statement) -> bool:
         """Run one statement; True when it blocks this period."""
         c = self.c
-        name = st.name
+        name, a = st.name, st.params
         if name == "servoj":
-            q, _ = _vec(st)
-            t = _num(st, "t", None, 0.002)
-            c.set_servo(q, _num(st, "lookahead_time", None, 0.1), _num(st, "gain", None, 300.0))
-            self.wait_ticks = self._ticks(t) - 1
+            q, _ = _target(a["q"])
+            c.set_servo(q, _float(st, "lookahead_time"), _float(st, "gain"))
+            self.wait_ticks = self._ticks(_float(st, "t")) - 1
             return True
         if name == "speedj":
-            qd, _ = _vec(st)
-            c.set_speed(qd, _num(st, "a", 1, 1.4))
-            self.wait_ticks = self._ticks(_num(st, "t", 2, 0.0)) - 1
+            qd, _ = _target(a["qd"])
+            c.set_speed(qd, _float(st, "a"))
+            self.wait_ticks = self._ticks(_float(st, "t")) - 1
             return True
         if name in ("stopj", "stopl"):
-            self.waiting_motion = c.stop_motion(_num(st, "a", 0, 2.0))
+            self.waiting_motion = c.stop_motion(_float(st, "a"))
             return True
         if name == "sleep":
-            self.wait_ticks = self._ticks(_num(st, "t", 0, 0.0)) - 1
+            self.wait_ticks = self._ticks(_float(st, "t")) - 1
             return True
         if name == "sync":
             return True
-        if name in ("textmsg", "popup"):
-            c.log(" ".join(str(a) for a in st.args))
+        if run_io_statement(c, st):
             return False
-        if name == "set_tcp":
-            pose, _ = _vec(st)
-            c.kin.set_tcp(pose)
-            return False
-        if name in ("set_payload", "set_target_payload"):
-            cog = st.args[1] if len(st.args) > 1 else [0.0, 0.0, 0.0]
-            c.set_payload(_num(st, "m", 0, 0.0), np.asarray(cog, dtype=float))
-            return False
-        if name == "write_output_integer_register":
-            c.set_out_int(int(_num(st, "i", 0, 0)), int(_num(st, "v", 1, 0)))
-            return False
-        if name == "write_output_float_register":
-            c.set_out_double(int(_num(st, "i", 0, 0)), _num(st, "v", 1, 0.0))
-            return False
-        if name == "write_output_boolean_register":
-            b = st.args[1] if len(st.args) > 1 else False
-            c.set_out_bit(int(_num(st, "i", 0, 0)), bool(b))
-            return False
-        if name in (
-            "set_standard_digital_out",
-            "set_digital_out",
-            "set_configurable_digital_out",
-            "set_tool_digital_out",
-        ):
-            n = int(_num(st, "n", 0, 0))
-            b = st.args[1] if len(st.args) > 1 else False
-            c.set_digital_out(name, n, bool(b))
-            return False
-        c.log(f"line {st.line}: {name}() is not supported by the emulator, skipped", level=2)
-        return False
+        # compile_program admits only the functions above
+        raise MotionError(f"line {st.line}: {name}() cannot run")  # pragma: no cover

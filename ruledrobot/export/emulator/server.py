@@ -231,7 +231,7 @@ class ThreadedEmulator:
                 late = now - next_t
             try:
                 state = ctrl.tick()
-                self.rtde.publish(state, now)
+                self.rtde.publish(state, now, ctrl.ticks)
             except Exception:  # pragma: no cover - keep the clock alive whatever happens
                 log.exception("emulator: clock tick failed")
             stats.ticks += 1
@@ -297,6 +297,11 @@ class ThreadedEmulator:
     @property
     def runtime_state(self) -> RuntimeState:
         return self.controller.runtime_state
+
+    @property
+    def popup(self) -> str | None:
+        """The popup the pendant shows (a compile error, URScript ``popup``), or None."""
+        return self.controller.popup
 
     @property
     def events(self) -> list[tuple[float, int, str]]:
