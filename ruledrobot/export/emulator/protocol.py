@@ -171,12 +171,14 @@ class OutputRecipe:
     recipe_id: int
     names: list[str]
     frequency: float
+    key: tuple[str, ...] = field(init=False, repr=False)
     types: list[str] = field(init=False)
     ok: bool = field(init=False)
     _struct: struct.Struct | None = field(init=False, repr=False, default=None)
     _counts: list[int] = field(init=False, repr=False, default_factory=list)
 
     def __post_init__(self) -> None:
+        self.key = (str(self.recipe_id), *self.names)  # equal recipes pack the same package
         self.types = [output_type(n) or "NOT_FOUND" for n in self.names]
         self.ok = "NOT_FOUND" not in self.types
         if self.ok:

@@ -158,6 +158,7 @@ class RTDEServer(TcpServer):
         self._owner_lock = threading.Lock()
         self._rng = random.Random(1)
         self.protocol_errors = 0
+        self.publish_errors = 0
 
     def make_connection(self, sock: socket.socket, addr: tuple) -> Connection:
         return RTDEConnection(sock, addr)
@@ -259,29 +260,58 @@ class RTDEServer(TcpServer):
         """Send a data package to each started connection whose frequency is due at ``tick``.
 
         ``tick``: the controller tick ``state`` belongs to (default: the
-        controller's tick count); ``now``: the clock's time [s] (for the slow fault).
+        controller's tick count); ``now``: the clock's time [s] (for the slow
+        fault).  Connections with the same output recipe share one packed
+        package.  A connection that cannot be served (its package cannot be
+        packed, its socket fails) is closed with one log line; the others are
+        served as if nothing happened.
         """
         period = self.controller.period
         if tick is None:
             tick = self.controller.ticks
-        delay = self.delay
+        packed: dict[tuple[str, ...], bytes | Exception] = {}
         for conn in self.connections():
             if not isinstance(conn, RTDEConnection) or conn.closed:
                 continue
-            if conn.started and conn.output is not None:
-                if due(tick, conn.output.frequency * period):
-                    data = conn.output.pack(state)
-                    conn.stats.packages += 1
-                    conn.stats.bytes += len(data)
-                    if delay > 0.0 or conn.delayed:
-                        jit = self._rng.uniform(0.0, self.jitter) if self.jitter > 0 else 0.0
-                        conn.delayed.append((now + delay + jit, data))
-                    else:
-                        conn.push(data, self.max_backlog)
-            while conn.delayed and conn.delayed[0][0] <= now:
-                conn.push(conn.delayed.popleft()[1], self.max_backlog)
-            if conn.backlog:
-                conn.flush()
+            try:
+                self._serve(conn, state, now, tick, period, packed)
+            except Exception as exc:  # this connection only
+                self.publish_errors += 1
+                log.warning("rtde: closing %s: its data package cannot be sent: %s",
+                            conn.peer, exc)  # fmt: skip
+                conn.close()
+
+    def _serve(
+        self,
+        conn: RTDEConnection,
+        state: Mapping[str, object],
+        now: float,
+        tick: int,
+        period: float,
+        packed: dict[tuple[str, ...], bytes | Exception],
+    ) -> None:
+        recipe = conn.output
+        if conn.started and recipe is not None and due(tick, recipe.frequency * period):
+            data = packed.get(recipe.key)
+            if data is None:
+                try:
+                    data = recipe.pack(state)
+                except Exception as exc:
+                    data = exc
+                packed[recipe.key] = data
+            if isinstance(data, Exception):
+                raise data
+            conn.stats.packages += 1
+            conn.stats.bytes += len(data)
+            if self.delay > 0.0 or conn.delayed:
+                jit = self._rng.uniform(0.0, self.jitter) if self.jitter > 0 else 0.0
+                conn.delayed.append((now + self.delay + jit, data))
+            else:
+                conn.push(data, self.max_backlog)
+        while conn.delayed and conn.delayed[0][0] <= now:
+            conn.push(conn.delayed.popleft()[1], self.max_backlog)
+        if conn.backlog:
+            conn.flush()
 
     def set_delay(self, delay: float, jitter: float = 0.0) -> None:
         """Slow-controller fault: hold data packages back by ``delay`` (+ up to ``jitter``) s."""

@@ -52,11 +52,15 @@ class ClockStats:
     ``ticks``: control periods run.  ``missed``: periods the clock was too
     late to publish (it steps the controller to catch up, without sending).
     ``lateness``: recent publish times minus their scheduled times [s].
+    ``tick_errors`` / ``publish_errors``: controller periods / publishes that
+    raised (logged, rate-limited; the clock goes on).
     """
 
     ticks: int = 0
     missed: int = 0
     resyncs: int = 0
+    tick_errors: int = 0
+    publish_errors: int = 0
     lateness: deque | None = None
 
     def summary(self) -> dict[str, float]:
@@ -65,6 +69,7 @@ class ClockStats:
             "ticks": float(self.ticks),
             "missed": float(self.missed),
             "missed_fraction": self.missed / max(1, self.ticks),
+            "tick_errors": float(self.tick_errors),
             "lateness_mean_ms": float(lat.mean() * 1e3),
             "lateness_p99_ms": float(np.percentile(lat, 99) * 1e3),
             "lateness_max_ms": float(lat.max() * 1e3),
@@ -224,19 +229,36 @@ class ThreadedEmulator:
                     next_t = now
                     missed = 0
                 for _ in range(missed):
-                    ctrl.tick()
+                    self._tick()
                     stats.ticks += 1
                 stats.missed += missed
                 next_t += missed * period
                 late = now - next_t
+            state = self._tick()
             try:
-                state = ctrl.tick()
                 self.rtde.publish(state, now, ctrl.ticks)
-            except Exception:  # pragma: no cover - keep the clock alive whatever happens
-                log.exception("emulator: clock tick failed")
+            except Exception:  # publish isolates connections; this is a bug, keep the clock
+                stats.publish_errors += 1
+                self._log_error("emulator: publishing failed", stats.publish_errors)
             stats.ticks += 1
             lateness.append(late)
             next_t += period
+
+    def _tick(self) -> dict[str, object]:
+        """One controller period; a failure is counted and logged (rate-limited), and the
+        last published values go out again: the clock and the streams go on."""
+        try:
+            return self.controller.tick()
+        except Exception:
+            self.stats.tick_errors += 1
+            self._log_error("emulator: controller tick failed", self.stats.tick_errors)
+            return self.controller.values
+
+    @staticmethod
+    def _log_error(message: str, count: int) -> None:
+        """Log the 1st, 2nd, 4th, 8th, ... occurrence (a traceback per tick floods the log)."""
+        if count & (count - 1) == 0:
+            log.exception("%s (%d times so far)", message, count)
 
     # ------------------------------------------------------------ faults
 
@@ -322,6 +344,7 @@ class ThreadedEmulator:
         """Clock timing (:meth:`ClockStats.summary`) plus RTDE counters."""
         out = self.stats.summary()
         out["rtde_protocol_errors"] = float(self.rtde.protocol_errors)
+        out["publish_errors"] = float(self.rtde.publish_errors + self.stats.publish_errors)
         out["rtde_connections"] = float(len(self.rtde.connections()))
         out["programs_received"] = float(self.script.programs_received)
         out["limit_events"] = float(self.controller.limit_events)

@@ -1,0 +1,166 @@
+"""The emulator under abuse (issue 9): what one client does can never reach another.
+
+Each test starts its servers on its own loopback address and stops them.
+"""
+
+from __future__ import annotations
+
+import socket
+import threading
+import time
+from collections.abc import Iterator
+
+import pytest
+
+from ruledrobot.export.emulator import Emulator, ThreadedEmulator
+from ruledrobot.export.emulator.rawclient import UR_RTDE_RECEIVE_RECIPE, RawRTDEClient
+
+from .conftest import _address
+
+
+@pytest.fixture
+def local(request: pytest.FixtureRequest) -> Iterator[ThreadedEmulator]:
+    """A threaded emulator in this process (raw-socket clients only), ports picked freely."""
+    emu = None
+    for attempt in range(5):
+        try:
+            emu = ThreadedEmulator(
+                _address(request.node.nodeid, attempt), "ur5e", realtime=False
+            ).start()
+            break
+        except OSError:
+            continue
+    assert emu is not None
+    try:
+        yield emu
+    finally:
+        emu.close()
+
+
+class Reader:
+    """A raw RTDE client that reads every package in a thread; records arrival gaps."""
+
+    def __init__(
+        self,
+        host: str,
+        names: list[str] | tuple[str, ...] = ("timestamp",),
+        frequency: float = 500.0,
+        port: int = 30004,
+    ) -> None:
+        self.cli = RawRTDEClient(host, port)
+        assert self.cli.negotiate()
+        assert "NOT_FOUND" not in self.cli.setup_outputs(list(names), frequency)
+        assert self.cli.start()
+        self.gaps: list[float] = []
+        self.timestamps: list[float] = []
+        self.error: BaseException | None = None
+        self._stop = threading.Event()
+        self._t = threading.Thread(target=self._run, daemon=True)
+        self._t.start()
+
+    def _run(self) -> None:
+        last = time.monotonic()
+        try:
+            while not self._stop.is_set():
+                d = self.cli.read_data(timeout=2.0)
+                now = time.monotonic()
+                self.gaps.append(now - last)
+                last = now
+                if "timestamp" in d:
+                    self.timestamps.append(d["timestamp"])
+        except BaseException as exc:
+            if not self._stop.is_set():
+                self.error = exc
+
+    def stop(self) -> None:
+        self._stop.set()
+        self._t.join(3.0)
+        self.cli.close()
+
+
+def _send_script(host: str, port: int, text: bytes) -> None:
+    with socket.create_connection((host, port), timeout=2.0) as s:
+        s.sendall(text)
+
+
+# ---------------------------------------------------------------- 3: one line, one client
+
+
+@pytest.mark.parametrize(
+    "line",
+    [
+        b"set_standard_digital_out(64, True)",
+        b"set_configurable_digital_out(100, True)",
+        b"set_standard_digital_out(1e7, True)",
+    ],
+)
+def test_a_bad_io_line_does_not_stop_any_stream(line: bytes, emulator: Emulator) -> None:
+    host = emulator.host
+    readers = [Reader(host, UR_RTDE_RECEIVE_RECIPE), Reader(host, ["timestamp"], 125.0)]
+    try:
+        time.sleep(0.3)
+        _send_script(host, emulator.ports["script"], line + b"\n")
+        _send_script(host, emulator.ports["script"], b"def p():\n  " + line + b"\nend\n")
+        time.sleep(0.7)
+        for r in readers:
+            assert r.error is None
+            assert len(r.gaps) > 60 and max(r.gaps[5:]) < 0.1
+    finally:
+        for r in readers:
+            r.stop()
+    errors = [m for _, lv, m in emulator.events if lv <= 1]
+    assert len(errors) == 2 and all("compile error" in m for m in errors)
+    stats = emulator.stats()
+    assert stats["tick_errors"] == 0 and stats["publish_errors"] == 0
+
+
+def test_a_connection_that_cannot_be_served_is_closed_alone(local: ThreadedEmulator) -> None:
+    """A value no package can carry (a 65-bit integer) in one client's recipe: that
+    client is closed with one log line; the others keep their stream; the clock goes on."""
+    host = local.host
+    port = local.ports["rtde"]
+    good = Reader(host, ["timestamp", "actual_q"], port=port)
+    victim = Reader(host, ["timestamp", "actual_digital_output_bits"], port=port)
+    try:
+        time.sleep(0.2)
+        ctrl = local.controller
+        with ctrl.lock:
+            ctrl.std_do = 1 << 64  # bypasses every check: the packing must fail
+        time.sleep(0.5)
+        with ctrl.lock:
+            ctrl.std_do = 0
+        assert victim.error is not None  # closed
+        assert good.error is None and max(good.gaps[5:]) < 0.1
+        n = len(good.timestamps)
+        time.sleep(0.2)
+        assert len(good.timestamps) > n + 50
+    finally:
+        good.stop()
+        victim.stop()
+    s = local.stats_summary()
+    assert s["publish_errors"] >= 1 and s["tick_errors"] == 0
+    assert local.running
+
+
+def test_a_failing_tick_does_not_stop_publishing(
+    local: ThreadedEmulator, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    reader = Reader(local.host, ["timestamp"], port=local.ports["rtde"])
+    try:
+        time.sleep(0.1)
+        ctrl = local.controller
+        real = ctrl.backend.step
+        calls = {"n": 0}
+
+        def broken(dt: float) -> None:
+            calls["n"] += 1
+            if calls["n"] < 200:
+                raise RuntimeError("backend exploded")
+            real(dt)
+
+        monkeypatch.setattr(ctrl.backend, "step", broken)
+        time.sleep(0.6)
+        assert reader.error is None and max(reader.gaps[5:]) < 0.1
+    finally:
+        reader.stop()
+    assert local.stats_summary()["tick_errors"] >= 100
