@@ -6,6 +6,7 @@ Each test starts its servers on its own loopback address and stops them.
 from __future__ import annotations
 
 import socket
+import struct
 import threading
 import time
 from collections.abc import Iterator
@@ -164,3 +165,38 @@ def test_a_failing_tick_does_not_stop_publishing(
     finally:
         reader.stop()
     assert local.stats_summary()["tick_errors"] >= 100
+
+
+# ---------------------------------------------------------------- 4: recipes RTDE cannot carry
+
+
+def test_an_output_recipe_beyond_the_16_bit_size_is_refused(local: ThreadedEmulator) -> None:
+    """2,000 VECTOR6D outputs = 96 KB per package: no RTDE packet can carry it (its size
+    field is 16 bits).  The setup fails (recipe id 0), the stream cannot start, and the
+    other clients never notice."""
+    host, port = local.host, local.ports["rtde"]
+    good = Reader(host, ["timestamp"], port=port)
+    try:
+        with RawRTDEClient(host, port) as cli:
+            assert cli.negotiate()
+            names = ["actual_q"] * 2000
+            payload = struct.pack(">d", 500.0) + ",".join(names).encode()
+            reply = cli.request(ord("O"), payload)
+            assert reply[0] == 0  # failed
+            assert not cli.start()
+            # a recipe just below the limit is accepted and streams
+            n = (65535 - 4) // 48
+            assert "NOT_FOUND" not in cli.setup_outputs(["actual_q"] * n, 125.0)
+            assert cli.start()
+            assert len(cli.read_data()) == 1
+        # an input recipe whose data package could never be sent is refused too
+        with RawRTDEClient(host, port) as cli:
+            assert cli.negotiate()
+            rid, _ = cli.setup_inputs(["external_force_torque"] * 2000)  # 96 KB
+            assert rid == 0
+        time.sleep(0.2)
+        assert good.error is None and max(good.gaps[5:]) < 0.1
+    finally:
+        good.stop()
+    s = local.stats_summary()
+    assert s["publish_errors"] == 0 and s["tick_errors"] == 0

@@ -164,8 +164,10 @@ def _counts(types: list[str]) -> list[int]:
 class OutputRecipe:
     """An output recipe: names, their types, and a precompiled packer.
 
-    ``ok`` is False when some name is unknown (the reply lists ``NOT_FOUND``;
-    such a recipe can never be started).
+    ``ok`` is False when some name is unknown (the reply lists ``NOT_FOUND``)
+    or when its data package would exceed :data:`MAX_PACKET_SIZE` (the size
+    field is 16 bits; ``too_large``): the reply's recipe id is 0 (failed) and
+    such a recipe can never be started.
     """
 
     recipe_id: int
@@ -174,6 +176,7 @@ class OutputRecipe:
     key: tuple[str, ...] = field(init=False, repr=False)
     types: list[str] = field(init=False)
     ok: bool = field(init=False)
+    too_large: bool = field(init=False, default=False)
     _struct: struct.Struct | None = field(init=False, repr=False, default=None)
     _counts: list[int] = field(init=False, repr=False, default_factory=list)
 
@@ -183,6 +186,10 @@ class OutputRecipe:
         self.ok = "NOT_FOUND" not in self.types
         if self.ok:
             fmt = ">HBB" + "".join(TYPE_FORMATS[t] for t in self.types)
+            if struct.calcsize(fmt) > MAX_PACKET_SIZE:
+                self.ok = False
+                self.too_large = True
+                return
             self._struct = struct.Struct(fmt)
             self._counts = _counts(self.types)
 
@@ -220,19 +227,26 @@ class OutputRecipe:
 class InputRecipe:
     """An input recipe: names, types, and the decoder of the client's data packages.
 
-    ``ok`` is False when some name is unknown (reply ``NOT_FOUND``, id 0).
+    ``ok`` is False when some name is unknown (reply ``NOT_FOUND``, id 0) or
+    when no data package of it could be sent (larger than
+    :data:`MAX_PACKET_SIZE`; ``too_large``, id 0).
     """
 
     recipe_id: int
     names: list[str]
     types: list[str] = field(init=False)
     ok: bool = field(init=False)
+    too_large: bool = field(init=False, default=False)
     _struct: struct.Struct | None = field(init=False, repr=False, default=None)
     _counts: list[int] = field(init=False, repr=False, default_factory=list)
 
     def __post_init__(self) -> None:
         self.types = [input_type(n) or "NOT_FOUND" for n in self.names]
         self.ok = "NOT_FOUND" not in self.types
+        fmt = ">" + "".join(TYPE_FORMATS[t] for t in self.types if t != "NOT_FOUND")
+        if self.ok and HEADER_SIZE + 1 + struct.calcsize(fmt) > MAX_PACKET_SIZE:
+            self.ok = False
+            self.too_large = True
         if self.ok:
             self._struct = struct.Struct(">" + "".join(TYPE_FORMATS[t] for t in self.types))
             self._counts = _counts(self.types)

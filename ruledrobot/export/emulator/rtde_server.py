@@ -43,6 +43,8 @@ from .protocol import (
     CONTROL_PACKAGE_START,
     DATA_PACKAGE,
     GET_URCONTROL_VERSION,
+    HEADER_SIZE,
+    MAX_PACKET_SIZE,
     REQUEST_PROTOCOL_VERSION,
     TEXT_MESSAGE,
     InputRecipe,
@@ -53,6 +55,7 @@ from .protocol import (
     parse_names,
     parse_output_setup,
 )
+from .rtde_types import TYPE_SIZES
 from .tcp import Connection, TcpServer
 
 __all__ = ["RTDEConnection", "RTDEServer", "StreamStats", "due"]
@@ -67,6 +70,12 @@ def due(tick: int, ratio: float) -> bool:
     ratio 1, the multiples of 4 for 1/4 (125 Hz on 500 Hz), of 5 for 1/5.
     """
     return math.floor(tick * ratio + 1e-9) != math.floor((tick - 1) * ratio + 1e-9)
+
+
+def _fit(reply: bytes) -> bytes:
+    """A setup reply that fits a packet; one that does not (thousands of ``NOT_FOUND``)
+    becomes a bare failure (recipe id 0, no types)."""
+    return reply if HEADER_SIZE + len(reply) <= MAX_PACKET_SIZE else b"\x00"
 
 
 class StreamStats:
@@ -210,10 +219,15 @@ class RTDEServer(TcpServer):
             recipe = OutputRecipe(1, names, freq)
             if recipe.ok:
                 conn.output = recipe
+            elif recipe.too_large:
+                conn.output = None
+                log.info("rtde: %s asked for %d outputs: a %d-byte package, beyond RTDE's "
+                         "64 KiB: refused", conn.peer, len(names),
+                         sum(TYPE_SIZES[t] for t in recipe.types) + 4)  # fmt: skip
             else:
                 missing = [n for n, t in zip(names, recipe.types, strict=True) if t == "NOT_FOUND"]
                 log.info("rtde: %s asked for unknown outputs %s", conn.peer, missing)
-            conn.reply(CONTROL_PACKAGE_SETUP_OUTPUTS, recipe.reply())
+            conn.reply(CONTROL_PACKAGE_SETUP_OUTPUTS, _fit(recipe.reply()))
         elif kind == CONTROL_PACKAGE_SETUP_INPUTS:
             names = parse_names(payload, "input setup")
             if conn.started:
@@ -227,13 +241,13 @@ class RTDEServer(TcpServer):
                         types = ["IN_USE" if n in taken else t
                                  for n, t in zip(names, recipe.types, strict=True)]  # fmt: skip
                         conn.reply(CONTROL_PACKAGE_SETUP_INPUTS,
-                                   bytes([0]) + ",".join(types).encode())  # fmt: skip
+                                   _fit(bytes([0]) + ",".join(types).encode()))  # fmt: skip
                         return
                     for n in names:
                         self._owners[n] = id(conn)
                         conn.owned.add(n)
                 conn.inputs[recipe.recipe_id] = recipe
-            conn.reply(CONTROL_PACKAGE_SETUP_INPUTS, recipe.reply())
+            conn.reply(CONTROL_PACKAGE_SETUP_INPUTS, _fit(recipe.reply()))
         elif kind == CONTROL_PACKAGE_START:
             ok = conn.output is not None
             conn.started = ok
