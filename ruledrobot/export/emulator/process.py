@@ -48,6 +48,7 @@ _CALLS = frozenset(
         "set_slow",
         "clear_faults",
         "stats_summary",
+        "reset_stats",
         "reset",
     }
 )
@@ -327,6 +328,10 @@ class Emulator:
     def events(self) -> list[tuple[float, int, str]]:
         """The controller's log: (controller time, level, message)."""
         return list(self._call("events"))
+
+    def reset_stats(self) -> None:
+        """Forget the clock's timing so far (measure one phase of a test)."""
+        self._call("reset_stats")
 
     def stats(self) -> dict[str, float]:
         """Clock timing and counters (see :meth:`ThreadedEmulator.stats_summary`)."""

@@ -13,9 +13,15 @@ once per control period; each started connection gets a data package when its
 own frequency is due, on the decimation grid of the controller clock: a
 125 Hz stream on a 500 Hz controller gets the ticks that are multiples of 4
 (timestamps multiples of 8 ms), from its first package on, whenever it was
-started (:func:`due`).  Sends
-never block the clock: a connection that does not drain its socket
-accumulates a backlog and is closed beyond ``max_backlog`` bytes, as a real
+started (:func:`due`).
+
+A slow client costs only itself.  The sockets are non-blocking (a send never
+waits), the kernel send buffer is bounded (:data:`SEND_BUFFER`), a
+connection with queued bytes is only written to when one ``poll()`` for all
+of them says its socket takes data (every socket call hands the GIL to
+whichever thread wants it, so 100 stuck clients must not cost 100 calls per
+period), and a connection whose queue passes ``max_backlog`` bytes
+(512 KiB) is marked broken and closed by its own thread, as a real
 controller drops clients that do not read.  The ``slow controller`` fault
 holds every data package back by ``delay`` seconds.
 
@@ -26,9 +32,11 @@ other connections are not affected.
 
 from __future__ import annotations
 
+import contextlib
 import logging
 import math
 import random
+import select
 import socket
 import struct
 import threading
@@ -63,6 +71,11 @@ __all__ = ["RTDEConnection", "RTDEServer", "StreamStats", "due"]
 log = logging.getLogger("ruledrobot.export.emulator")
 
 
+#: kernel send buffer of an RTDE connection [bytes] (Linux doubles it): about 0.1 s of
+#: ur_rtde's 58-variable recipe at 500 Hz
+SEND_BUFFER = 64 * 1024
+
+
 def due(tick: int, ratio: float) -> bool:
     """Is a stream of ``ratio`` = frequency / controller frequency due at controller ``tick``?
 
@@ -70,6 +83,24 @@ def due(tick: int, ratio: float) -> bool:
     ratio 1, the multiples of 4 for 1/4 (125 Hz on 500 Hz), of 5 for 1/5.
     """
     return math.floor(tick * ratio + 1e-9) != math.floor((tick - 1) * ratio + 1e-9)
+
+
+def _writable(conns: list[RTDEConnection]) -> set[int]:
+    """File descriptors of ``conns`` whose socket takes data now (one system call)."""
+    if not conns:
+        return set()
+    fds = [c.sock.fileno() for c in conns]
+    fds = [fd for fd in fds if fd >= 0]
+    poll = getattr(select, "poll", None)
+    try:
+        if poll is None:  # pragma: no cover - not Linux
+            return set(select.select([], fds, [], 0.0)[1])
+        p = poll()
+        for fd in fds:
+            p.register(fd, select.POLLOUT)
+        return {fd for fd, ev in p.poll(0) if ev & select.POLLOUT}
+    except (OSError, ValueError):
+        return set()
 
 
 def _fit(reply: bytes) -> bytes:
@@ -102,28 +133,35 @@ class RTDEConnection(Connection):
         self.owned: set[str] = set()
         self.broken = False  # a send failed or the backlog overflowed: close
 
-    def push(self, data: bytes, max_backlog: int) -> None:
-        """Queue bytes and send what the socket takes now, never blocking."""
+    @property
+    def closing(self) -> bool:
+        """Broken: the connection's own thread closes it (closing a socket with megabytes
+        unsent costs milliseconds, which the clock thread must not pay)."""
+        return self.broken
+
+    def push(self, data: bytes, max_backlog: int, send: bool = True) -> None:
+        """Queue bytes and send what the socket takes now, never blocking; beyond
+        ``max_backlog`` queued bytes the connection is marked broken (closed by its thread).
+
+        ``send=False``: only queue (the socket is known not to be writable: a send
+        attempt would only cost a GIL hand-off)."""
         with self.write_lock:
             if self.closed or self.broken:
                 return
             self.backlog += data
-            self._flush_locked()
+            if send:
+                self._flush_locked()
             if len(self.backlog) > max_backlog:
                 self.stats.dropped_backlog += 1
                 log.warning("rtde: client %s does not read its data (%d bytes queued): closing",
                             self.peer, len(self.backlog))  # fmt: skip
-                self.backlog.clear()
+                self.backlog = bytearray()
                 self.broken = True
-        if self.broken:
-            self.close()
 
     def flush(self) -> None:
         with self.write_lock:
             if not self.closed and not self.broken and self.backlog:
                 self._flush_locked()
-        if self.broken:
-            self.close()
 
     def _flush_locked(self) -> None:
         try:
@@ -131,13 +169,14 @@ class RTDEConnection(Connection):
         except (BlockingIOError, InterruptedError):
             return
         except OSError:
-            self.backlog.clear()
+            self.backlog = bytearray()
             self.broken = True
             return
         del self.backlog[:n]
 
-    def reply(self, kind: int, payload: bytes) -> None:
-        self.push(pack_packet(kind, payload), 1 << 30)
+    def reply(self, kind: int, payload: bytes, max_backlog: int = 512 * 1024) -> None:
+        """Queue a reply (never blocks; a client that does not read them is closed)."""
+        self.push(pack_packet(kind, payload), max_backlog)
 
 
 class RTDEServer(TcpServer):
@@ -147,6 +186,7 @@ class RTDEServer(TcpServer):
     """
 
     name = "rtde"
+    nonblocking = True
 
     def __init__(
         self,
@@ -170,6 +210,10 @@ class RTDEServer(TcpServer):
         self.publish_errors = 0
 
     def make_connection(self, sock: socket.socket, addr: tuple) -> Connection:
+        # a bounded kernel buffer: a client that stops reading is "stuck" (no more send
+        # attempts, see publish) within a fraction of a second instead of after megabytes
+        with contextlib.suppress(OSError):
+            sock.setsockopt(socket.SOL_SOCKET, socket.SO_SNDBUF, SEND_BUFFER)
         return RTDEConnection(sock, addr)
 
     # ------------------------------------------------------------ reading
@@ -284,11 +328,15 @@ class RTDEServer(TcpServer):
         if tick is None:
             tick = self.controller.ticks
         packed: dict[tuple[str, ...], bytes | Exception] = {}
-        for conn in self.connections():
-            if not isinstance(conn, RTDEConnection) or conn.closed:
-                continue
+        conns = [c for c in self.connections()
+                 if isinstance(c, RTDEConnection) and not c.closed and not c.broken]  # fmt: skip
+        # connections with queued bytes: one poll() for all of them instead of a send
+        # attempt each (every socket call hands the GIL to whichever thread wants it)
+        writable = _writable([c for c in conns if c.backlog])
+        for conn in conns:
             try:
-                self._serve(conn, state, now, tick, period, packed)
+                self._serve(conn, state, now, tick, period, packed,
+                            not conn.backlog or conn.sock.fileno() in writable)  # fmt: skip
             except Exception as exc:  # this connection only
                 self.publish_errors += 1
                 log.warning("rtde: closing %s: its data package cannot be sent: %s",
@@ -303,6 +351,7 @@ class RTDEServer(TcpServer):
         tick: int,
         period: float,
         packed: dict[tuple[str, ...], bytes | Exception],
+        send: bool,
     ) -> None:
         recipe = conn.output
         if conn.started and recipe is not None and due(tick, recipe.frequency * period):
@@ -321,10 +370,10 @@ class RTDEServer(TcpServer):
                 jit = self._rng.uniform(0.0, self.jitter) if self.jitter > 0 else 0.0
                 conn.delayed.append((now + self.delay + jit, data))
             else:
-                conn.push(data, self.max_backlog)
+                conn.push(data, self.max_backlog, send)
         while conn.delayed and conn.delayed[0][0] <= now:
-            conn.push(conn.delayed.popleft()[1], self.max_backlog)
-        if conn.backlog:
+            conn.push(conn.delayed.popleft()[1], self.max_backlog, send)
+        if conn.backlog and send:
             conn.flush()
 
     def set_delay(self, delay: float, jitter: float = 0.0) -> None:

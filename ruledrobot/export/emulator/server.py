@@ -10,6 +10,7 @@ unless ``allow_remote=True``.
 from __future__ import annotations
 
 import contextlib
+import gc
 import ipaddress
 import logging
 import socket
@@ -53,7 +54,11 @@ class ClockStats:
     late to publish (it steps the controller to catch up, without sending).
     ``lateness``: recent publish times minus their scheduled times [s].
     ``tick_errors`` / ``publish_errors``: controller periods / publishes that
-    raised (logged, rate-limited; the clock goes on).
+    raised (logged, rate-limited; the clock goes on).  ``gaps``: recent
+    intervals between consecutive publishes [s] (one period when all is well;
+    a stall shows here even when the clock resynchronises after it).
+    ``gc_max``: the longest garbage-collector pause [s] (it holds the GIL, so
+    it stalls the clock too).
     """
 
     ticks: int = 0
@@ -61,10 +66,13 @@ class ClockStats:
     resyncs: int = 0
     tick_errors: int = 0
     publish_errors: int = 0
+    gc_max: float = 0.0
     lateness: deque | None = None
+    gaps: deque | None = None
 
     def summary(self) -> dict[str, float]:
         lat = np.asarray(self.lateness or [0.0])
+        gap = np.asarray(self.gaps or [0.0])
         return {
             "ticks": float(self.ticks),
             "missed": float(self.missed),
@@ -73,6 +81,10 @@ class ClockStats:
             "lateness_mean_ms": float(lat.mean() * 1e3),
             "lateness_p99_ms": float(np.percentile(lat, 99) * 1e3),
             "lateness_max_ms": float(lat.max() * 1e3),
+            "gap_p99_ms": float(np.percentile(gap, 99) * 1e3),
+            "gap_max_ms": float(gap.max() * 1e3),
+            "resyncs": float(self.resyncs),
+            "gc_max_ms": self.gc_max * 1e3,
         }
 
 
@@ -152,7 +164,7 @@ class ThreadedEmulator:
         self.script = ScriptPortServer(host, script_port, self.controller)
         for srv in (self.rtde, self.dashboard, self.script):
             srv.realtime = realtime
-        self.stats = ClockStats(lateness=deque(maxlen=20000))
+        self.stats = ClockStats(lateness=deque(maxlen=20000), gaps=deque(maxlen=20000))
         self._stop = threading.Event()
         self._clock: threading.Thread | None = None
         self._started = False
@@ -173,6 +185,7 @@ class ThreadedEmulator:
                 srv.close(timeout=1.0)
             raise
         _acquire_switch_interval()
+        gc.callbacks.append(self._gc_timer)
         self._started = True
         self._clock = threading.Thread(target=self._run_clock, name="emu-clock", daemon=True)
         self._clock.start()
@@ -191,6 +204,8 @@ class ThreadedEmulator:
             self._clock.join(max(0.1, deadline - time.monotonic()))
         for srv in (self.rtde, self.dashboard, self.script):
             srv.close(timeout=max(0.1, (deadline - time.monotonic()) / 3))
+        with contextlib.suppress(ValueError):
+            gc.callbacks.remove(self._gc_timer)
         _release_switch_interval()
 
     def __enter__(self) -> ThreadedEmulator:
@@ -211,9 +226,10 @@ class ThreadedEmulator:
         ctrl = self.controller
         period = ctrl.period
         stats = self.stats
-        lateness = stats.lateness
-        assert lateness is not None
+        lateness, gaps = stats.lateness, stats.gaps
+        assert lateness is not None and gaps is not None
         next_t = time.perf_counter() + period
+        last_publish: float | None = None
         while not self._stop.is_set():
             now = time.perf_counter()
             wait = next_t - now
@@ -235,6 +251,9 @@ class ThreadedEmulator:
                 next_t += missed * period
                 late = now - next_t
             state = self._tick()
+            if last_publish is not None:
+                gaps.append(now - last_publish)
+            last_publish = now
             try:
                 self.rtde.publish(state, now, ctrl.ticks)
             except Exception:  # publish isolates connections; this is a bug, keep the clock
@@ -243,6 +262,14 @@ class ThreadedEmulator:
             stats.ticks += 1
             lateness.append(late)
             next_t += period
+
+    def _gc_timer(self, phase: str, info: dict) -> None:
+        """gc callback: the longest collector pause (``stats.gc_max``)."""
+        if phase == "start":
+            self._gc_t0 = time.perf_counter()
+        else:
+            pause = time.perf_counter() - getattr(self, "_gc_t0", time.perf_counter())
+            self.stats.gc_max = max(self.stats.gc_max, pause)
 
     def _tick(self) -> dict[str, object]:
         """One controller period; a failure is counted and logged (rate-limited), and the
@@ -350,6 +377,13 @@ class ThreadedEmulator:
         out["limit_events"] = float(self.controller.limit_events)
         out["realtime_clock"] = float(self.realtime_clock)
         return out
+
+    def reset_stats(self) -> None:
+        """Forget the clock's timing so far (measure one phase of a test)."""
+        self.stats.lateness.clear()  # type: ignore[union-attr]
+        self.stats.gaps.clear()  # type: ignore[union-attr]
+        self.stats.missed = self.stats.resyncs = 0
+        self.stats.gc_max = 0.0
 
     def reset(self, q: ArrayLike) -> None:
         """Put the arm at rest at ``q`` (no motion, no program change)."""

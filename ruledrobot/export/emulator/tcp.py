@@ -12,17 +12,23 @@ from __future__ import annotations
 import contextlib
 import logging
 import os
+import selectors
 import socket
 import threading
 import time
 from collections.abc import Callable
 
-__all__ = ["POLL", "Connection", "TcpServer"]
+__all__ = ["IDLE_WAIT", "POLL", "Connection", "TcpServer"]
 
 log = logging.getLogger("ruledrobot.export.emulator")
 
 #: seconds between checks of the stop flag in blocking socket calls
 POLL = 0.1
+#: seconds a non-blocking connection's thread waits for data before it looks at its
+#: flags again; close() wakes it at once (the shutdown makes the socket readable), so
+#: this only bounds how soon a connection the clock marked broken is closed.  Short
+#: waits cost: 100 connections x 10 wake-ups/s compete with the clock for the GIL.
+IDLE_WAIT = 1.0
 
 
 class Connection:
@@ -33,6 +39,11 @@ class Connection:
         self.addr = addr
         self.closed = False
         self.write_lock = threading.Lock()
+
+    @property
+    def closing(self) -> bool:
+        """True when the connection should be closed by its own thread."""
+        return False
 
     @property
     def peer(self) -> str:
@@ -82,6 +93,8 @@ class TcpServer:
 
     name = "tcp"
     realtime = False
+    #: non-blocking sockets (no send ever waits; :meth:`recv_loop` waits in a selector)
+    nonblocking = False
 
     def __init__(self, host: str, port: int) -> None:
         self.host = host
@@ -167,7 +180,10 @@ class TcpServer:
                 with contextlib.suppress(OSError):
                     sock.close()
                 continue
-            sock.settimeout(POLL)
+            if self.nonblocking:
+                sock.setblocking(False)
+            else:
+                sock.settimeout(POLL)
             with contextlib.suppress(OSError):
                 sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
             conn = self.make_connection(sock, addr)
@@ -201,6 +217,9 @@ class TcpServer:
         self, conn: Connection, on_data: Callable[[bytes], None], bufsize: int = 65536
     ) -> None:
         """Read until the peer closes, the server stops or ``on_data`` raises."""
+        if conn.sock.gettimeout() == 0.0:
+            self._recv_nonblocking(conn, on_data, bufsize)
+            return
         while not self._stop.is_set() and not conn.closed:
             try:
                 data = conn.sock.recv(bufsize)
@@ -211,6 +230,27 @@ class TcpServer:
             if not data:
                 return
             on_data(data)
+
+    def _recv_nonblocking(
+        self, conn: Connection, on_data: Callable[[bytes], None], bufsize: int
+    ) -> None:
+        with selectors.DefaultSelector() as sel:
+            try:
+                sel.register(conn.sock, selectors.EVENT_READ)
+            except (OSError, ValueError):
+                return
+            while not self._stop.is_set() and not conn.closed and not conn.closing:
+                if not sel.select(IDLE_WAIT):
+                    continue
+                try:
+                    data = conn.sock.recv(bufsize)
+                except (BlockingIOError, InterruptedError):
+                    continue
+                except OSError:
+                    return
+                if not data:
+                    return
+                on_data(data)
 
     # ------------------------------------------------------------ for subclasses
 
