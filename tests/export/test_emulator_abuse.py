@@ -5,6 +5,7 @@ Each test starts its servers on its own loopback address and stops them.
 
 from __future__ import annotations
 
+import contextlib
 import socket
 import struct
 import threading
@@ -14,7 +15,15 @@ from collections.abc import Iterator
 import pytest
 
 from ruledrobot.export.emulator import Emulator, ThreadedEmulator
+from ruledrobot.export.emulator.program import (
+    MAX_LINE_BYTES,
+    MAX_PROGRAM_BYTES,
+    ProgramSplitter,
+    ScriptSyntaxError,
+    parse_call,
+)
 from ruledrobot.export.emulator.rawclient import UR_RTDE_RECEIVE_RECIPE, RawRTDEClient
+from ruledrobot.export.emulator.script_functions import bind
 
 from .conftest import _address
 
@@ -240,3 +249,90 @@ def test_clients_that_do_not_read_cost_only_themselves(n: int, emulator: Emulato
     assert rate > 480.0  # the reader's 500 Hz stream
     assert controller_time == pytest.approx(wall, abs=0.05)  # the clock kept real time
     assert stats["rtde_connections"] == 1  # the n slow ones were disconnected
+
+
+# ---------------------------------------------------------------- 6: the script port is linear
+
+
+def test_program_text_is_cut_and_parsed_in_linear_time() -> None:
+    # a 320 KB line of 100,000 tokens: 8 s of CPU before (the tokenizer re-stripped the
+    # rest of the line at every token), milliseconds now
+    cost = {}
+    for n in (32_000, 320_000):
+        line = "write_output_integer_register(1" + ", 1" * ((n - 32) // 3) + ")"
+        t = time.process_time()
+        with pytest.raises(ScriptSyntaxError, match="at most 2 arguments"):
+            bind(parse_call(line))
+        cost[n] = time.process_time() - t
+    # linear: 10 times the text, about 10 times the time (measured 0.05 s and 0.46 s)
+    assert cost[320_000] < 2.0 and cost[320_000] < 25 * cost[32_000] + 0.05, cost
+    # 20 MiB without a newline (before: the whole buffer scanned again at every chunk,
+    # 1 s of CPU for 20 MiB, 4 times that for twice the size): refused at MAX_LINE_BYTES
+    sp = ProgramSplitter()
+    chunk = "x" * (256 << 10)
+    t = time.process_time()
+    with pytest.raises(ValueError, match="line longer than"):
+        for _ in range(80):
+            list(sp.feed(chunk))
+    assert time.process_time() - t < 0.1
+    # 20 MiB of short lines and no 'end': refused at MAX_PROGRAM_BYTES, each byte seen once
+    sp = ProgramSplitter()
+    chunk = "def p():\n" + "  sync()\n" * (1 << 15)
+    t = time.process_time()
+    with pytest.raises(ValueError, match="larger than 8 MiB"):
+        for _ in range(80):
+            list(sp.feed(chunk))
+    assert time.process_time() - t < 1.0
+    # a line longer than MAX_LINE_BYTES is refused as soon as it is
+    sp = ProgramSplitter()
+    with pytest.raises(ValueError, match="line longer than"):
+        list(sp.feed('def p():\n  textmsg("' + "y" * (MAX_LINE_BYTES + 10)))
+
+
+def test_splitter_keeps_its_cuts() -> None:
+    """The linear splitter cuts exactly where the old one did, for any fragmentation."""
+    a = "def a():\n  if True:\n    sleep(1)\n  end\nend\n"
+    b = "\n\n  \ndef b():\n  sync()\nend   \n"
+    c = "textmsg(1)\n"
+    d = "sec s():\n  set_standard_digital_out(1, True)\nend\n"
+    text = a + b + c + d
+    for step in (1, 3, 7, 64, len(text)):
+        sp = ProgramSplitter()
+        got = []
+        for i in range(0, len(text), step):
+            got.extend(sp.feed(text[i : i + step]))
+        assert got == [a, "def b():\n  sync()\nend   \n", c, d], step
+    sp = ProgramSplitter()
+    assert list(sp.feed("def e():\n  sync()\nend")) == []  # 'end' without its newline yet
+    assert list(sp.feed("\n")) == ["def e():\n  sync()\nend\n"]
+
+
+def test_a_servoj_program_of_some_megabytes_runs(local: ThreadedEmulator) -> None:
+    """Limits: MAX_PROGRAM_BYTES per program, MAX_LINE_BYTES per line.  A 2.5 MB program
+    (the size urscript_program refuses by default) is compiled in about a second
+    and runs; one beyond the limit is refused, logged, and its connection closed."""
+    q = "[0.0, -1.5707963, 1.5707963, -1.5707963, -1.5707963, 0.0]"
+    line = f"  servoj({q}, t=0.002, lookahead_time=0.1, gain=300)\n"
+    n = 2_500_000 // len(line)
+    text = ("def big():\n" + line * n + "end\n").encode()
+    reader = Reader(local.host, ["timestamp"], port=local.ports["rtde"])
+    try:
+        t = time.monotonic()
+        _send_script(local.host, local.ports["script"], text)
+        assert local.wait_for(lambda: local.runtime_state == 2, 10.0)
+        compile_s = time.monotonic() - t
+        too_big = b"def huge():\n" + line.encode() * (MAX_PROGRAM_BYTES // len(line) + 1)
+        with socket.create_connection((local.host, local.ports["script"]), timeout=5.0) as s:
+            with contextlib.suppress(OSError):
+                s.sendall(too_big)
+            s.settimeout(5.0)
+            with contextlib.suppress(OSError):
+                assert s.recv(10) == b""  # closed by the emulator
+        assert local.wait_for(
+            lambda: any("larger than" in m for _, lv, m in local.events if lv <= 1), 5.0
+        )
+        assert local.runtime_state == 2  # the big program still runs
+        assert reader.error is None and max(reader.gaps[5:]) < 0.1
+    finally:
+        reader.stop()
+    assert compile_s < 5.0

@@ -32,6 +32,8 @@ from collections.abc import Iterator
 from dataclasses import dataclass, field
 
 __all__ = [
+    "MAX_LINE_BYTES",
+    "MAX_PROGRAM_BYTES",
     "CompileError",
     "PathWaypoint",
     "Pose",
@@ -112,7 +114,7 @@ class Program:
 # ------------------------------------------------------------------ tokenizer / parser
 
 _TOKEN = re.compile(
-    r"""\s*(?:
+    r"""(?:
         (?P<num>[-+]?(?:\d+\.\d*|\.\d+|\d+)(?:[eE][-+]?\d+)?)
       | (?P<str>"(?:[^"\\]|\\.)*"|'(?:[^'\\]|\\.)*')
       | (?P<name>[A-Za-z_][A-Za-z_0-9]*)
@@ -121,15 +123,15 @@ _TOKEN = re.compile(
     )""",
     re.VERBOSE,
 )
+_SPACE = re.compile(r"\s*")
 
 
 def _tokens(text: str) -> list[tuple[str, str]]:
+    """The tokens of one line, in one pass (linear in its length)."""
     out = []
-    pos = 0
+    pos = _SPACE.match(text).end()  # type: ignore[union-attr]
     n = len(text)
     while pos < n:
-        if text[pos:].strip() == "":
-            break
         m = _TOKEN.match(text, pos)
         if m is None or m.end() == pos:
             raise ScriptSyntaxError(f"unexpected text {text[pos : pos + 20]!r}")
@@ -137,7 +139,7 @@ def _tokens(text: str) -> list[tuple[str, str]]:
         if kind == "comment":
             break
         out.append((kind, m.group(kind)))
-        pos = m.end()
+        pos = _SPACE.match(text, m.end()).end()  # type: ignore[union-attr]
     return out
 
 
@@ -326,51 +328,79 @@ def parse_program(text: str) -> Program:
     return prog
 
 
+#: the largest program the script port takes [bytes]: 4 times what
+#: :func:`ruledrobot.export.urscript.urscript_program` writes without ``allow_long``;
+#: a field report tells of an 18 MB program crashing a controller
+MAX_PROGRAM_BYTES = 8 << 20
+#: the longest line [bytes]; ur_rtde's and ruledrobot's lines are about 100
+MAX_LINE_BYTES = 64 << 10
+
+
 class ProgramSplitter:
-    """Splits the script-port byte stream into complete programs.
+    """Splits the script-port text stream into complete programs, line by line.
 
     A program starting with ``def name():`` / ``sec name():`` is complete at
     a line that is exactly ``end`` at column 0 (inner ``end`` s are indented);
-    any other text is taken one line at a time.  ``max_bytes`` bounds what an
-    unterminated program may buffer (ValueError beyond).
+    any other text is taken one line at a time; blank lines between programs
+    are dropped.  Each byte is looked at once (the time is linear in the
+    text).  A program longer than ``max_bytes`` or a line longer than
+    ``max_line`` raises ValueError as soon as it is: the stream cannot be
+    resynchronised, the connection must close.
     """
 
-    def __init__(self, max_bytes: int = 64 << 20) -> None:
-        self._buf = ""
-        self._max = max_bytes
-        self._scan = 0  # where to resume looking for the closing 'end'
+    def __init__(self, max_bytes: int = MAX_PROGRAM_BYTES, max_line: int = MAX_LINE_BYTES) -> None:
+        self._max = int(max_bytes)
+        self._max_line = int(max_line)
+        self._partial: list[str] = []  # the current line, not complete yet
+        self._partial_len = 0
+        self._program: list[str] | None = None  # lines of the def/sec program being read
+        self._program_len = 0
 
     def feed(self, text: str) -> Iterator[str]:
         """Add received text; yield each program completed by it."""
-        self._buf += text
-        if len(self._buf) > self._max:
-            raise ValueError(f"script port: more than {self._max} bytes without a complete program")
-        while True:
-            buf = self._buf.lstrip()
-            if len(buf) != len(self._buf):
-                self._scan = max(0, self._scan - (len(self._buf) - len(buf)))
-                self._buf = buf
-            if not buf:
+        start = 0
+        n = len(text)
+        while start < n:
+            nl = text.find("\n", start)
+            if nl < 0:
+                self._partial.append(text[start:])
+                self._partial_len += n - start
+                self._check(self._partial_len)
                 return
-            if _DEF.match(buf.split("\n", 1)[0].strip()):
-                m = re.compile(r"^end[ \t\r]*$", re.M).search(buf, self._scan)
-                if m is None:
-                    self._scan = max(0, len(buf) - 8)
-                    return
-                end = m.end()
-                if end < len(buf) and buf[end] == "\n":
-                    end += 1
-                elif end == len(buf):
-                    # 'end' without its newline yet: wait for more text
-                    self._scan = m.start()
-                    return
-                self._buf = buf[end:]
-                self._scan = 0
-                yield buf[:end]
-            else:
-                nl = buf.find("\n")
-                if nl < 0:
-                    return
-                self._buf = buf[nl + 1 :]
-                self._scan = 0
-                yield buf[: nl + 1]
+            piece = text[start : nl + 1]
+            start = nl + 1
+            if self._partial:
+                self._partial.append(piece)
+                piece = "".join(self._partial)
+                self._partial.clear()
+                self._partial_len = 0
+            self._check(len(piece))
+            done = self._line(piece)
+            if done is not None:
+                yield done
+
+    def _check(self, line_len: int) -> None:
+        if line_len > self._max_line:
+            raise ValueError(f"script port: a line longer than {self._max_line} bytes")
+        if self._program_len + line_len > self._max:
+            raise ValueError(f"script port: a program larger than {self._max / 2**20:g} MiB")
+
+    def _line(self, line: str) -> str | None:
+        """One complete line (with its newline); the program it completes, if any."""
+        if self._program is None:
+            stripped = line.strip()
+            if not stripped:
+                return None
+            if _DEF.match(stripped):
+                self._program = [line]
+                self._program_len = len(line)
+                return None
+            return line
+        self._program.append(line)
+        self._program_len += len(line)
+        if line.startswith("end") and line.rstrip(" \t\r\n") == "end":
+            text = "".join(self._program)
+            self._program = None
+            self._program_len = 0
+            return text
+        return None

@@ -5,7 +5,10 @@ control script (and re-uploads for path moves) as raw text.  A real
 controller streams realtime-interface data here, which ur_rtde never reads;
 the emulator stays silent.  Each complete program (see
 :class:`~.program.ProgramSplitter`) goes to the controller, where it
-replaces the running one.
+replaces the running one.  A program beyond
+:data:`~.program.MAX_PROGRAM_BYTES` (8 MiB) or a line beyond
+:data:`~.program.MAX_LINE_BYTES` (64 KiB) is refused: logged at error level,
+the connection closed (the stream cannot be resynchronised).
 """
 
 from __future__ import annotations
@@ -40,7 +43,10 @@ class ScriptPortServer(TcpServer):
         def on_data(data: bytes) -> None:
             for text in splitter.feed(decoder.decode(data)):
                 self.programs_received += 1
-                self.last_program = text
+                self.last_program = text[:4096]
                 self.controller.load_script(text)
 
-        self.recv_loop(conn, on_data, bufsize=1 << 18)
+        try:
+            self.recv_loop(conn, on_data, bufsize=1 << 18)
+        except ValueError as exc:  # beyond MAX_PROGRAM_BYTES / MAX_LINE_BYTES
+            self.controller.log(f"{exc}: refused, connection from {conn.peer} closed", level=1)
