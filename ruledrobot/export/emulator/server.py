@@ -382,7 +382,7 @@ class ThreadedEmulator:
         """Forget the clock's timing so far (measure one phase of a test)."""
         self.stats.lateness.clear()  # type: ignore[union-attr]
         self.stats.gaps.clear()  # type: ignore[union-attr]
-        self.stats.missed = self.stats.resyncs = 0
+        self.stats.ticks = self.stats.missed = self.stats.resyncs = 0
         self.stats.gc_max = 0.0
 
     def reset(self, q: ArrayLike) -> None:
