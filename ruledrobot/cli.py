@@ -182,15 +182,20 @@ def simulate(
     out: Path = typer.Option(Path("out/sim"), "--out", "-o", help="Output folder."),
     video: bool = typer.Option(False, "--video/--no-video", help="Render video.mp4 too."),
 ) -> None:
-    """Play a joint trajectory in MuJoCo: tracking errors, limits, collisions, video."""
+    """Play a joint trajectory in MuJoCo: collisions, limits, torques, tracking, video.
+
+    Exits 1 when a check fails (collision, joint range, speed, torque)."""
     from .sim import RenderUnavailable
     from .sim import simulate as do_simulate
 
     try:
+        scene, where = _cell_of(trajectory)
+        console.print(f"scene: {where}", highlight=False, markup=False)
         with console.status("simulating") as status:
             files = do_simulate(
                 trajectory,
                 out,
+                model_or_scene=scene,
                 video=video,
                 progress=lambda f, stage: status.update(f"{stage}: {100 * f:.0f} %"),
             )
@@ -201,16 +206,38 @@ def simulate(
         files = {"report": out / "report.json"}
     import json
 
+    from .robot.verdict import Verdict
+
     report = json.loads((out / "report.json").read_text())
-    tcp = report.get("tcp_position_error_mm", {})
-    console.print(
-        f"  TCP position error: max {tcp.get('max', float('nan')):.3g} mm, "
-        f"rms {tcp.get('rms', float('nan')):.3g} mm",
-        highlight=False,
-    )
-    console.print(f"  collisions: {len(report.get('collisions', []))}", highlight=False)
+    verdict = Verdict.from_dict(report["verdict"])
+    _print_verdict(verdict, f"checks of the playback of {trajectory}")
     for name, path in files.items():
-        console.print(f"wrote {path}  ({name})", highlight=False)
+        console.print(f"wrote {path}  ({name})", highlight=False, markup=False)
+    if not verdict.ok:
+        raise typer.Exit(code=1)
+
+
+def _cell_of(trajectory: Path):
+    """The scene of the job a trajectory names (its file, or the plan folder's copy
+    ``job.toml``, with the same SHA-256), else None: the robot alone on a table."""
+    import hashlib
+
+    from .io.trajectory import read_trajectory
+    from .robot import model_for
+
+    meta = read_trajectory(trajectory).meta
+    ref = meta.job or {}
+    for cand in (Path(ref.get("path", "")), trajectory.parent / "job.toml"):
+        if ref and cand.is_file() and hashlib.sha256(cand.read_bytes()).hexdigest() == ref.get(
+            "sha256"
+        ):
+            from .sim import Scene
+            from .wirecut.job import load_job
+
+            job = load_job(cand)
+            robot = model_for(meta).with_base(job.robot.base)
+            return Scene.from_job(job, robot=robot), f"the cell of {cand} (arm, bow, stock, table)"
+    return None, "the robot on a table (the trajectory names no job file that is at hand)"
 
 
 class ScriptMode(str, Enum):

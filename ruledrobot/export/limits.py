@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..io.trajectory import Trajectory
+from ..robot.trajectory import Trajectory
 from ..robot import RobotModel
 from ..robot.rates import finite_difference_rates
 

@@ -50,6 +50,7 @@ from ..io.trajectory import HEADER, TRAJECTORY_FORMAT, meta_to_dict, write_traje
 from ..robot import model_for
 from ..robot.trajectory import Trajectory
 from .decimate import decimate_tcp_path
+from .limits import check_trajectory
 
 __all__ = [
     "EXPORT_FORMATS",
@@ -139,6 +140,7 @@ def urscript_program(
     if not isinstance(traj, Trajectory):
         raise ValueError(f"trajectory: expected a ruledrobot Trajectory, got {type(traj).__name__}")
     robot = model_for(traj.meta)
+    check_trajectory(traj, robot)  # a program never carries motion beyond the limits
     if mode not in ("servoj", "movep", "movel"):
         raise ValueError(f"mode: expected 'servoj', 'movep' or 'movel', got {mode!r}")
     if not name.isidentifier():

@@ -117,6 +117,13 @@ class Verdict:
         k = len(self.failed)
         return f"{k} of {n} checks fail: {names}"
 
+    @classmethod
+    def from_dict(cls, doc: dict[str, Any]) -> Verdict:
+        """The verdict written by :meth:`as_dict` (a report's ``"verdict"``)."""
+        fields = Check.__dataclass_fields__
+        return cls(tuple(Check(**{k: v for k, v in c.items() if k in fields})
+                         for c in doc["checks"]))  # fmt: skip
+
     def as_dict(self) -> dict[str, Any]:
         return {
             "ok": self.ok,

@@ -47,6 +47,7 @@ from ..geometry._arrays import FloatArray, as_float_array
 from ..geometry.box import Box
 from ..io.atomic import atomic_open, atomic_write_text
 from ..robot.model import RobotModel
+from ..robot.verdict import Check, Verdict
 from ._mujoco import mujoco
 from .mjcf import ServoGains, physics_timestep, robot_mjcf
 from .scene import BowTool, Scene
@@ -165,6 +166,28 @@ class PlaybackResult:
         R = np.einsum("nji,njk->nik", self.tcp_ref[:, :3, :3], self.tcp[:, :3, :3])
         return np.linalg.norm(se3.rotvec_from_matrix(R), axis=-1)
 
+    def verdict(self) -> Verdict:
+        """The playback's checks: collisions, joint positions, speeds and torques of the
+        simulated arm against the robot's limits (gating); TCP error (information)."""
+        rep = self.report()
+        names = [f"{c['geom1']}/{c['geom2']} {c['max_depth_mm']:.1f} mm at {c['start_s']:.2f} s"
+                 for c in rep["collisions"]]  # fmt: skip
+        pos = rep["joint_position"]
+        return Verdict((
+            Check("collisions", "collisions in the simulation", len(names), 0, relation="<=",
+                  ok=not names, detail="\n".join(names[:8])),
+            Check("joint_position", "simulated joints within their ranges",
+                  "yes" if pos["within_limits"] else "no", "yes", relation="==",
+                  ok=bool(pos["within_limits"]), detail="a joint leaves its position range"),
+            Check.at_most("joint_speed", "simulated joint speed / limit",
+                          rep["joint_speed"]["max_ratio"], 1.0 + 1e-9),
+            Check.at_most("joint_torque", "simulated joint torque / limit",
+                          rep["joint_torque"]["max_ratio"], 1.0 + 1e-9,
+                          detail="a joint needs more torque than it has"),
+            Check.info("tcp_error", "TCP position error (simulated vs reference)",
+                       rep["tcp_position_error_mm"]["max"], "mm"),
+        ))  # fmt: skip
+
     def report(self) -> dict[str, Any]:
         """The playback report as a JSON-ready dict (keys documented in ``docs/sim.md``)."""
         r = self.robot
@@ -272,6 +295,7 @@ class PlaybackResult:
         out.mkdir(parents=True, exist_ok=True)
         paths: dict[str, Path] = {}
         rep = self.report()
+        rep["verdict"] = self.verdict().as_dict()
         paths["report"] = atomic_write_text(out / "report.json", json.dumps(rep, indent=2) + "\n")
         if plots:
             paths.update(self.plot(out))

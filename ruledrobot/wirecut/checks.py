@@ -13,7 +13,8 @@ Gating (the plan is feasible only when all hold; ``docs/verdict.md``):
 * ``feed_max`` / ``feed_min`` — the feed of the wire inside the stock within
   ``[cut] feed_tolerance`` of the set feed (above and below);
 * ``joint_position`` / ``joint_speed`` / ``joint_acceleration`` — ratios to the
-  robot's limits (finite differences of the samples) at most 1;
+  robot's limits (finite differences of the samples) at most 1; ``joint_torque``
+  — the simulated joint torques (MuJoCo, with the bow's mass) at most the limits;
 * ``singularity`` — the singularity measure during the cut at least the margin.
 
 Information only: TCP tracking error, feed within 1 %, kerf, duration.
@@ -48,6 +49,7 @@ class Measurements:
     position_ratio: float | None
     speed_ratio: float | None
     acc_ratio: float | None
+    torque_ratio: float | None
     singularity_min: float | None
     tracking_error_mm: float | None
     kerf_mm: float
@@ -89,6 +91,8 @@ def plan_verdict(
                       detail="a joint is faster than its limit"),
         Check.at_most("joint_acceleration", "joint acceleration / limit", m.acc_ratio, 1.0,
                       detail="a joint accelerates beyond its limit"),
+        Check.at_most("joint_torque", "simulated joint torque / limit", m.torque_ratio, 1.0,
+                      detail="a joint needs more torque than it has (payload, speed)"),
         Check.at_least("singularity", "singularity measure during the cut", m.singularity_min,
                        singularity_margin, detail="the arm comes too close to a singularity"),
         Check.info("tracking_error", "simulated TCP tracking error", m.tracking_error_mm, "mm"),

@@ -260,7 +260,7 @@ def plan(
         dev = deviation(flange)
         timings["measure_s"] = time.perf_counter() - t2
         pb = None
-        dev_sim_mm = tracking_mm = None
+        dev_sim_mm = tracking_mm = torque_ratio = None
         if simulate:
             say("verifying in MuJoCo")
             t3 = time.perf_counter()
@@ -272,6 +272,7 @@ def plan(
             dev_sim = deviation(model.fk(pb.q))
             dev_sim_mm = float(dev_sim[hit_t].max() * 1e3) if hit_t.any() else 0.0
             tracking_mm = sim["tcp_position_error_mm"]["max"]
+            torque_ratio = sim["joint_torque"]["max_ratio"]
             report["simulation_realtime_factor"] = sim.get("realtime_factor")
             for c in pb.collisions:
                 d = c.as_dict()
@@ -294,7 +295,7 @@ def plan(
             feed_within_1pct=float(np.mean(np.abs(feed[interior] / job.cut.feed_speed - 1.0)
                                            <= 0.01)) if interior.any() else None,
             position_ratio=pos_ratio, speed_ratio=ratios["max_speed_ratio"],
-            acc_ratio=ratios["max_acc_ratio"],
+            acc_ratio=ratios["max_acc_ratio"], torque_ratio=torque_ratio,
             singularity_min=float(model.singularity_measure(traj.q[in_cut]).min()),
             tracking_error_mm=tracking_mm, kerf_mm=job.cut.kerf * 1e3,
             duration_s=float(traj.t[-1]),
@@ -322,6 +323,7 @@ def plan(
                 "max_joint_position_ratio": pos_ratio,
                 "max_joint_speed_ratio": ratios["max_speed_ratio"],
                 "max_joint_accel_ratio": ratios["max_acc_ratio"],
+                "max_joint_torque_ratio": torque_ratio,
                 "min_singularity_measure": meas.singularity_min,
                 "max_planned_wire_deviation_mm": meas.planned_wire_deviation_mm,
                 "max_wire_deviation_mm": dev_sim_mm,
@@ -473,7 +475,8 @@ def _plots(
     ax2 = fig.add_subplot(2, 2, 2)
     for j in range(6):
         ax2.plot(traj.t, traj.q[:, j], label=f"q{j + 1}")
-    ax2.set_title("joint positions (rad); limits ±2π")
+    lim = ", ".join(f"{hi:.3g}" if np.isfinite(hi) else "inf" for hi in model.upper)
+    ax2.set_title(f"joint positions (rad); limits ± [{lim}]")
     ax2.set_xlabel("t (s)")
     ax2.legend(ncol=6, fontsize=7)
     ax3 = fig.add_subplot(2, 2, 4)

@@ -188,3 +188,12 @@ def test_programs_of_any_mode_say_which_kinematics_they_need() -> None:
     text = urscript_program(traj, mode="movel")
     assert traj.meta.kinematics.checksum in text
     assert model_for(traj.meta).name == "ur5e"
+
+
+def test_a_program_is_never_written_for_motion_beyond_the_limits(tmp_path) -> None:
+    traj = smooth_trajectory()
+    q = traj.q.copy()
+    q[300:, 2] += 0.05  # a 25 rad/s step on the elbow
+    with pytest.raises(ValueError, match=r"sample 300 .*joint q3 speed"):
+        export_trajectory(Trajectory(traj.t, q, traj.tcp, traj.meta), tmp_path / "x.script")
+    assert not (tmp_path / "x.script").exists()
