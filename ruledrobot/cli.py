@@ -217,6 +217,13 @@ def simulate(
         raise typer.Exit(code=1)
 
 
+def _say_program_size(path: Path) -> None:
+    """Warn about a long URScript program (its header says so too)."""
+    for line in path.read_text().splitlines()[:8]:
+        if line.strip().startswith("# long program"):
+            err.print("warning: " + line.strip()[2:], highlight=False, markup=False)
+
+
 def _cell_of(trajectory: Path):
     """The scene of the job a trajectory names (its file, or the plan folder's copy
     ``job.toml``, with the same SHA-256), else None: the robot alone on a table."""
@@ -280,6 +287,8 @@ def export(
         path = export_trajectory(traj, out, None if fmt is None else fmt.value, **options)
     except ValueError as exc:
         raise _fail(str(exc)) from None
+    if is_script:
+        _say_program_size(path)
     console.print(f"wrote {path}")
 
 
@@ -428,11 +437,12 @@ def demo(
         result = _run_plan(job_path, out, video=video)
     traj_path = out / "trajectory.csv"
     try:
-        script = export_trajectory(result.trajectory, out / "cut.script", allow_long=True)
+        script = export_trajectory(result.trajectory, out / "cut.script")
     except ValueError as exc:
         raise _fail(str(exc)) from None
     console.print(f"wrote {script}  (URScript for the teach pendant; streaming is the route for "
                   "long cuts: docs/rtde.md)", highlight=False, markup=False)  # fmt: skip
+    _say_program_size(script)
     if stream:
         res = _stream(traj_path, None, yes=True)
         if res.status != "completed":
