@@ -43,9 +43,6 @@ from ..robot.model import RobotModel
 from ._xml import placed, sub, to_string
 
 __all__ = [
-    "COMMITTED_MODELS",
-    "EXAMPLE_SCENE_FILE",
-    "MODELS_DIR",
     "ServoGains",
     "chain_mjcf",
     "default_armature",
@@ -54,15 +51,7 @@ __all__ = [
     "physics_timestep",
     "robot_mjcf",
     "write_chain",
-    "write_models",
 ]
-
-#: Folder of the committed, generated models (``models/`` at the repository root).
-MODELS_DIR = Path(__file__).resolve().parents[2] / "models"
-#: Catalogue models written by :func:`write_models`.
-COMMITTED_MODELS: tuple[str, ...] = ("ur5e", "ur10e")
-#: File name of the committed example work cell.
-EXAMPLE_SCENE_FILE = "ur5e_hotwire_cell.xml"
 
 #: Largest physics step [s]: the e-Series servo period.  Slower controllers
 #: (CB3, 8 ms) are simulated with substeps of at most this size.
@@ -346,7 +335,7 @@ class _RobotTree:
     flange: FloatArray  # DH frame J in the last link body's frame
 
 
-def _build_robot(
+def build_robot(
     model: RobotModel,
     *,
     gains: ServoGains | None,
@@ -518,7 +507,7 @@ def robot_mjcf(
     """
     if not isinstance(model, RobotModel):
         raise ValueError(f"model: expected a RobotModel, got {type(model).__name__}")
-    tree = _build_robot(
+    tree = build_robot(
         model,
         gains=gains,
         armature=armature,
@@ -535,25 +524,6 @@ def robot_mjcf(
         "ruledrobot.sim.write_models()"
     )
     return to_string(tree.root, comment)
-
-
-def write_models(
-    folder: str | os.PathLike[str] | None = None, names: tuple[str, ...] = COMMITTED_MODELS
-) -> list[Path]:
-    """Write the generated models into ``folder`` (default the repository's ``models/``).
-
-    ``<name>.xml`` for each catalogue model in ``names`` (default UR5e and
-    UR10e) and the example work cell ``ur5e_hotwire_cell.xml``
-    (:func:`ruledrobot.sim.scene.example_scene`), atomically; returns the
-    paths.  The test suite checks that the committed files equal this output.
-    """
-    from ..robot import load
-    from .scene import example_scene
-
-    out = Path(folder) if folder is not None else MODELS_DIR
-    paths = [atomic_write_text(out / f"{name}.xml", robot_mjcf(load(name))) for name in names]
-    paths.append(atomic_write_text(out / EXAMPLE_SCENE_FILE, example_scene().mjcf()))
-    return paths
 
 
 # ---------------------------------------------------------------------------------------

@@ -31,7 +31,7 @@ from ..geometry._arrays import FloatArray, as_float_array
 from ..geometry.box import Box
 from ..robot.model import RobotModel
 from ._xml import placed, sub, to_string
-from .mjcf import ServoGains, _build_robot, link_radii
+from .mjcf import ServoGains, build_robot, link_radii
 
 __all__ = ["BowTool", "Scene", "default_camera", "default_table", "example_scene", "scene_mjcf"]
 
@@ -310,7 +310,7 @@ def scene_mjcf(
     elif table is not None and not isinstance(table, Box):
         raise ValueError(f"table: expected a Box, 'auto' or None, got {type(table).__name__}")
 
-    tree = _build_robot(
+    tree = build_robot(
         model,
         gains=gains,
         armature=None,

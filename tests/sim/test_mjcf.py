@@ -4,6 +4,7 @@ limits, actuators, and the committed models are what the generator writes."""
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET
+from pathlib import Path
 
 import mujoco
 import numpy as np
@@ -187,13 +188,18 @@ def _equivalent(a: ET.Element, b: ET.Element, where: str = "") -> None:
         _equivalent(ca, cb, here)
 
 
+MODELS_DIR = Path(__file__).resolve().parents[2] / "models"
+
+
 def test_committed_models_are_current(tmp_path):
     """models/*.xml are what write_models() writes now (regenerate with
-    ``python -c 'import ruledrobot.sim as s; s.write_models()'``)."""
-    written = mjcf.write_models(tmp_path)
-    assert {p.name for p in written} == {"ur5e.xml", "ur10e.xml", mjcf.EXAMPLE_SCENE_FILE}
+    ``python scripts/write_models.py``)."""
+    from ruledrobot.sim import models
+
+    written = models.write_models(tmp_path)
+    assert {p.name for p in written} == {"ur5e.xml", "ur10e.xml", models.EXAMPLE_SCENE_FILE}
     for p in written:
-        committed = mjcf.MODELS_DIR / p.name
+        committed = MODELS_DIR / p.name
         assert committed.exists(), f"{committed} is missing; run write_models()"
         text_new, text_old = p.read_text(), committed.read_text()
         if text_new != text_old:
