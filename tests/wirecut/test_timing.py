@@ -156,27 +156,27 @@ def test_one_long_gap_is_crossed_at_speed():
 
 def test_limits_that_cannot_be_met_raise(monkeypatch):
     s, q, sf = feed_path(50)
-    real = timing._timed_from_law
+    real = timing.sampling._timed_from_law
 
     def always_over(prob, t, sig, *rest):  # every round reports samples 0..1 over a limit
         tp, _, _ = real(prob, t, sig, *rest)
         return tp, sig[:1], sig[1:2]
 
-    monkeypatch.setattr(timing, "_timed_from_law", always_over)
+    monkeypatch.setattr(timing.path, "_timed_from_law", always_over)
     with pytest.raises(ValueError, match=r"exceeds the limits after 6 rounds.*between s ="):
         time_path(s, q, sf, 0.05, VL, AL, DT)
 
 
 def test_a_path_speed_that_collapses_names_the_place(monkeypatch):
     s, q, sf = feed_path(50)
-    real = timing._x_upper
+    real = timing.problem._x_upper
 
     def zero_in_the_middle(prob, vlim):
         x = real(prob, vlim)
         mid = np.abs(prob.grid - prob.grid[-1] / 2) < prob.grid[-1] / 10
         return np.where(mid, 0.0, x)
 
-    monkeypatch.setattr(timing, "_x_upper", zero_in_the_middle)
+    monkeypatch.setattr(timing.solvers, "_x_upper", zero_in_the_middle)
     with pytest.raises(ValueError, match=r"collapses to zero between s = 0\.4.*binding"):
         time_path(s, q, sf, 0.05, VL, AL, DT, solver="reachability")
 
