@@ -45,6 +45,7 @@ from numpy.typing import ArrayLike
 from ..geometry import se3
 from ..geometry._arrays import FloatArray, as_float_array
 from ..geometry.box import Box
+from ..geometry.interp import interp_hermite
 from ..io.atomic import atomic_open, atomic_write_text
 from ..robot.model import RobotModel
 from ..robot.verdict import Check, Verdict
@@ -386,21 +387,7 @@ def _reference(
         return t.copy(), q.copy(), np.asarray(qd, dtype=np.float64).copy()
     n = math.floor((t[-1] - t[0]) / dt + 1e-9) + 1
     ts = t[0] + dt * np.arange(n)
-    k = np.clip(np.searchsorted(t, ts, side="right") - 1, 0, t.size - 2)
-    h = steps[k]
-    s = ((ts - t[k]) / h)[:, None]
-    hh = h[:, None]
-    q0, q1, v0, v1 = q[k], q[k + 1], qd[k], qd[k + 1]
-    h00 = 2 * s**3 - 3 * s**2 + 1
-    h10 = s**3 - 2 * s**2 + s
-    h01 = -2 * s**3 + 3 * s**2
-    h11 = s**3 - s**2
-    qs = h00 * q0 + h10 * hh * v0 + h01 * q1 + h11 * hh * v1
-    d00 = (6 * s**2 - 6 * s) / hh
-    d10 = 3 * s**2 - 4 * s + 1
-    d01 = (-6 * s**2 + 6 * s) / hh
-    d11 = 3 * s**2 - 2 * s
-    vs = d00 * q0 + d10 * v0 + d01 * q1 + d11 * v1
+    qs, vs = interp_hermite(ts, t, q, qd)
     return ts, qs, vs
 
 

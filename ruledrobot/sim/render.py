@@ -29,6 +29,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ..geometry._arrays import FloatArray
+from ..geometry.interp import interp_linear
 from ..io.atomic import atomic_write_bytes
 from ..robot.model import RobotModel
 from ._mujoco import INSTALL_HINT, RenderUnavailable, mujoco
@@ -102,9 +103,7 @@ def frame_times(t: FloatArray, fps: float) -> FloatArray:
 
 def _sample(t: FloatArray, q: FloatArray, times: FloatArray) -> FloatArray:
     """Joint positions at ``times``, linear between samples (exact on the samples)."""
-    if t.size == 1:
-        return np.repeat(q, times.size, axis=0)
-    return np.stack([np.interp(times, t, q[:, j]) for j in range(q.shape[1])], axis=-1)
+    return interp_linear(times, t, q)
 
 
 _OPEN: weakref.WeakSet[Renderer] = weakref.WeakSet()

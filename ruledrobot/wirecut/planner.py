@@ -28,6 +28,7 @@ import numpy as np
 
 from ..geometry import se3
 from ..geometry._arrays import FloatArray
+from ..geometry.interp import interp_linear
 from ..io.atomic import atomic_write_bytes, atomic_write_text
 from ..io.lines import save_lines
 from ..io.trajectory import write_trajectory
@@ -87,12 +88,6 @@ def _fill_nearest(values: FloatArray, valid: np.ndarray) -> FloatArray:
     k = np.arange(len(values))
     nearest = np.where(np.abs(k - left) <= np.abs(right - k), left, right)
     return values[nearest]
-
-
-def _interp_rows(x: FloatArray, xp: FloatArray, fp: FloatArray) -> FloatArray:
-    flat = fp.reshape(len(xp), -1)
-    out = np.stack([np.interp(x, xp, flat[:, k]) for k in range(flat.shape[1])], axis=1)
-    return out.reshape(len(x), *fp.shape[1:])
 
 
 def _timed_motion(job: Job, model, cp: CutPath) -> tuple[TimedPath, int]:
@@ -228,7 +223,7 @@ def plan(
         i0 = np.clip(np.floor(s_t).astype(int), 0, len(s) - 2)
         # inside the stock: both neighbouring rulings cross it
         hit_t = in_cut & m.hit[i0] & m.hit[i0 + 1]
-        ends_t = _interp_rows(s_t, s, _fill_nearest(ends, m.hit))
+        ends_t = interp_linear(s_t, s, _fill_nearest(ends, m.hit))
         feed = feed_speeds(traj.t, flange, ends_t, hit_t)
         ratios = trajectory_limits_report(traj.t, traj.q, model.max_velocity,
                                           model.max_acceleration)  # fmt: skip
