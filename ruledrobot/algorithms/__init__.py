@@ -28,7 +28,7 @@ from ..geometry.lines import (
     plucker_from_point_direction,
 )
 from ..geometry.ruled import RuledSurface
-from ..subdivision import check_length, check_steps, get_scheme, refine_plucker
+from ..subdivision import check_length, check_size, check_steps, get_scheme, refine_plucker
 from ..subdivision.engine import refine_sequence
 from ..subdivision.spaces import EuclideanSpace, SE3Space, SphereSpace
 
@@ -111,6 +111,7 @@ def refine(
     steps = check_steps(steps)
     check_distinct_neighbours(surf.lines.plucker, surf.closed)
     check_length(sch, len(surf.lines), "lines")
+    check_size(sch, len(surf.lines), steps, surf.closed, "steps")
     flip = bool(surf.flip)
     common = dict(closed=surf.closed, flip=flip, algorithm=algorithm, scheme=scheme, steps=steps)
     if algorithm == "projection":

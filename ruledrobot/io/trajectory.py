@@ -260,6 +260,20 @@ def _parse_csv(p: Path, text: str) -> np.ndarray:
     return data
 
 
+def _check_manifest(p: Path, data: bytes) -> None:
+    """In an output folder (one with ``manifest.json``), a listed file must be the one
+    the folder was completed with."""
+    from .outdir import read_manifest
+
+    man = read_manifest(p.parent)
+    if man is None:
+        return
+    entry = man.get("files", {}).get(p.name)
+    if entry is not None and entry.get("sha256") != hashlib.sha256(data).hexdigest():
+        raise ValueError(f"{p}: differs from the file its folder's manifest.json lists (the "
+                         "folder was changed after the plan wrote it); plan again")  # fmt: skip
+
+
 def _check_tcp(traj: Trajectory, where: str, line_offset: int) -> None:
     dp, da, k = traj.tcp_error()
     if dp > TCP_TOLERANCE or da > TCP_TOLERANCE:
@@ -337,6 +351,7 @@ def read_trajectory(path: str | os.PathLike[str], check_tcp: bool = True) -> Tra
             f"{p}: does not match its metadata {sp.name} (checksum differs): the CSV was "
             "changed or comes from another plan; plan again or fix the pair"
         )
+    _check_manifest(p, text.encode())
     data = _parse_csv(p, text)
     try:
         traj = Trajectory(data[:, 0], data[:, 1:7], data[:, 7:], meta)

@@ -24,8 +24,10 @@ __all__ = [
     "Scheme",
     "Space",
     "SphereSpace",
+    "check_size",
     "get_scheme",
     "refine_plucker",
+    "refined_count",
     "subdivide",
 ]
 
@@ -37,6 +39,41 @@ def check_steps(steps: int) -> int:
     if isinstance(steps, bool) or not isinstance(steps, (int, np.integer)) or not 0 <= steps <= 20:
         raise ValueError(f"steps: expected an integer 0 <= steps <= 20, got {steps!r}")
     return int(steps)
+
+
+#: Most elements a refinement may produce (about 1 kB each while refining, frames and
+#: lines included: ~5 GB); beyond it :func:`check_size` refuses before any work.
+MAX_REFINED = 5_000_000
+#: Bytes per refined element used for the memory estimate (measured peak of the dh
+#: algorithm: ~300 B per ruling, times margin for the output and its file).
+BYTES_PER_ELEMENT = 1000
+
+
+def refined_count(scheme: Scheme, n: int, steps: int, closed: bool) -> int:
+    """How many elements ``steps`` steps of ``scheme`` make of ``n`` (exact)."""
+    for _ in range(steps):
+        n = scheme.refined_length(n, closed)
+    return n
+
+
+def check_size(
+    scheme: Scheme, n: int, steps: int, closed: bool, what: str, limit: int = MAX_REFINED,
+    bytes_per_element: float | None = BYTES_PER_ELEMENT,
+) -> int:
+    """The refined count, or ValueError with the numbers (and the memory estimate when
+    ``bytes_per_element`` is given) and the most steps that fit."""
+    count = refined_count(scheme, n, steps, closed)
+    if count <= limit:
+        return count
+    fit = max((k for k in range(steps + 1) if refined_count(scheme, n, k, closed) <= limit),
+              default=0)  # fmt: skip
+    def mem(k: int) -> str:
+        return f" (about {k * bytes_per_element / 1e9:.3g} GB)" if bytes_per_element else ""
+
+    raise ValueError(
+        f"{what}: {steps} steps of {scheme.name} on {n} elements make {count:,}{mem(count)}; "
+        f"the limit is {limit:,}{mem(limit)}: use at most {fit} steps, or fewer input elements"
+    )
 
 
 def check_length(scheme: Scheme, n: int, what: str) -> None:
@@ -108,6 +145,7 @@ def subdivide(
     if isinstance(elements, Lines):
         x = elements.plucker
         check_length(sch, len(x), "lines")
+        check_size(sch, len(x), steps, closed, "steps")
         if flip is None:
             flip = bool(closed and x[-1, :3] @ x[0, :3] < 0.0)
         return Lines(refine_plucker(x, sch, steps, closed, bool(flip) and closed))
@@ -133,6 +171,7 @@ def subdivide(
         if space == "sphere" and arr.shape[1] != 3:
             raise ValueError(f"unit vectors: expected shape (N, 3), got {arr.shape}")
     check_length(sch, arr.shape[0], (space == "se3" and "poses") or "points")
+    check_size(sch, arr.shape[0], steps, closed, "steps")
     if flip and not closed:
         raise ValueError("flip=True needs closed=True")
     x = sp.encode(arr)

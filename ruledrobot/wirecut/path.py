@@ -25,6 +25,7 @@ from ..geometry import se3
 from ..geometry._arrays import FloatArray
 from ..geometry.box import Box
 from ..geometry.ruled import RuledSurface
+from ..subdivision import check_size, get_scheme, refined_count
 from .job import Job
 from .redundancy import RedundancyResult, solve_redundancy
 from .toolpath import chords
@@ -32,6 +33,9 @@ from .toolpath import chords
 __all__ = ["CutPath", "chord_ends_in_flange", "cut_path", "refine_for_job"]
 
 MAX_STEPS = 10
+#: Most refined rulings a cut may have (the redundancy search, the time law and the
+#: simulation scale with them: ~2 min of planning and ~2 GB at this size).
+MAX_PATH_RULINGS = 250_000
 
 
 @dataclass(frozen=True)
@@ -83,11 +87,22 @@ def refine_for_job(job: Job) -> tuple[FloatArray, int]:
     where = f"{job.source or 'job'}: [surface]"
     check_distinct_neighbours(job.input_lines().plucker, False,
                               f"{where} {job.surface.file or job.surface.builtin}")  # fmt: skip
+    n = len(job.input_lines())
+    sch = get_scheme(job.surface.scheme)
     if job.surface.steps is not None:
+        check_size(sch, n, job.surface.steps, False, f"{where} steps", MAX_PATH_RULINGS, None)
         return _frames(job, job.surface.steps), job.surface.steps
+    gap = np.inf
     for steps in range(MAX_STEPS + 1):
+        if refined_count(sch, n, steps, False) > MAX_PATH_RULINGS:
+            raise ValueError(
+                f"{where} spacing: {job.surface.spacing} m needs more than "
+                f"{MAX_PATH_RULINGS:,} rulings (the limit of a cut); {steps - 1} steps give a "
+                f"largest gap of {gap:.3g} m: ask for a larger spacing"
+            )
         F = _frames(job, steps)
-        if _gaps(F, job.stock) <= job.surface.spacing:
+        gap = _gaps(F, job.stock)
+        if gap <= job.surface.spacing:
             return F, steps
     raise ValueError(
         f"{where} spacing: {job.surface.spacing} m not reached after {MAX_STEPS} steps "
