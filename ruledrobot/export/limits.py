@@ -10,9 +10,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..robot.trajectory import Trajectory
 from ..robot import RobotModel
 from ..robot.rates import finite_difference_rates
+from ..robot.trajectory import Trajectory
 
 __all__ = ["check_trajectory"]
 
