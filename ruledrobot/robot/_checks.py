@@ -19,6 +19,7 @@ __all__ = [
     "FloatArray",
     "as_array",
     "as_joint_vector",
+    "as_point",
     "as_pose_or_vector",
     "as_poses",
     "first_index",
@@ -68,6 +69,14 @@ def as_joint_vector(value: ArrayLike, name: str, n: int, allow_inf: bool = False
         what = "NaN" if allow_inf else "NaN or infinity"
         raise ValueError(f"{name}{first_index(bad)}: contains {what}")
     return arr
+
+
+def as_point(value: ArrayLike, name: str) -> FloatArray:
+    """A read-only point or vector (3,) in metres; ValueError naming ``name`` otherwise."""
+    v = as_array(value, name)
+    if v.shape != (3,):
+        raise ValueError(f"{name}: expected 3 numbers (m), got shape {v.shape}")
+    return readonly(v)
 
 
 def readonly(arr: FloatArray) -> FloatArray:

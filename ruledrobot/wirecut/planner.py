@@ -371,7 +371,7 @@ def _position_ratio(model, q: FloatArray) -> float:
 
 
 def _bow_cog(job: Job) -> FloatArray:
-    from ..sim.scene import BowTool
+    from ..robot.tool import BowTool
 
     return BowTool.from_spec(job.tool).inertia()[0]
 

@@ -42,7 +42,7 @@ from ..geometry._arrays import FloatArray
 from ..geometry.box import Box
 from ..geometry.segments import segment_distance
 from ..robot import path_ik, wrap_angle
-from ..sim.scene import BowTool
+from ..robot.tool import BowTool
 from .job import ToolSpec
 from .toolpath import chords, flange_poses, slide_bounds, wire_frame, wire_poses
 
@@ -50,7 +50,7 @@ __all__ = ["RedundancyResult", "bow_segments", "solve_redundancy"]
 
 
 def bow_segments(tool: ToolSpec) -> FloatArray:
-    """The bow's rods (3, 2, 3) in the flange frame (:meth:`ruledrobot.sim.BowTool.segments`):
+    """The bow's rods (3, 2, 3) in the flange frame (:meth:`.BowTool.segments`):
     an arm from each wire end back to the plane through the flange axis normal to the
     bow's depth direction, and the crossbar between the arms' ends."""
     return BowTool.from_spec(tool).segments()

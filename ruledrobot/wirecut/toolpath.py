@@ -28,7 +28,7 @@ from numpy.typing import ArrayLike
 from ..geometry import se3
 from ..geometry._arrays import FloatArray
 from ..geometry.box import Box
-from ..sim.scene import BowTool
+from ..robot.tool import BowTool
 from .job import ToolSpec
 
 __all__ = [
@@ -44,14 +44,8 @@ __all__ = [
 def wire_frame(tool: ToolSpec) -> FloatArray:
     """The wire frame W (4, 4) in the flange frame (see the module doc): origin at the
     wire midpoint, z along the wire, x the bow's depth direction
-    (:meth:`ruledrobot.sim.BowTool.depth_direction`)."""
-    bow = BowTool.from_spec(tool)
-    z = (bow.wire_end - bow.wire_start) / bow.wire_length
-    x = bow.depth_direction()
-    W = np.eye(4)
-    W[:3, 0], W[:3, 1], W[:3, 2] = x, np.cross(z, x), z
-    W[:3, 3] = 0.5 * (bow.wire_start + bow.wire_end)
-    return W
+    (:meth:`ruledrobot.robot.tool.BowTool.wire_frame`)."""
+    return BowTool.from_spec(tool).wire_frame()
 
 
 def chords(frames: ArrayLike, stock: Box) -> tuple[FloatArray, FloatArray, np.ndarray]:
