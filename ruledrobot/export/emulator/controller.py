@@ -85,6 +85,9 @@ _SAFETY_BITS = {
 
 Event = tuple[float, int, str]
 
+#: the longest message the controller log keeps [characters]
+MAX_LOG_MESSAGE = 1000
+
 
 class _IdleProgram:
     """A program loaded from the dashboard (``.urp``) that the emulator cannot run: it idles."""
@@ -424,7 +427,12 @@ class Controller:
     # ------------------------------------------------------------ log
 
     def log(self, message: str, level: int = 3) -> None:
-        """Record an event (level 0 exception, 1 error, 2 warning, 3 info)."""
+        """Record an event (level 0 exception, 1 error, 2 warning, 3 info).
+
+        Messages are cut at :data:`MAX_LOG_MESSAGE` characters (the log keeps the
+        last 2,000 events: bounded memory whatever clients send)."""
+        if len(message) > MAX_LOG_MESSAGE:
+            message = message[: MAX_LOG_MESSAGE - 3] + "..."
         self.events.append((self.time, level, message))
         log.log({0: logging.ERROR, 1: logging.ERROR, 2: logging.WARNING}.get(level, logging.INFO),
                 "emulator: %s", message)  # fmt: skip

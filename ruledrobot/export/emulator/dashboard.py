@@ -9,6 +9,7 @@ exactly ``Stopped``; ``get serial number`` digits only).
 from __future__ import annotations
 
 import logging
+from collections import deque
 
 from .controller import Controller
 from .states import RuntimeState
@@ -35,12 +36,14 @@ class DashboardServer(TcpServer):
         *,
         version: tuple[int, int, int, int],
         serial_number: str,
+        **limits: float,
     ) -> None:
-        super().__init__(host, port)
+        super().__init__(host, port, **limits)  # type: ignore[arg-type]
         self.controller = controller
         self.version = version
         self.serial_number = serial_number
-        self.commands: list[str] = []
+        #: the last commands received (shortened), for tests and diagnostics
+        self.commands: deque[str] = deque(maxlen=100)
 
     def handle(self, conn: Connection) -> None:
         if not conn.sendall((GREETING + "\n").encode()):
@@ -70,7 +73,7 @@ class DashboardServer(TcpServer):
 
     def answer(self, line: str) -> str:
         """The reply to one command line."""
-        self.commands.append(line)
+        self.commands.append(line[:200])
         c = self.controller
         cmd = line.strip()
         low = cmd.lower()

@@ -160,6 +160,23 @@ def _counts(types: list[str]) -> list[int]:
     return [int(TYPE_FORMATS[t][0]) if TYPE_FORMATS[t][0].isdigit() else 1 for t in types]
 
 
+class RecipeKey:
+    """Recipe id and names, hashed once: equal recipes share one packed package per period
+    (a tuple of 59 names would be hashed again at every lookup)."""
+
+    __slots__ = ("_hash", "items")
+
+    def __init__(self, items: tuple[str, ...]) -> None:
+        self.items = items
+        self._hash = hash(items)
+
+    def __hash__(self) -> int:
+        return self._hash
+
+    def __eq__(self, other: object) -> bool:
+        return isinstance(other, RecipeKey) and other.items == self.items
+
+
 @dataclass
 class OutputRecipe:
     """An output recipe: names, their types, and a precompiled packer.
@@ -173,7 +190,7 @@ class OutputRecipe:
     recipe_id: int
     names: list[str]
     frequency: float
-    key: tuple[str, ...] = field(init=False, repr=False)
+    key: RecipeKey = field(init=False, repr=False)
     types: list[str] = field(init=False)
     ok: bool = field(init=False)
     too_large: bool = field(init=False, default=False)
@@ -181,7 +198,7 @@ class OutputRecipe:
     _counts: list[int] = field(init=False, repr=False, default_factory=list)
 
     def __post_init__(self) -> None:
-        self.key = (str(self.recipe_id), *self.names)  # equal recipes pack the same package
+        self.key = RecipeKey((str(self.recipe_id), *self.names))  # equal recipes, one package
         self.types = [output_type(n) or "NOT_FOUND" for n in self.names]
         self.ok = "NOT_FOUND" not in self.types
         if self.ok:

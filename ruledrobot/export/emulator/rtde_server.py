@@ -20,8 +20,9 @@ waits), the kernel send buffer is bounded (:data:`SEND_BUFFER`), a
 connection with queued bytes is only written to when one ``poll()`` for all
 of them says its socket takes data (every socket call hands the GIL to
 whichever thread wants it, so 100 stuck clients must not cost 100 calls per
-period), and a connection whose queue passes ``max_backlog`` bytes
-(512 KiB) is marked broken and closed by its own thread, as a real
+period; at most :data:`SEND_BUDGET` of a period is spent sending, the rest
+is queued for the next), and a connection whose queue passes ``max_backlog`` bytes
+(:data:`MAX_BACKLOG`, 256 KiB) is marked broken and closed by its own thread, as a real
 controller drops clients that do not read.  The ``slow controller`` fault
 holds every data package back by ``delay`` seconds.
 
@@ -40,6 +41,7 @@ import select
 import socket
 import struct
 import threading
+import time
 from collections import deque
 from collections.abc import Mapping
 
@@ -59,6 +61,7 @@ from .protocol import (
     OutputRecipe,
     PacketFramer,
     ProtocolError,
+    RecipeKey,
     pack_packet,
     parse_names,
     parse_output_setup,
@@ -70,6 +73,14 @@ __all__ = ["RTDEConnection", "RTDEServer", "StreamStats", "due"]
 
 log = logging.getLogger("ruledrobot.export.emulator")
 
+
+#: bytes queued for a client beyond which it is disconnected: about 0.45 s of ur_rtde's
+#: 58-variable stream at 500 Hz, after the kernel buffers (another 0.4 s) are full
+#: (ur_rtde's own receive timeout is 2.5 s; its receive thread is native, it keeps up)
+MAX_BACKLOG = 256 * 1024
+
+#: the fraction of a control period the clock may spend in socket calls per publish
+SEND_BUDGET = 0.4
 
 #: kernel send buffer of an RTDE connection [bytes] (Linux doubles it): about 0.1 s of
 #: ur_rtde's 58-variable recipe at 500 Hz
@@ -133,6 +144,10 @@ class RTDEConnection(Connection):
         self.owned: set[str] = set()
         self.broken = False  # a send failed or the backlog overflowed: close
 
+    def idle_for(self, now: float) -> float:
+        """A started stream is in use (it receives data every period), never idle."""
+        return 0.0 if self.started and not self.broken else now - self.last_rx
+
     @property
     def closing(self) -> bool:
         """Broken: the connection's own thread closes it (closing a socket with megabytes
@@ -174,7 +189,7 @@ class RTDEConnection(Connection):
             return
         del self.backlog[:n]
 
-    def reply(self, kind: int, payload: bytes, max_backlog: int = 512 * 1024) -> None:
+    def reply(self, kind: int, payload: bytes, max_backlog: int = MAX_BACKLOG) -> None:
         """Queue a reply (never blocks; a client that does not read them is closed)."""
         self.push(pack_packet(kind, payload), max_backlog)
 
@@ -195,9 +210,10 @@ class RTDEServer(TcpServer):
         controller: Controller,
         version: tuple[int, int, int, int],
         *,
-        max_backlog: int = 512 * 1024,
+        max_backlog: int = MAX_BACKLOG,
+        **limits: float,
     ) -> None:
-        super().__init__(host, port)
+        super().__init__(host, port, **limits)  # type: ignore[arg-type]
         self.controller = controller
         self.version = version
         self.max_backlog = max_backlog
@@ -327,16 +343,21 @@ class RTDEServer(TcpServer):
         period = self.controller.period
         if tick is None:
             tick = self.controller.ticks
-        packed: dict[tuple[str, ...], bytes | Exception] = {}
+        packed: dict[RecipeKey, bytes | Exception] = {}
         conns = [c for c in self.connections()
                  if isinstance(c, RTDEConnection) and not c.closed and not c.broken]  # fmt: skip
         # connections with queued bytes: one poll() for all of them instead of a send
         # attempt each (every socket call hands the GIL to whichever thread wants it)
         writable = _writable([c for c in conns if c.backlog])
-        for conn in conns:
+        # at most SEND_BUDGET of the period for socket calls; the rest is queued and goes
+        # out next period; the order rotates so that no connection is always last
+        deadline = time.perf_counter() + SEND_BUDGET * period
+        k = tick % len(conns) if conns else 0
+        for conn in conns[k:] + conns[:k]:
+            send = (not conn.backlog or conn.sock.fileno() in writable) and (
+                time.perf_counter() < deadline)  # fmt: skip
             try:
-                self._serve(conn, state, now, tick, period, packed,
-                            not conn.backlog or conn.sock.fileno() in writable)  # fmt: skip
+                self._serve(conn, state, now, tick, period, packed, send)
             except Exception as exc:  # this connection only
                 self.publish_errors += 1
                 log.warning("rtde: closing %s: its data package cannot be sent: %s",
@@ -350,7 +371,7 @@ class RTDEServer(TcpServer):
         now: float,
         tick: int,
         period: float,
-        packed: dict[tuple[str, ...], bytes | Exception],
+        packed: dict[RecipeKey, bytes | Exception],
         send: bool,
     ) -> None:
         recipe = conn.output

@@ -30,8 +30,8 @@ class ScriptPortServer(TcpServer):
 
     name = "script"
 
-    def __init__(self, host: str, port: int, controller: Controller) -> None:
-        super().__init__(host, port)
+    def __init__(self, host: str, port: int, controller: Controller, **limits: float) -> None:
+        super().__init__(host, port, **limits)  # type: ignore[arg-type]
         self.controller = controller
         self.programs_received = 0
         self.last_program: str = ""

@@ -83,6 +83,7 @@ class ClockStats:
             "lateness_max_ms": float(lat.max() * 1e3),
             "gap_p99_ms": float(np.percentile(gap, 99) * 1e3),
             "gap_max_ms": float(gap.max() * 1e3),
+            "gaps_over_10ms": float(np.count_nonzero(gap > 0.010)),
             "resyncs": float(self.resyncs),
             "gc_max_ms": self.gc_max * 1e3,
         }
@@ -122,6 +123,10 @@ class ThreadedEmulator:
     serial_number : digits, reported by ``get serial number``.
     unlock_delay : seconds before a protective stop can be unlocked (5 on a robot).
     allow_remote : allow a non-loopback ``host``.
+    max_connections, idle_timeout : per server, at most ``max_connections``
+        connections; when full, a newcomer replaces the connection idle longest if
+        it has received nothing (and streams nothing) for ``idle_timeout`` s,
+        else it is refused.
     realtime : try to run the clock thread with real-time priority
         (``SCHED_FIFO`` 10, the server threads 5; needs CAP_SYS_NICE, silently
         skipped otherwise): fewer missed periods when clients load the CPU.
@@ -142,6 +147,8 @@ class ThreadedEmulator:
         unlock_delay: float = 5.0,
         allow_remote: bool = False,
         realtime: bool = True,
+        max_connections: int = 32,
+        idle_timeout: float = 10.0,
     ) -> None:
         _check_host(host, allow_remote)
         self.realtime = realtime
@@ -156,12 +163,13 @@ class ThreadedEmulator:
         if isinstance(backend, type) or (callable(backend) and not hasattr(backend, "state")):
             backend = backend(self.model)  # a factory: called with the model
         self.controller = Controller(self.model, backend, q0=q0, unlock_delay=unlock_delay)
-        self.rtde = RTDEServer(host, rtde_port, self.controller, self.version)  # type: ignore[arg-type]
+        limits = {"max_connections": max_connections, "idle_timeout": idle_timeout}
+        self.rtde = RTDEServer(host, rtde_port, self.controller, self.version, **limits)  # type: ignore[arg-type]
         self.dashboard = DashboardServer(
             host, dashboard_port, self.controller, version=self.version,  # type: ignore[arg-type]
-            serial_number=serial_number,
+            serial_number=serial_number, **limits,
         )  # fmt: skip
-        self.script = ScriptPortServer(host, script_port, self.controller)
+        self.script = ScriptPortServer(host, script_port, self.controller, **limits)
         for srv in (self.rtde, self.dashboard, self.script):
             srv.realtime = realtime
         self.stats = ClockStats(lateness=deque(maxlen=20000), gaps=deque(maxlen=20000))
@@ -374,6 +382,9 @@ class ThreadedEmulator:
         out["publish_errors"] = float(self.rtde.publish_errors + self.stats.publish_errors)
         out["rtde_connections"] = float(len(self.rtde.connections()))
         out["programs_received"] = float(self.script.programs_received)
+        servers = (self.rtde, self.dashboard, self.script)
+        out["refused_connections"] = float(sum(s.refused for s in servers))
+        out["evicted_connections"] = float(sum(s.evicted for s in servers))
         out["limit_events"] = float(self.controller.limit_events)
         out["realtime_clock"] = float(self.realtime_clock)
         return out

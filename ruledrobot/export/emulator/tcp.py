@@ -5,6 +5,14 @@ socket has a short timeout so threads notice :meth:`TcpServer.close` within
 ``POLL`` seconds; ``close`` is bounded in time.  :meth:`TcpServer.drop_all`
 closes every connection and refuses new ones for a while (the "dropped
 connection" fault).
+
+Bounds: at most ``max_connections`` connections (one thread each).  When the
+server is full, a newcomer takes the place of the connection that has been
+idle longest, if that one has received nothing for ``idle_timeout`` seconds
+(and, for RTDE, streams nothing); otherwise the newcomer is refused (accepted
+and closed at once).  Idle connections are not closed otherwise: ur_rtde
+keeps its dashboard and script-port connections open and silent for a whole
+session.
 """
 
 from __future__ import annotations
@@ -39,6 +47,11 @@ class Connection:
         self.addr = addr
         self.closed = False
         self.write_lock = threading.Lock()
+        self.last_rx = time.monotonic()  # when bytes last arrived
+
+    def idle_for(self, now: float) -> float:
+        """Seconds since the peer last sent anything (0 for a connection in use)."""
+        return now - self.last_rx
 
     @property
     def closing(self) -> bool:
@@ -96,7 +109,17 @@ class TcpServer:
     #: non-blocking sockets (no send ever waits; :meth:`recv_loop` waits in a selector)
     nonblocking = False
 
-    def __init__(self, host: str, port: int) -> None:
+    def __init__(
+        self, host: str, port: int, *, max_connections: int = 32, idle_timeout: float = 10.0
+    ) -> None:
+        if max_connections < 1:
+            raise ValueError(f"max_connections: expected >= 1, got {max_connections}")
+        if not idle_timeout > 0.0:
+            raise ValueError(f"idle_timeout: expected > 0 s, got {idle_timeout}")
+        self.max_connections = int(max_connections)
+        self.idle_timeout = float(idle_timeout)
+        self.refused = 0
+        self.evicted = 0
         self.host = host
         self.port = int(port)
         self._stop = threading.Event()
@@ -176,7 +199,7 @@ class TcpServer:
                     return
                 time.sleep(POLL)
                 continue
-            if time.monotonic() < self._refuse_until:
+            if time.monotonic() < self._refuse_until or not self._make_room():
                 with contextlib.suppress(OSError):
                     sock.close()
                 continue
@@ -196,6 +219,27 @@ class TcpServer:
                 )
                 self._threads.append(t)
             t.start()
+
+    def _make_room(self) -> bool:
+        """Room for one more connection: True, evicting the idlest one if needed."""
+        with self._lock:
+            if len(self._conns) < self.max_connections:
+                return True
+            now = time.monotonic()
+            victim = max(self._conns.values(), key=lambda c: c.idle_for(now))
+            if victim.idle_for(now) < self.idle_timeout:
+                self.refused += 1
+                if self.refused & (self.refused - 1) == 0:  # 1st, 2nd, 4th, ... time
+                    log.warning("%s server: %d connections, none idle for %g s: refusing "
+                                "(%d times so far)", self.name, len(self._conns),
+                                self.idle_timeout, self.refused)  # fmt: skip
+                return False
+            del self._conns[id(victim)]
+            self.evicted += 1
+        log.info("%s server: full; closing %s, idle for %.1f s", self.name, victim.peer,
+                 victim.idle_for(now))  # fmt: skip
+        victim.close()
+        return True
 
     def _run(self, conn: Connection) -> None:
         if self.realtime:
@@ -229,6 +273,7 @@ class TcpServer:
                 return
             if not data:
                 return
+            conn.last_rx = time.monotonic()
             on_data(data)
 
     def _recv_nonblocking(
@@ -250,6 +295,7 @@ class TcpServer:
                     return
                 if not data:
                     return
+                conn.last_rx = time.monotonic()
                 on_data(data)
 
     # ------------------------------------------------------------ for subclasses
