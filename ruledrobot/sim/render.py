@@ -48,7 +48,7 @@ Source = Any  # PlaybackResult | Scene | RobotModel
 
 
 def _scene_of(source: Source, width: int, height: int) -> Scene:
-    from .playback import PlaybackResult
+    from .result import PlaybackResult
 
     if isinstance(source, PlaybackResult):
         scene = source.scene or Scene(source.robot)
@@ -72,7 +72,7 @@ def _scene_of(source: Source, width: int, height: int) -> Scene:
 def _motion(
     source: Source, t: ArrayLike | None, q: ArrayLike | None
 ) -> tuple[FloatArray, FloatArray]:
-    from .playback import PlaybackResult
+    from .result import PlaybackResult
 
     if isinstance(source, PlaybackResult) and t is None and q is None:
         return source.t, source.q
