@@ -358,16 +358,27 @@ def _stream(trajectory: Path, host: str | None, **options):
 def ursim(
     host: str = typer.Option("127.0.0.1", help="Address to listen on (loopback by default)."),
     model: str = typer.Option("ur5e", help="Robot model."),
+    programs: Path | None = typer.Option(
+        None, help="Folder the dashboard's `load` serves programs from (default: an empty one)."
+    ),
+    duration: float | None = typer.Option(
+        None, min=0.0, help="Stop after this many seconds (default: run until Ctrl-C)."
+    ),
 ) -> None:
     """Run the controller emulator (RTDE 30004, dashboard 29999, script 30003) until Ctrl-C."""
     from .export import serve
 
-    console.print(
-        f"UR controller emulator ({model}) on {host}: RTDE 30004, dashboard 29999, "
-        "script 30003; Ctrl-C to stop"
-    )
+    def ready(emu) -> None:  # printed once the ports are bound, never before
+        p = emu.ports
+        console.print(
+            f"UR controller emulator ({model}) listening on {host}: RTDE {p['rtde']}, "
+            f"dashboard {p['dashboard']}, script {p['script']}; programs in "
+            f"{emu.programs_dir}; Ctrl-C to stop", highlight=False, markup=False,
+        )  # fmt: skip
+
+    options: dict = {} if programs is None else {"programs_dir": str(programs)}
     try:
-        serve(host, model)
+        serve(host, model, duration=duration, ready=ready, **options)
     except KeyboardInterrupt:
         pass
     except (ValueError, OSError) as exc:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import socket
 import time
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -218,7 +219,7 @@ def _kinematics(r, c) -> None:
     np.testing.assert_allclose(pt, [0.1, 0.1, 0.0, 0.0, 0.0, np.pi / 2], atol=1e-12)
 
 
-def test_stop_script_reupload_and_dashboard(emulator: Emulator, ur: UR, tmp_path) -> None:
+def test_stop_script_reupload_and_dashboard(emulator: Emulator, ur: UR) -> None:
     import dashboard_client
 
     r, c = ur.r, ur.c
@@ -261,10 +262,10 @@ def test_stop_script_reupload_and_dashboard(emulator: Emulator, ur: UR, tmp_path
         assert d.getLoadedProgram() == "No program loaded"
         with pytest.raises(RuntimeError, match="File not found"):
             d.loadURP("/no/such/program.urp")
-        urp = tmp_path / "cut.urp"
+        urp = Path(emulator.programs_dir) / "cut.urp"  # PolyScope's /programs
         urp.write_text("placeholder")
-        d.loadURP(str(urp))
-        assert d.getLoadedProgram() == f"Loaded program: {urp}"
+        d.loadURP("cut.urp")
+        assert d.getLoadedProgram() == f"Loaded program: {urp.resolve()}"
         d.play()
         assert _wait(lambda: r.getRuntimeState() == 2)
         d.pause()

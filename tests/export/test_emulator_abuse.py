@@ -11,6 +11,7 @@ import struct
 import threading
 import time
 from collections.abc import Iterator
+from pathlib import Path
 
 import pytest
 
@@ -446,3 +447,87 @@ def dashboard_line(host: str, port: int, command: str) -> str:
         f.write(command + "\n")
         f.flush()
         return f.readline().strip()
+
+
+# ---------------------------------------------------------------- 8: what the network may do
+
+
+def test_restart_safety_does_not_release_an_emergency_stop(emulator: Emulator) -> None:
+    """An e-stop is released on the robot (the button), never from the network."""
+    host, port = emulator.host, emulator.ports["dashboard"]
+    emulator.emergency_stop("test")
+    assert emulator.wait_for(lambda: emulator.robot_mode == 3, 3.0)  # braked, power off
+    assert dashboard_line(host, port, "restart safety") == "Restarting safety"
+    time.sleep(0.1)
+    assert emulator.safety_mode == 7  # ROBOT_EMERGENCY_STOP, still
+    assert dashboard_line(host, port, "power on").startswith("Failed")
+    assert any(
+        "emergency stop" in m and "released on the robot" in m
+        for _, lv, m in emulator.events
+        if lv <= 2
+    )
+    emulator.release_emergency_stop()  # the button
+    assert emulator.safety_mode == 1
+    assert dashboard_line(host, port, "power on") == "Powering on"
+    assert dashboard_line(host, port, "brake release") == "Brake releasing"
+    assert emulator.wait_for(lambda: emulator.robot_mode == 7, 2.0)
+
+
+def test_programs_are_loaded_from_the_programs_folder_only(
+    request: pytest.FixtureRequest, tmp_path: Path
+) -> None:
+    """As PolyScope serves /programs: anything outside the folder, or missing, is
+    "File not found" (the answer reveals nothing about other files)."""
+    programs = tmp_path / "programs"
+    programs.mkdir()
+    (programs / "cut.urp").write_text("placeholder")
+    (programs / "sub").mkdir()
+    (programs / "sub" / "heat.script").write_text(
+        "def heat():\n  set_standard_digital_out(2, True)\nend\n"
+    )
+    secret = tmp_path / "secret.urp"
+    secret.write_text("outside")
+    (programs / "link.urp").symlink_to(secret)
+    emu = start_emulator(request.node.nodeid, model="ur5e", programs_dir=str(programs))
+    host, port = emu.host, emu.ports["dashboard"]
+    try:
+        assert emu.programs_dir == str(programs)
+        for path in (
+            "/etc/shadow",
+            "/etc/hostname",
+            "/etc/passwd",
+            "../secret.urp",
+            str(secret),
+            "link.urp",
+            "sub/../../secret.urp",
+            "missing.urp",
+            "",
+        ):
+            reply = dashboard_line(host, port, f"load {path}")
+            assert reply == f"File not found: {path}".strip(), reply
+        assert dashboard_line(host, port, "get loaded program") == "No program loaded"
+        assert dashboard_line(host, port, "load cut.urp") == "Loading program: cut.urp"
+        assert dashboard_line(host, port, "get loaded program") == (
+            f"Loaded program: {programs / 'cut.urp'}"
+        )
+        full = str(programs / "sub" / "heat.script")
+        assert dashboard_line(host, port, f"load {full}") == f"Loading program: {full}"
+        assert dashboard_line(host, port, "play") == "Starting program"
+        assert emu.wait_for(lambda: any("heat finished" in m for _, _, m in emu.events), 3.0)
+    finally:
+        emu.close()
+
+
+def test_ursim_binds_before_it_says_it_listens() -> None:
+    from typer.testing import CliRunner
+
+    from ruledrobot.cli import app
+
+    runner = CliRunner()
+    refused = runner.invoke(app, ["ursim", "--host", "10.255.255.1", "--duration", "0.5"])
+    assert refused.exit_code == 2, refused.output
+    assert "listening" not in refused.output and "not a loopback" in refused.output
+    host = _address("test_ursim_binds_before_it_says_it_listens", 0)
+    ok = runner.invoke(app, ["ursim", "--host", host, "--duration", "0.5"])
+    assert ok.exit_code == 0, ok.output
+    assert f"listening on {host}" in ok.output

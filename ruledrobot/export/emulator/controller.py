@@ -115,6 +115,8 @@ class Controller:
         stop`` is accepted (5 s on a real controller).
     fault_deceleration : joint deceleration [rad/s^2] of the braking after a
         protective or emergency stop.
+    programs_dir : the folder the dashboard's ``load`` serves programs from
+        (PolyScope serves ``/programs``); nothing outside it can be loaded.
     """
 
     def __init__(
@@ -125,8 +127,11 @@ class Controller:
         q0: ArrayLike | None = None,
         unlock_delay: float = 5.0,
         fault_deceleration: float = 20.0,
+        programs_dir: str | Path | None = None,
     ) -> None:
         self.model = model
+        #: the folder ``load`` serves programs from (PolyScope's /programs); None: none
+        self.programs_dir = Path(programs_dir).resolve() if programs_dir is not None else None
         self.period = float(model.control_period)
         self.lock = RLock()
         self.kin = ArmKinematics(model)
@@ -617,13 +622,28 @@ class Controller:
             prog = self._loaded_script or Program(Path(self.loaded_program).stem, "", "idle")
             return self.start_program(prog)
 
+    def program_path(self, path: str) -> Path | None:
+        """The file ``path`` names inside :attr:`programs_dir` (relative to it, or absolute
+        within it, symbolic links resolved), or None: outside, missing, not a file."""
+        root = self.programs_dir
+        if root is None or not path or "\x00" in path:
+            return None
+        p = Path(path)
+        try:
+            real = (p if p.is_absolute() else root / p).resolve(strict=True)
+        except (OSError, RuntimeError, ValueError):
+            return None
+        return real if real.is_relative_to(root) and real.is_file() else None
+
     def load(self, path: str) -> str:
         """Dashboard ``load``: ``"ok"``, ``"not found"`` or ``"error"`` (a ``.script`` that
-        does not compile: logged and shown as a popup).  A ``.script`` is run by
+        does not compile: logged and shown as a popup).  Only files inside
+        :attr:`programs_dir` (:meth:`program_path`).  A ``.script`` is run by
         ``play``; a ``.urp`` idles (the emulator cannot run PolyScope programs)."""
-        p = Path(path)
-        if not p.is_file():
+        found = self.program_path(path)
+        if found is None:
             return "not found"
+        p = found
         script: Program | None = None
         if p.suffix == ".script":
             try:
@@ -710,6 +730,20 @@ class Controller:
             self.stop_program("emergency stop", decelerate=False)
             self._brake()
             self._power_off_when_stopped = True
+
+    def restart_safety(self) -> None:
+        """Dashboard ``restart safety``: the safety system restarts after a fault or a
+        violation, the robot is then powered off.  An emergency stop stays: it is
+        released on the robot (the button), never from the network."""
+        with self.lock:
+            if self.safety_mode in (SafetyMode.ROBOT_EMERGENCY_STOP,
+                                    SafetyMode.SYSTEM_EMERGENCY_STOP):  # fmt: skip
+                self.log("restart safety: the emergency stop is still pressed; it must be "
+                         "released on the robot", level=2)  # fmt: skip
+            elif self.safety_mode in (SafetyMode.FAULT, SafetyMode.VIOLATION):
+                self.log(f"restart safety: {self.safety_mode.name} cleared")
+                self.safety_mode = SafetyMode.NORMAL
+            self.power_off()
 
     def release_emergency_stop(self) -> None:
         """The e-stop button is released: safety NORMAL; power on + brake release to run."""

@@ -115,9 +115,12 @@ class DashboardServer(TcpServer):
         if low.startswith("addtolog"):
             c.log(f"dashboard: {cmd[8:].strip()}")
             return "Added log message"
-        if low.startswith("load "):
+        if low == "load" or low.startswith("load "):
             path = cmd[5:].strip()
             if path.endswith(".installation"):
+                if c.program_path(path) is None:
+                    return f"File not found: {path}"
+                c.log(f"dashboard: installation {path} loaded (no effect in the emulator)")
                 return f"Loading installation: {path}"
             result = c.load(path)
             if result == "ok":
@@ -146,8 +149,7 @@ class DashboardServer(TcpServer):
             name = (c.program.name if c.program else "") or "<unnamed>"
             return f"true {name}"
         if low == "restart safety":
-            c.release_emergency_stop()
-            c.power_off()
+            c.restart_safety()
             return "Restarting safety"
         if low == "get operational mode":
             return "NONE"

@@ -62,6 +62,7 @@ _PROPS = frozenset(
         "events",
         "ports",
         "popup",
+        "programs_dir",
     }
 )
 
@@ -318,6 +319,11 @@ class Emulator:
     @property
     def runtime_state(self) -> RuntimeState:
         return RuntimeState(self._call("runtime_state"))
+
+    @property
+    def programs_dir(self) -> str:
+        """The folder the dashboard's ``load`` serves programs from."""
+        return str(self._call("programs_dir"))
 
     @property
     def popup(self) -> str | None:

@@ -13,13 +13,16 @@ import contextlib
 import gc
 import ipaddress
 import logging
+import shutil
 import socket
 import sys
+import tempfile
 import threading
 import time
 from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -127,6 +130,9 @@ class ThreadedEmulator:
         connections; when full, a newcomer replaces the connection idle longest if
         it has received nothing (and streams nothing) for ``idle_timeout`` s,
         else it is refused.
+    programs_dir : the folder the dashboard's ``load`` serves programs from (as
+        PolyScope serves ``/programs``); default: an empty temporary folder,
+        removed by :meth:`close` (:attr:`programs_dir` says where).
     realtime : try to run the clock thread with real-time priority
         (``SCHED_FIFO`` 10, the server threads 5; needs CAP_SYS_NICE, silently
         skipped otherwise): fewer missed periods when clients load the CPU.
@@ -149,6 +155,7 @@ class ThreadedEmulator:
         realtime: bool = True,
         max_connections: int = 32,
         idle_timeout: float = 10.0,
+        programs_dir: str | None = None,
     ) -> None:
         _check_host(host, allow_remote)
         self.realtime = realtime
@@ -162,7 +169,14 @@ class ThreadedEmulator:
         self.host = host
         if isinstance(backend, type) or (callable(backend) and not hasattr(backend, "state")):
             backend = backend(self.model)  # a factory: called with the model
-        self.controller = Controller(self.model, backend, q0=q0, unlock_delay=unlock_delay)
+        self._own_programs = programs_dir is None
+        if programs_dir is None:
+            programs_dir = tempfile.mkdtemp(prefix="ruledrobot-programs-")
+        elif not Path(programs_dir).is_dir():
+            raise ValueError(f"programs_dir: {programs_dir!r} is not a folder")
+        self.programs_dir = str(programs_dir)
+        self.controller = Controller(self.model, backend, q0=q0, unlock_delay=unlock_delay,
+                                     programs_dir=self.programs_dir)  # fmt: skip
         limits = {"max_connections": max_connections, "idle_timeout": idle_timeout}
         self.rtde = RTDEServer(host, rtde_port, self.controller, self.version, **limits)  # type: ignore[arg-type]
         self.dashboard = DashboardServer(
@@ -215,6 +229,8 @@ class ThreadedEmulator:
         with contextlib.suppress(ValueError):
             gc.callbacks.remove(self._gc_timer)
         _release_switch_interval()
+        if self._own_programs:
+            shutil.rmtree(self.programs_dir, ignore_errors=True)
 
     def __enter__(self) -> ThreadedEmulator:
         return self.start()
