@@ -364,25 +364,57 @@ def ursim(
     duration: float | None = typer.Option(
         None, min=0.0, help="Stop after this many seconds (default: run until Ctrl-C)."
     ),
+    fault: list[str] = typer.Option(
+        [],
+        "--fault",
+        help="KIND@WHEN[:ARG], repeatable: KIND protective_stop, emergency_stop, drop, freeze, "
+        "slow, clear; WHEN seconds after start (5s, 500ms) or SIGUSR1/SIGUSR2; ARG seconds "
+        "(drop: refuse new connections, freeze: how long, slow: the delay). E.g. --fault "
+        "protective_stop@5s --fault freeze@10s:3s --fault clear@SIGUSR2",
+    ),
+    physics: str = typer.Option(
+        "kinematic", help="The arm behind the controller: kinematic, or mujoco (simulated)."
+    ),
 ) -> None:
-    """Run the controller emulator (RTDE 30004, dashboard 29999, script 30003) until Ctrl-C."""
+    """Run the controller emulator (RTDE 30004, dashboard 29999, script 30003) until Ctrl-C,
+    optionally with faults on a timer or on a signal (docs/rtde.md)."""
     from .export import serve
+    from .export.emulator.faults import FaultSchedule, parse_fault
+
+    if physics not in ("kinematic", "mujoco"):
+        raise typer.BadParameter(f"expected kinematic or mujoco, got {physics!r}",
+                                 param_hint="'--physics'")  # fmt: skip
+    try:
+        specs = [parse_fault(f) for f in fault]
+    except ValueError as exc:
+        raise _fail(f"--fault: {exc}") from None
+    schedule = FaultSchedule(specs, on_fire=lambda s: console.print(
+        f"fault: {s.describe()}", highlight=False, markup=False))  # fmt: skip
 
     def ready(emu) -> None:  # printed once the ports are bound, never before
         p = emu.ports
         console.print(
-            f"UR controller emulator ({model}) listening on {host}: RTDE {p['rtde']}, "
-            f"dashboard {p['dashboard']}, script {p['script']}; programs in "
+            f"UR controller emulator ({model}, {physics}) listening on {host}: RTDE "
+            f"{p['rtde']}, dashboard {p['dashboard']}, script {p['script']}; programs in "
             f"{emu.programs_dir}; Ctrl-C to stop", highlight=False, markup=False,
         )  # fmt: skip
+        for s in specs:
+            console.print(f"scheduled fault: {s.describe()}", highlight=False, markup=False)
+        schedule.start(emu)
 
     options: dict = {} if programs is None else {"programs_dir": str(programs)}
+    if physics == "mujoco":
+        from .export.emulator.physics import MujocoBackend
+
+        options["backend"] = MujocoBackend
     try:
         serve(host, model, duration=duration, ready=ready, **options)
     except KeyboardInterrupt:
         pass
     except (ValueError, OSError) as exc:
         raise _fail(str(exc)) from None
+    finally:
+        schedule.stop()
 
 
 def _run_plan(job_path: Path, out: Path, video: bool = False):

@@ -6,16 +6,20 @@ Each test starts its servers on its own loopback address and stops them.
 from __future__ import annotations
 
 import contextlib
+import signal
 import socket
 import struct
+import subprocess
+import sys
 import threading
 import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from pathlib import Path
 
 import pytest
 
 from ruledrobot.export.emulator import Emulator, ThreadedEmulator
+from ruledrobot.export.emulator.faults import FaultSpec, parse_fault
 from ruledrobot.export.emulator.program import (
     MAX_LINE_BYTES,
     MAX_PROGRAM_BYTES,
@@ -531,3 +535,116 @@ def test_ursim_binds_before_it_says_it_listens() -> None:
     ok = runner.invoke(app, ["ursim", "--host", host, "--duration", "0.5"])
     assert ok.exit_code == 0, ok.output
     assert f"listening on {host}" in ok.output
+
+
+# ---------------------------------------------------------------- 9: faults, frozen controller
+
+
+def test_fault_specs_parse_or_say_what_is_wrong() -> None:
+    assert parse_fault("protective_stop@5s") == FaultSpec(
+        "protective_stop", 5.0, None, None, "protective_stop@5s"
+    )
+    assert parse_fault("freeze@500ms:3s").at == 0.5 and parse_fault("freeze@1:3").arg == 3.0
+    assert parse_fault("emergency-stop@SIGUSR1").signal == "SIGUSR1"
+    assert parse_fault("clear@usr2").signal == "SIGUSR2"
+    assert parse_fault("drop@2:250ms").arg == 0.25
+    for bad, why in [("protective_stop", "KIND@WHEN"), ("explode@5s", "unknown kind"),
+                     ("freeze@soon", "not a time"), ("slow@1:fast", "not a time"),
+                     ("emergency_stop@1:2", "takes no argument")]:  # fmt: skip
+        with pytest.raises(ValueError, match=why):
+            parse_fault(bad)
+
+
+def test_a_frozen_controller_keeps_its_sockets_and_answers_nothing(emulator: Emulator) -> None:
+    host, ports = emulator.host, emulator.ports
+    with (
+        RawRTDEClient(host) as cli,
+        socket.create_connection((host, ports["dashboard"]), timeout=2.0) as dash,
+    ):
+        assert cli.negotiate()
+        cli.setup_outputs(["timestamp"], 125.0)
+        assert cli.start()
+        f = dash.makefile("rb")
+        assert f.readline().startswith(b"Connected")
+        t_before = cli.read_data()["timestamp"]
+        emulator.freeze()
+        time.sleep(0.05)
+        # drain what was sent before the freeze, then: nothing, but the socket is open
+        t_last = t_before
+        with contextlib.suppress(TimeoutError):
+            while True:
+                t_last = cli.read_data(timeout=0.2)["timestamp"]
+        dash.sendall(b"robotmode\n")
+        dash.settimeout(0.5)
+        with pytest.raises(TimeoutError):
+            dash.recv(100)  # no reply, no EOF
+        late = socket.create_connection((host, ports["dashboard"]), timeout=2.0)  # queued
+        late.settimeout(0.3)
+        with pytest.raises(TimeoutError):
+            late.recv(100)  # no greeting while frozen
+        assert emulator.runtime_state in (1, 2)  # the emulator itself is alive
+        emulator.unfreeze()
+        dash.settimeout(2.0)
+        assert f.readline() == b"Robotmode: RUNNING\n"  # the queued request, answered now
+        late.settimeout(2.0)
+        assert late.recv(100).startswith(b"Connected")
+        late.close()
+        t_after = cli.read_data(timeout=2.0)["timestamp"]
+        assert t_after - t_last < 0.1  # the controller time stood still (frozen > 1 s)
+        assert t_last >= t_before
+    assert any("frozen" in m for _, _, m in emulator.events)
+
+
+def test_ursim_injects_faults_on_a_timer_and_on_a_signal(tmp_path: Path) -> None:
+    host = _address("test_ursim_injects_faults_on_a_timer_and_on_a_signal", 0)
+    cmd = [sys.executable, "-c", "from ruledrobot.cli import app; app()", "ursim",
+           "--host", host, "--duration", "20", "--programs", str(tmp_path),
+           "--fault", "protective_stop@1s", "--fault", "emergency_stop@SIGUSR1",
+           "--fault", "clear@SIGUSR2"]  # fmt: skip
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    try:
+        assert proc.stdout is not None
+        lines = []
+        for line in proc.stdout:  # the banner comes once the ports are bound
+            lines.append(line)
+            if "listening on" in line:
+                break
+        assert any("listening on" in ln for ln in lines), lines
+        dash = emulator_dashboard(host)
+        assert dash("safetymode") == "Safetymode: NORMAL"
+        deadline = time.monotonic() + 5.0
+        while dash("safetymode") != "Safetymode: PROTECTIVE_STOP":
+            assert time.monotonic() < deadline, "no protective stop after 1 s"
+            time.sleep(0.05)
+        proc.send_signal(signal.SIGUSR1)
+        deadline = time.monotonic() + 3.0
+        while dash("safetymode") != "Safetymode: ROBOT_EMERGENCY_STOP":
+            assert time.monotonic() < deadline, "SIGUSR1 did not trigger the e-stop"
+            time.sleep(0.05)
+        proc.send_signal(signal.SIGUSR2)
+        deadline = time.monotonic() + 3.0
+        while dash("safetymode") != "Safetymode: NORMAL":
+            assert time.monotonic() < deadline, "SIGUSR2 did not clear"
+            time.sleep(0.05)
+    finally:
+        proc.send_signal(signal.SIGINT)
+        try:
+            out, _ = proc.communicate(timeout=10.0)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            out, _ = proc.communicate()
+    assert "fault: emergency_stop on SIGUSR1" in out and proc.returncode == 0, out
+
+
+def emulator_dashboard(host: str) -> Callable[[str], str]:
+    """A dashboard query function on one connection."""
+    s = socket.create_connection((host, 29999), timeout=3.0)
+    f = s.makefile("rw")
+    assert f.readline().startswith("Connected")
+
+    def ask(cmd: str) -> str:
+        f.write(cmd + "\n")
+        f.flush()
+        return f.readline().strip()
+
+    return ask

@@ -49,6 +49,8 @@ _CALLS = frozenset(
         "clear_faults",
         "stats_summary",
         "reset_stats",
+        "freeze",
+        "unfreeze",
         "reset",
     }
 )
@@ -280,6 +282,15 @@ class Emulator:
     def drop_connections(self, refuse_for: float = 0.0) -> int:
         """Fault: close every client connection; refuse new ones for ``refuse_for`` s."""
         return int(self._call("drop_connections", refuse_for))
+
+    def freeze(self, duration: float | None = None) -> None:
+        """Fault: a frozen controller (sockets open, nothing answers or is sent, the time
+        stands still) for ``duration`` s, or until :meth:`unfreeze`."""
+        self._call("freeze", duration)
+
+    def unfreeze(self) -> None:
+        """End the frozen-controller fault."""
+        self._call("unfreeze")
 
     def set_slow(self, delay: float, jitter: float = 0.0) -> None:
         """Fault: slow controller; data packages arrive ``delay`` (+ up to ``jitter``) s late."""

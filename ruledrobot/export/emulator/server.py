@@ -184,8 +184,11 @@ class ThreadedEmulator:
             serial_number=serial_number, **limits,
         )  # fmt: skip
         self.script = ScriptPortServer(host, script_port, self.controller, **limits)
+        self.frozen = threading.Event()  # the frozen-controller fault
+        self._thaw: threading.Timer | None = None
         for srv in (self.rtde, self.dashboard, self.script):
             srv.realtime = realtime
+            srv.frozen = self.frozen
         self.stats = ClockStats(lateness=deque(maxlen=20000), gaps=deque(maxlen=20000))
         self._stop = threading.Event()
         self._clock: threading.Thread | None = None
@@ -221,6 +224,7 @@ class ThreadedEmulator:
             return
         self._started = False
         deadline = time.monotonic() + timeout
+        self.unfreeze()
         self._stop.set()
         if self._clock is not None:
             self._clock.join(max(0.1, deadline - time.monotonic()))
@@ -255,6 +259,11 @@ class ThreadedEmulator:
         next_t = time.perf_counter() + period
         last_publish: float | None = None
         while not self._stop.is_set():
+            if self.frozen.is_set():  # frozen: no tick, no data, the time stands still
+                self._stop.wait(0.01)
+                next_t = time.perf_counter() + period
+                last_publish = None
+                continue
             now = time.perf_counter()
             wait = next_t - now
             if wait > 0:
@@ -332,6 +341,35 @@ class ThreadedEmulator:
             n += srv.drop_all(refuse_for)
         self.controller.log(f"dropped {n} connections (refusing for {refuse_for:g} s)", level=2)
         return n
+
+    def freeze(self, duration: float | None = None) -> None:
+        """Fault: a frozen controller, for ``duration`` s (None: until :meth:`unfreeze`).
+
+        Sockets stay open, nothing is accepted, read, answered or sent, and the
+        controller time stands still (the kernel buffers what clients send; it is
+        read and answered after the freeze).
+        """
+        if duration is not None and not duration > 0.0:
+            raise ValueError(f"freeze: duration must be > 0 s, got {duration}")
+        self.controller.log("controller frozen" + (f" for {duration:g} s" if duration else ""),
+                            level=2)  # fmt: skip
+        self.frozen.set()
+        if self._thaw is not None:
+            self._thaw.cancel()
+            self._thaw = None
+        if duration is not None:
+            self._thaw = threading.Timer(duration, self.unfreeze)
+            self._thaw.daemon = True
+            self._thaw.start()
+
+    def unfreeze(self) -> None:
+        """End the frozen-controller fault (no-op when not frozen)."""
+        if self._thaw is not None:
+            self._thaw.cancel()
+            self._thaw = None
+        if self.frozen.is_set():
+            self.frozen.clear()
+            self.controller.log("controller answers again (frozen fault over)", level=2)
 
     def set_slow(self, delay: float, jitter: float = 0.0) -> None:
         """Fault: a slow controller; every data package arrives ``delay`` (+ jitter) s late.

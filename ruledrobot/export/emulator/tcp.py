@@ -13,6 +13,9 @@ idle longest, if that one has received nothing for ``idle_timeout`` seconds
 and closed at once).  Idle connections are not closed otherwise: ur_rtde
 keeps its dashboard and script-port connections open and silent for a whole
 session.
+
+``frozen`` (an Event, set by the frozen-controller fault): nothing is accepted,
+read or answered; connections stay open and the kernel buffers what arrives.
 """
 
 from __future__ import annotations
@@ -129,6 +132,8 @@ class TcpServer:
         self._refuse_until = 0.0
         self._listener: socket.socket | None = None
         self._accept_thread: threading.Thread | None = None
+        #: set: a frozen controller (nothing accepted, read or answered; sockets stay open)
+        self.frozen = threading.Event()
         self.accepted = 0
         self.errors = 0
 
@@ -190,6 +195,9 @@ class TcpServer:
         if self.realtime:
             try_realtime_priority(5)
         while not self._stop.is_set():
+            if self.frozen.is_set():  # the kernel's listen queue holds the newcomers
+                self._stop.wait(POLL)
+                continue
             try:
                 sock, addr = self._listener.accept()
             except TimeoutError:
@@ -265,6 +273,9 @@ class TcpServer:
             self._recv_nonblocking(conn, on_data, bufsize)
             return
         while not self._stop.is_set() and not conn.closed:
+            if self.frozen.is_set():
+                self._stop.wait(POLL)
+                continue
             try:
                 data = conn.sock.recv(bufsize)
             except TimeoutError:
@@ -285,6 +296,9 @@ class TcpServer:
             except (OSError, ValueError):
                 return
             while not self._stop.is_set() and not conn.closed and not conn.closing:
+                if self.frozen.is_set():
+                    self._stop.wait(POLL)
+                    continue
                 if not sel.select(IDLE_WAIT):
                     continue
                 try:
