@@ -11,6 +11,7 @@ import time
 import numpy as np
 
 from ruledrobot.export.emulator import DEFAULT_Q, Emulator
+from ruledrobot.export.emulator import fuzz as fuzz_mod
 from ruledrobot.export.emulator.protocol import pack_packet
 from ruledrobot.export.emulator.rawclient import UR_RTDE_RECEIVE_RECIPE, RawRTDEClient
 
@@ -106,3 +107,57 @@ def test_malformed_packets_fuzz(emulator: Emulator, ur: UR) -> None:
     assert c.moveJ(target, 1.0, 4.0)
     np.testing.assert_allclose(r.getActualQ(), target, atol=1e-9)
     assert emulator.runtime_state == 2
+
+
+def test_semantic_fuzz_of_the_three_ports(emulator: Emulator, ur: UR) -> None:
+    """Hostile but well-formed input (emulator.fuzz): programs with bad arguments, control
+    flow, huge numbers, over-long lines; dashboard commands with paths outside the
+    programs folder; random RTDE recipes and frequencies.  For 3 s, loopback only, while a
+    client streams: the stream never stalls, no controller period and no publish fails,
+    the outputs never take a value a controller could not have, nothing outside the
+    programs folder loads, and ur_rtde works afterwards."""
+    host = emulator.host
+    fuzz_mod.check_loopback(host)
+    gaps: list[float] = []
+    bits: list[int] = []
+    stop = threading.Event()
+
+    def watch() -> None:
+        with RawRTDEClient(host) as cli:
+            assert cli.negotiate()
+            cli.setup_outputs(["timestamp", "actual_digital_output_bits",
+                               "standard_analog_output0"], 500.0)  # fmt: skip
+            assert cli.start()
+            last = time.monotonic()
+            while not stop.is_set():
+                d = cli.read_data(timeout=2.0)
+                now = time.monotonic()
+                gaps.append(now - last)
+                last = now
+                bits.append(d["actual_digital_output_bits"])
+                assert 0.0 <= d["standard_analog_output0"] <= 1.0
+
+    watcher = threading.Thread(target=watch, daemon=True)
+    watcher.start()
+    time.sleep(0.2)
+    report = fuzz_mod.fuzz(host, emulator.ports, duration=3.0, seed=7)
+    stop.set()
+    watcher.join(5.0)
+    assert not watcher.is_alive()
+    assert sum(report.cases.values()) > 150, report
+    stats = emulator.stats()
+    assert stats["tick_errors"] == 0 and stats["publish_errors"] == 0, stats
+    assert len(gaps) > 1000 and max(gaps[10:]) < 0.1
+    assert max(bits) < 1 << 18  # 8 standard + 8 configurable + 2 tool outputs
+    events = emulator.events
+    assert not any("Loading program" in m for _, _, m in events)
+    assert not any("program step failed" in m or "internal error" in m for _, _, m in events)
+    # back to a known state, as an operator would: then ur_rtde as if nothing happened
+    emulator.release_emergency_stop()
+    emulator.clear_faults()
+    emulator.reset(DEFAULT_Q)
+    r, c = ur.r, ur.c
+    assert c.isConnected()
+    target = (np.array(DEFAULT_Q) + 0.05).tolist()
+    assert c.moveJ(target, 1.0, 4.0)
+    np.testing.assert_allclose(r.getActualQ(), target, atol=1e-9)
