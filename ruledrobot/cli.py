@@ -292,65 +292,121 @@ def export(
     console.print(f"wrote {path}")
 
 
+class RunModeName(str, Enum):
+    servoj = "servoj"
+    path = "path"
+
+
 @app.command(
     epilog="Example:  ruledrobot run out/demo/trajectory.csv --host 192.168.1.10   "
-    "(--dry-run checks without motion; without --host a local emulator is used)"
+    "(--dry-run checks without motion; --resume N re-enters the cut at sample N; without "
+    "--host a local emulator is used)"
 )
 def run(
     trajectory: Path = typer.Argument(..., help="Trajectory CSV."),
     host: str | None = typer.Option(
         None, help="Robot controller address; default: an embedded emulator on 127.0.0.42."
     ),
-    mode: str = typer.Option("servoj", help="servoj (stream) or path (moveJ path + blends)."),
+    mode: RunModeName = typer.Option(
+        RunModeName.servoj, help="servoj (stream one servoJ per period) or path (moveL path)."
+    ),
     speed_scale: float = typer.Option(1.0, min=0.01, max=1.0, help="Slow the whole run down."),
+    resume: int | None = typer.Option(
+        None, "--resume", min=0, help="Re-enter the cut at sample N (printed when a run stops)."
+    ),
+    yes: bool = typer.Option(False, "--yes", "-y", help="Start without asking (scripts)."),
     dry_run: bool = typer.Option(False, "--dry-run", help="Check everything, move nothing."),
 ) -> None:
-    """Stream a planned trajectory to a UR controller through RTDE (ur_rtde), with checks
-    before motion, monitoring and a safe stop; records the actual trajectory."""
-    result = _stream(trajectory, host, mode=mode, speed_scale=speed_scale, dry_run=dry_run)
-    if result.status != "completed" and not dry_run:
+    """Stream a planned trajectory to a UR controller through RTDE (ur_rtde): checks the
+    controller (robot model, period, state) and shows the approach move before asking to
+    start; monitors the motion, stops safely, says where and how to resume; records the
+    actual trajectory (<name>.run-NNN.csv).  Exit 0 completed, 1 refused or stopped, 2 bad
+    input."""
+    import sys
+
+    if not (yes or dry_run or sys.stdin.isatty()):
+        raise _fail("no terminal to confirm the motion on: pass --yes to start without asking")
+    result = _stream(trajectory, host, yes=yes, mode=mode.value, speed_scale=speed_scale,
+                     dry_run=dry_run, start_index=resume or 0)  # fmt: skip
+    if not result.completed or (result.verdict is not None and not result.verdict.ok):
         raise typer.Exit(code=1)
 
 
-def _stream(trajectory: Path, host: str | None, **options):
+def _stream(trajectory: Path, host: str | None, *, yes: bool = False, **options):
+    """Run ``trajectory`` (the CLI's side of :func:`run_trajectory`): checks table,
+    confirmation, progress bar, where it stopped and the resume command."""
+    from rich.text import Text
+
     from .export import ControllerError, Emulator, run_trajectory
+    from .export.run_report import RunProgress, resume_command
     from .io.trajectory import read_trajectory
 
     try:
         traj = read_trajectory(trajectory)
     except ValueError as exc:
         raise _fail(str(exc)) from None
-    options.pop("yes", None)
-    model = traj.meta.robot
+    dry_run = bool(options.get("dry_run"))
+    target = host
+    shown: list[bool] = []
+
+    def show_plan(plan) -> None:
+        shown.append(True)
+        where = plan.host or "no controller"
+        _print_verdict(plan.verdict, f"checks before motion ({trajectory} on {where})")
+        for line in plan.describe():
+            console.print(Text(f"  {line}"), highlight=False)
+
+    def confirm(plan) -> bool:
+        show_plan(plan)
+        if yes:
+            console.print("  --yes: starting without asking", highlight=False)
+            return True
+        return typer.confirm("Start the motion?", default=False)
+
+    bar = RunProgress(traj, console)
     emulator = None
     try:
-        if host is None and not options.get("dry_run"):
-            host = "127.0.0.42"
-            console.print(
-                f"no --host: starting the embedded MuJoCo-backed controller emulator on {host}"
-            )
+        if host is None and not dry_run:
+            target = "127.0.0.42"
+            console.print(f"no --host: starting the embedded MuJoCo-backed controller emulator "
+                          f"on {target}")  # fmt: skip
             from .export.emulator.physics import MujocoBackend
 
-            emulator = Emulator(host, model, q0=traj.q[0], backend=MujocoBackend).start()
-        with console.status("streaming") as status:
-            result = run_trajectory(
-                trajectory,
-                host,
-                model,
-                progress=lambda i, n: status.update(f"streaming: sample {i} of {n}"),
-                **options,
-            )
+            emulator = Emulator(target, traj.meta.robot, q0=traj.q[0], backend=MujocoBackend)
+            emulator.start()
+        try:
+            result = run_trajectory(trajectory, target, traj.meta.robot, progress=bar.update,
+                                    confirm=confirm, **options)  # fmt: skip
+        finally:
+            bar.stop()
     except (ValueError, ControllerError) as exc:
         raise _fail(str(exc)) from None
     finally:
         if emulator is not None:
             emulator.close()
-    console.print(f"  {result.status}: {result.message}", highlight=False)
-    console.print(
-        f"  max deviation actual vs commanded: {result.max_deviation:.3g} rad", highlight=False
-    )
+    if not shown and result.verdict is not None:
+        from .export import RunPlan
+
+        show_plan(RunPlan(result.verdict, result.entry, target, options.get("mode", "servoj"),
+                          traj, options.get("approach_speed", 0.25),
+                          options.get("speed_scale", 1.0)))  # fmt: skip
+    style = "bold green" if result.completed else "bold red"
+    console.print(Text(f"{result.status}: {result.message}", style=style), highlight=False)
+    if result.status == "dry_run":
+        console.print("  dry run: nothing moved", highlight=False)
+    elif result.moved:
+        console.print(f"  max deviation actual vs plan: {result.max_deviation:.3g} rad",
+                      highlight=False)  # fmt: skip
+    if result.stop is not None and result.status != "completed":
+        console.print(Text(f"  stopped at {result.stop.describe()}"), highlight=False)
+        cmd = resume_command(trajectory, host, options.get("mode", "servoj"),
+                             options.get("speed_scale", 1.0), result.resume_index)  # fmt: skip
+        console.print(Text(f"  resume with: {cmd}", style="bold"), highlight=False)
+    if result.client:
+        err.print(Text(f"  ur_rtde client: {result.client}"), highlight=False)
     if result.actual_path is not None:
-        console.print(f"wrote {result.actual_path}  (actual trajectory)")
+        console.print(f"wrote {result.actual_path}  (recording of the actual motion)",
+                      highlight=False, markup=False)  # fmt: skip
     return result
 
 

@@ -15,17 +15,20 @@ from __future__ import annotations
 
 from .emulator import Emulator, serve
 from .limits import check_trajectory
-from .runner import ControllerError, RunResult, actual_path_for, run_trajectory
+from .run_plan import recording_path_for
+from .runner import ControllerError, RunMode, RunPlan, RunResult, run_trajectory
 from .urscript import EXPORT_FORMATS, export_trajectory, urscript_program
 
 __all__ = [
     "EXPORT_FORMATS",
     "ControllerError",
     "Emulator",
+    "RunMode",
+    "RunPlan",
     "RunResult",
-    "actual_path_for",
     "check_trajectory",
     "export_trajectory",
+    "recording_path_for",
     "run_trajectory",
     "serve",
     "urscript_program",

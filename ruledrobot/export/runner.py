@@ -1,40 +1,33 @@
-"""Play a joint trajectory on a UR controller through ur_rtde, with monitoring and safe stops.
+"""Play a joint trajectory on a UR controller through ur_rtde: checks, confirmation,
+monitoring, safe stops, resume, recording.
 
 :func:`run_trajectory` does, in order:
 
-1. **Checks before motion** — the trajectory against the model's joint
-   position, speed and acceleration limits (ValueError naming the sample and
-   joint); the controller reachable, robot mode RUNNING and safety NORMAL
-   (:class:`ControllerError` otherwise).  ``dry_run=True`` stops here (and
-   reports the approach move it would make).
-2. **Approach** — a ``moveJ`` at reduced speed (``approach_speed``) to the
-   first sample, unless the arm is already there.
-3. **Motion** — ``mode="servoj"``: one ``servoJ`` per controller period
-   (``initPeriod``/``waitPeriod``) with ``lookahead``/``gain``;
-   ``mode="path"``: the TCP path decimated to ``path_tolerance`` and sent as
-   one blended ``moveL`` path (async, monitored).
-4. **Monitoring**, every period: protective and emergency stops, the
-   connection, the control script, the age of the controller's data, and the
-   deviation of the actual joints from the plan (distance to the nearest
-   planned sample at or before the commanded one, so the servo lag does not
-   count).  Any of them — or Ctrl-C — ends the motion with a safe stop:
-   ``servoStop``/``stopJ``, then ``stopScript``; the RTDE watchdog set at the
-   start stops the arm by itself if this process goes silent.
-5. **Recording** — the actual joints and TCP at every controller timestamp,
-   written next to the input as ``<name>.actual.csv``.
-
-The result (:class:`RunResult`) tells why it stopped and ``stop_index``: the
-sample the arm reached, from which ``start_index`` resumes the job.
+1. **Checks before motion** (a :class:`~ruledrobot.robot.verdict.Verdict`):
+   the trajectory against the model's joint limits (ValueError naming the
+   sample and joint when it fails: bad input); the controller's robot model and
+   control period against the trajectory's (dashboard, :mod:`.run_checks`);
+   the controller kinematics (information: not read yet); robot mode RUNNING
+   and safety NORMAL; where the run enters the trajectory (:mod:`.run_plan`:
+   continue, replay the kerf, or approach).  A failing check refuses the run
+   (status ``"refused"``); ``dry_run=True`` stops here.
+2. **Confirmation** — ``confirm(plan)`` (a :class:`RunPlan`: the checks and the
+   approach move) must return True; none given means confirmed.
+3. **Motion**, in a child process (:mod:`.run_child`) that alone loads ur_rtde,
+   supervised (:mod:`.run_supervisor`): a hang is killed, a crash survived;
+   the recording streams out in chunks as it is made.
+4. **Result** (:class:`RunResult`): status, where it stopped (sample, time,
+   phase, wire in the stock), the resume sample, the recording
+   ``<stem>.run-NNN.csv`` (never overwritten).
 """
 
 from __future__ import annotations
 
 import math
 import os
-import sys
-import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from enum import Enum
 from pathlib import Path
 from typing import Any
 
@@ -42,35 +35,93 @@ import numpy as np
 
 from ..io.trajectory import read_trajectory, write_trajectory
 from ..robot import RobotModel, load, model_for
-from ..robot.trajectory import Trajectory, TrajectoryMeta
+from ..robot.trajectory import Trajectory
+from ..robot.verdict import Check, Verdict
 from .decimate import decimate_tcp_path
 from .limits import check_trajectory
+from .run_checks import controller_checks, query_dashboard, readiness_check
+from .run_plan import (
+    Entry,
+    StopPlace,
+    path_waypoints,
+    plan_entry,
+    recording_path_for,
+    resample,
+    stop_place,
+)
+from .run_supervisor import Child, ChildGone
 
-__all__ = ["ControllerError", "RunResult", "actual_path_for", "run_trajectory"]
-
-ROBOT_MODE_RUNNING = 7
-SAFETY_MODE_NORMAL = 1
-RUNTIME_PLAYING = 2
+__all__ = ["ControllerError", "RunMode", "RunPlan", "RunResult", "run_trajectory"]
 
 ProgressFn = Callable[[int, int], Any]
 
 
+class RunMode(str, Enum):
+    """How the motion is sent: one servoJ per controller period, or one blended moveL path."""
+
+    servoj = "servoj"
+    path = "path"
+
+
 class ControllerError(RuntimeError):
-    """The controller cannot run the trajectory (unreachable, not running, faulted)."""
+    """The controller cannot be asked (not reachable, no answer): nothing was checked."""
+
+
+@dataclass(frozen=True)
+class RunPlan:
+    """What a run will do, shown before it moves: the checks and the entry move."""
+
+    verdict: Verdict
+    entry: Entry | None
+    host: str | None
+    mode: str
+    trajectory: Trajectory
+    approach_speed: float
+    speed_scale: float
+
+    def describe(self) -> list[str]:
+        """The approach move in words (one line each)."""
+        e = self.entry
+        if e is None:
+            return ["approach move: not known (the controller was not contacted)"]
+        lines = [f"entry: {e.kind} — {e.note}"]
+        if e.distance < 1e-4:
+            lines.append(f"approach move: none (the arm is at sample {e.sample})")
+        else:
+            lines.append(
+                f"approach move: moveJ to sample {e.sample}, leading joint q{e.joint} "
+                f"{e.distance:.4f} rad at {self.approach_speed:g} rad/s, about "
+                f"{e.approach_time:.1f} s"
+            )
+        if e.replay_time > 0:
+            lines.append(
+                f"replay of the kerf: samples {e.sample}..{e.requested} "
+                f"({e.replay_time / self.speed_scale:.1f} s) before the cut goes on"
+            )
+        traj = self.trajectory
+        rest = (traj.t[-1] - traj.t[e.sample]) / self.speed_scale
+        lines.append(f"motion: samples {e.sample}..{traj.n - 1} ({rest:.1f} s, mode {self.mode})")
+        return lines
 
 
 @dataclass
 class RunResult:
     """What :func:`run_trajectory` did.
 
-    ``status``: ``"completed"``, ``"dry_run"``, ``"deviation"``,
-    ``"protective_stop"``, ``"emergency_stop"``, ``"connection_lost"``,
-    ``"controller_slow"``, ``"program_stopped"``, ``"command_failed"`` or
-    ``"interrupted"``.  ``stop_index``: index of the input sample the arm
-    reached when it stopped (pass it as ``start_index`` to resume); the
-    number of samples when completed.  ``max_deviation``: largest joint
-    deviation from the plan seen [rad].  ``actual``: the recorded trajectory
-    (controller timestamps from 0), ``actual_path``: where it was written.
+    ``status``: ``"completed"``, ``"dry_run"``, ``"refused"`` (a check failed;
+    nothing moved), ``"cancelled"`` (not confirmed), or why the motion stopped:
+    ``"deviation"``, ``"protective_stop"``, ``"emergency_stop"``,
+    ``"connection_lost"``, ``"controller_slow"``, ``"program_stopped"``,
+    ``"command_failed"``, ``"interrupted"``, ``"client_died"`` (the ur_rtde
+    process crashed), ``"client_hung"`` (it stopped answering and was killed).
+    ``start_index``: the first sample streamed (the entry), ``requested_index``:
+    the sample asked for; ``stop_index``: the input sample the arm reached
+    (``n_samples`` when completed) — resume with it; ``stop``: where, in words
+    (time, phase, wire in the stock); ``verdict``: the checks before motion;
+    ``entry``: how the run entered; ``actual``/``actual_path``: the recording
+    and its file (``<stem>.run-NNN.csv``); ``client``: how the ur_rtde process
+    ended and the tail of its output, when it did not end normally;
+    ``timeline``: (``time.monotonic()``, event) of the supervised steps.
     """
 
     status: str
@@ -84,377 +135,54 @@ class RunResult:
     approach_distance: float = 0.0
     actual: Trajectory | None = None
     actual_path: Path | None = None
-    checks: list[str] = field(default_factory=list)
+    verdict: Verdict | None = None
+    entry: Entry | None = None
+    requested_index: int = 0
+    stop: StopPlace | None = None
+    client: str = ""
+    timeline: list[tuple[float, str]] = field(default_factory=list)
 
     @property
     def completed(self) -> bool:
         return self.status in ("completed", "dry_run")
 
+    @property
+    def moved(self) -> bool:
+        """Whether motion was started (not a dry run, refusal or cancellation)."""
+        return self.status not in ("dry_run", "refused", "cancelled")
+
+    @property
+    def checks(self) -> tuple[Check, ...]:
+        return () if self.verdict is None else self.verdict.checks
+
+    @property
+    def resume_index(self) -> int | None:
+        """The sample to resume from (``--resume``), None when completed or nothing moved."""
+        return self.stop_index if self.moved and self.status != "completed" else None
+
     def __str__(self) -> str:
-        return (f"{self.status}: {self.message} (samples {self.start_index}..{self.stop_index} of "
-                f"{self.n_samples}, max deviation {self.max_deviation:.4f} rad)")  # fmt: skip
-
-
-def actual_path_for(path: str | os.PathLike[str]) -> Path:
-    """``cut.csv`` -> ``cut.actual.csv`` beside it."""
-    p = Path(path)
-    return p.with_name(f"{p.stem}.actual.csv")
-
-
-class _Recorder:
-    """Collects (controller time, actual q, actual TCP) once per new controller timestamp."""
-
-    def __init__(self) -> None:
-        self.t: list[float] = []
-        self.q: list[list[float]] = []
-        self.tcp: list[list[float]] = []
-        self.last_ts = -math.inf
-        self.ts0: float | None = None
-
-    def add(self, ts: float, q: list[float], tcp: list[float]) -> bool:
-        if ts <= self.last_ts:
-            return False
-        if self.ts0 is None:
-            self.ts0 = ts
-        self.last_ts = ts
-        self.t.append(ts - self.ts0)
-        self.q.append(q)
-        self.tcp.append(tcp)
-        return True
-
-    def trajectory(self, meta: TrajectoryMeta) -> Trajectory | None:
-        if len(self.t) < 2:
-            return None
-        return Trajectory(np.array(self.t), np.array(self.q), np.array(self.tcp), meta)
-
-
-class _Stop(Exception):
-    def __init__(self, status: str, message: str) -> None:
-        super().__init__(message)
-        self.status = status
-        self.message = message
-
-
-def _resample(t: np.ndarray, q: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray]:
-    """Samples at a uniform period ``dt`` from ``t[0]`` (linear interpolation), end included."""
-    T = float(t[-1] - t[0])
-    n = math.floor(T / dt + 1e-9)
-    tg = t[0] + dt * np.arange(n + 1)
-    if tg[-1] < t[-1] - 1e-12:
-        tg = np.append(tg, t[0] + dt * (n + 1))
-    qg = np.empty((tg.size, q.shape[1]))
-    for j in range(q.shape[1]):
-        qg[:, j] = np.interp(tg, t, q[:, j])
-    return tg, qg
-
-
-class _Session:
-    """One run: the two ur_rtde interfaces, the plan, monitoring and recording."""
-
-    def __init__(
-        self,
-        host: str,
-        model: RobotModel,
-        frequency: float,
-        *,
-        deviation_limit: float,
-        max_latency: float,
-        window: int,
-        watchdog: float = 0.0,
-    ) -> None:
-        self.host = host
-        self.watchdog = watchdog
-        self.model = model
-        self.frequency = frequency
-        self.deviation_limit = deviation_limit
-        self.max_latency = max_latency
-        self.window = window
-        self.r: Any = None
-        self.c: Any = None
-        self.rec = _Recorder()
-        self.max_dev = 0.0
-        self.k_match = 0
-        self._lag_min = math.inf
-        self._wall0 = 0.0
-        self._ts0 = 0.0
-
-    # ---------------------------------------------------------------- connection
-
-    def connect_receive(self) -> None:
-        import rtde_receive
-
-        try:
-            self.r = rtde_receive.RTDEReceiveInterface(self.host, self.frequency)
-        except RuntimeError as exc:
-            raise ControllerError(f"controller at {self.host} not reachable: {exc}") from None
-
-    def check_ready(self) -> None:
-        r = self.r
-        mode, safety = r.getRobotMode(), r.getSafetyMode()
-        if mode != ROBOT_MODE_RUNNING:
-            raise ControllerError(
-                f"controller at {self.host}: robot mode {mode}, expected 7 (RUNNING): power on and "
-                "release the brakes first"
+        text = f"{self.status}: {self.message}"
+        if self.moved:
+            text += (
+                f" (samples {self.start_index}..{self.stop_index} of {self.n_samples}, max "
+                f"deviation {self.max_deviation:.4f} rad)"
             )
-        if safety != SAFETY_MODE_NORMAL or r.isProtectiveStopped() or r.isEmergencyStopped():
-            raise ControllerError(
-                f"controller at {self.host}: safety mode {safety}, expected 1 (NORMAL): clear the "
-                "protective or emergency stop first"
-            )
-
-    def connect_control(self) -> None:
-        import rtde_control
-
-        try:
-            self.c = rtde_control.RTDEControlInterface(self.host, self.frequency)
-        except RuntimeError as exc:
-            raise ControllerError(f"controller at {self.host}: control interface: {exc}") from None
-
-    def arm_watchdog(self) -> None:
-        """Have the control script stop the program when this process falls silent."""
-        if self.watchdog > 0:
-            self.c.setWatchdog(float(self.watchdog))
-
-    def kick(self) -> None:
-        if self.watchdog > 0:
-            self.c.kickWatchdog()
-
-    def disconnect(self) -> None:
-        """Close the control interface, then the receive interface.
-
-        ur_rtde's ``disconnect()`` sleeps 0.5 s and its destructor calls it
-        again: an interface nobody else holds is simply destroyed (one
-        disconnect), one still referenced elsewhere is disconnected explicitly.
-        """
-        for name in ("c", "r"):
-            iface = getattr(self, name)
-            setattr(self, name, None)
-            if iface is None:
-                continue
-            if sys.getrefcount(iface) > 2:  # this local and getrefcount's argument
-                try:
-                    iface.disconnect()
-                except Exception:
-                    pass
-            del iface
-
-    # ---------------------------------------------------------------- monitoring
-
-    def start_clock(self) -> None:
-        self._wall0 = time.monotonic()
-        self._ts0 = self.r.getTimestamp()
-        self._lag_min = math.inf
-
-    def poll(self) -> np.ndarray:
-        """Read the state, record it, raise :class:`_Stop` on a fault; returns actual q."""
-        r, c = self.r, self.c
-        if not r.isConnected() or (c is not None and not c.isConnected()):
-            raise _Stop("connection_lost", "the RTDE connection to the controller was lost")
-        if r.isEmergencyStopped():
-            raise _Stop("emergency_stop", "the robot is emergency stopped")
-        if r.isProtectiveStopped():
-            raise _Stop("protective_stop", "the robot is protective stopped")
-        ts = r.getTimestamp()
-        qa = r.getActualQ()
-        self.rec.add(ts, qa, r.getActualTCPPose())
-        lag = (time.monotonic() - self._wall0) - (ts - self._ts0)
-        self._lag_min = min(self._lag_min, lag)
-        if lag - self._lag_min > self.max_latency:
-            raise _Stop(
-                "controller_slow",
-                f"controller data {1e3 * (lag - self._lag_min):.0f} ms late "
-                f"(limit {1e3 * self.max_latency:.0f} ms)",
-            )
-        if r.getRuntimeState() != RUNTIME_PLAYING:
-            raise _Stop("program_stopped", "the control script stopped running on the controller")
-        return np.asarray(qa)
-
-    def track(self, plan: np.ndarray, qa: np.ndarray, upto: int) -> float:
-        """Deviation of ``qa`` from the plan samples [k_match, upto]; advances ``k_match``."""
-        lo = self.k_match
-        hi = min(upto, lo + self.window) + 1
-        d = np.max(np.abs(plan[lo:hi] - qa), axis=1)
-        j = int(np.argmin(d))
-        self.k_match = lo + j
-        dev = float(d[j])
-        self.max_dev = max(self.max_dev, dev)
-        return dev
-
-    def check_deviation(self, plan: np.ndarray, qa: np.ndarray, upto: int) -> None:
-        dev = self.track(plan, qa, upto)
-        if dev > self.deviation_limit:
-            raise _Stop(
-                "deviation",
-                f"joint deviation {dev:.4f} rad from the plan exceeds the limit "
-                f"{self.deviation_limit:.4f} rad",
-            )
-
-    def connection_lost(self, exc: Exception) -> bool:
-        """Is this ur_rtde exception a lost connection? (socket errors, or an interface down)"""
-        text = str(exc).lower()
-        if any(w in text for w in ("end of file", "broken pipe", "connection", "connect",
-                                    "timeout", "timed out", "reset by peer")):  # fmt: skip
-            return True
-        deadline = time.monotonic() + 0.05
-        while time.monotonic() < deadline:
-            try:
-                if not self.r.isConnected() or (self.c is not None and not self.c.isConnected()):
-                    return True
-            except Exception:
-                return True
-            time.sleep(0.005)
-        return False
-
-    def diagnose(self, what: str) -> _Stop:
-        """Why did a command return False?  (The receive stream may be a period behind.)"""
-        deadline = time.monotonic() + 0.1
-        while True:
-            try:
-                self.poll()
-            except _Stop as stop:
-                return _Stop(stop.status, stop.message)
-            except Exception as exc:
-                return _Stop("connection_lost", f"{what}: {exc}")
-            if time.monotonic() > deadline:
-                break
-            time.sleep(0.004)
-        if not self.r.isConnected() or not self.c.isConnected():
-            return _Stop("connection_lost", f"{what}: the connection to the controller was lost")
-        return _Stop("command_failed", f"{what} was refused by the controller")
-
-    # ---------------------------------------------------------------- stopping
-
-    def safe_stop(self, mode: str, deceleration: float) -> None:
-        """servoStop / stopJ, then stopScript; every step best effort."""
-        c = self.c
-        if c is None:
-            return
-        try:
-            if c.isConnected() and c.isProgramRunning():
-                if mode == "servoj":
-                    c.servoStop(deceleration)
-                else:
-                    c.stopJ(deceleration, False)
-        except Exception:
-            pass
-        try:
-            if c.isConnected() and c.isProgramRunning():
-                c.stopScript()
-        except Exception:
-            pass
-
-    def settle(self, timeout: float = 1.5) -> None:
-        """Record until the arm rests (speed < 1e-3 rad/s for 50 ms) or ``timeout``."""
-        r = self.r
-        deadline = time.monotonic() + timeout
-        quiet = 0.0
-        while time.monotonic() < deadline:
-            try:
-                if not r.isConnected():
-                    return
-                self.rec.add(r.getTimestamp(), r.getActualQ(), r.getActualTCPPose())
-                qd = max(abs(x) for x in r.getActualQd())
-            except Exception:
-                return
-            quiet = quiet + 0.002 if qd < 1e-3 else 0.0
-            if quiet >= 0.05:
-                return
-            time.sleep(0.002)
+        return text
 
 
-def _path_waypoints(
-    tcp: np.ndarray,
-    t: np.ndarray,
-    keep: np.ndarray,
-    *,
-    blend: float,
-    acceleration: float,
-) -> list[list[float]]:
-    """moveL path rows ``[x, y, z, rx, ry, rz, v, a, r]`` for the kept samples."""
-    rows = []
-    p = tcp[:, :3]
-    seg_len = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(p, axis=0), axis=1))]
-    lengths = np.diff(seg_len[keep])
-    for n, k in enumerate(keep[1:], start=1):
-        i = keep[n - 1]
-        L = lengths[n - 1]
-        dur = max(t[k] - t[i], 1e-6)
-        v = float(np.clip(L / dur, 1e-4, 3.0))
-        if n < len(keep) - 1:
-            r = min(blend, 0.45 * L, 0.45 * lengths[n])
-        else:
-            r = 0.0
-        rows.append([*map(float, tcp[k]), v, float(acceleration), float(max(r, 0.0))])
-    return rows
-
-
-def run_trajectory(
-    traj: Trajectory | str | os.PathLike[str],
-    host: str = "127.0.0.1",
-    model: RobotModel | str | None = None,
-    *,
-    mode: str = "servoj",
-    lookahead: float = 0.1,
-    gain: float = 300.0,
-    speed_scale: float = 1.0,
-    deviation_limit: float = 0.05,
-    dry_run: bool = False,
-    progress: ProgressFn | None = None,
-    start_index: int = 0,
-    approach_speed: float = 0.25,
-    approach_acceleration: float = 0.5,
-    stop_deceleration: float = 4.0,
-    max_latency: float = 0.1,
-    path_tolerance: float = 0.0005,
-    path_blend: float = 0.002,
-    path_acceleration: float = 1.0,
-    actual_path: str | os.PathLike[str] | None = None,
-    watchdog: float = 2.0,
-) -> RunResult:
-    """Run a joint trajectory on the UR controller at ``host`` (ur_rtde), monitored.
-
-    Parameters
-    ----------
-    traj : the trajectory, or a trajectory CSV path (the recording goes beside it).
-    host : controller address (a robot, URSim, or :class:`~.emulator.Emulator`).
-    model : the robot model (limits, control period) or its name; default, and it
-        must agree with, the trajectory's metadata (:func:`ruledrobot.robot.model_for`).
-    mode : ``"servoj"`` (stream one servoJ per controller period) or ``"path"``
-        (one blended moveL path through the TCP samples decimated to
-        ``path_tolerance`` m, blend radius ``path_blend`` m).
-    lookahead, gain : servoJ parameters (ur_rtde accepts 0.03-0.2 s, 100-2000).
-    speed_scale : play the trajectory this much faster (< 1 slower); the limits
-        are checked at the scaled speed.
-    deviation_limit : largest joint deviation from the plan [rad] before a safe stop.
-    dry_run : check everything (limits, controller state, approach) without motion.
-        With ``host=None`` the controller is not contacted.
-    progress : ``progress(done, total)`` about 10 times per second.
-    start_index : first sample to run (resume after a stop: ``RunResult.stop_index``).
-    approach_speed, approach_acceleration : the moveJ to the first sample
-        [rad/s, rad/s^2] (leading axis).
-    stop_deceleration : joint deceleration of the safe stop [rad/s^2].
-    max_latency : how much later than normal the controller's data may arrive [s].
-    actual_path : where to write the recording (default ``<name>.actual.csv``
-        beside an input file; none for an in-memory trajectory).
-    watchdog : RTDE watchdog frequency [Hz] on the command register (the
-        controller stops the program if this process falls silent for
-        ``1/watchdog`` s); 0 disables it.
-
-    Returns
-    -------
-    :class:`RunResult`.  Raises ValueError (limits, parameters) and
-    :class:`ControllerError` (controller not reachable or not ready) before
-    any motion.
-    """
-    source: Path | None = None
-    if not isinstance(traj, Trajectory):
-        source = Path(traj)
-        traj = read_trajectory(source)
-    planned = model_for(traj.meta)
-    robot = planned if model is None else (load(model) if isinstance(model, str) else model)
+def _validate(
+    traj: Trajectory,
+    robot: RobotModel,
+    planned: RobotModel,
+    mode: str,
+    lookahead: float,
+    gain: float,
+    deviation_limit: float,
+    start_index: int,
+) -> str:
     if robot.name != planned.name:
-        raise ValueError(f"trajectory planned for a {planned.name}, not for the {robot.name} "
-                         "given")  # fmt: skip
+        raise ValueError(f"trajectory planned for a {planned.name}, not for the {robot.name} given")
+    mode = mode.value if isinstance(mode, Enum) else str(mode)
     if mode not in ("servoj", "path"):
         raise ValueError(f"mode: expected 'servoj' or 'path', got {mode!r}")
     if not 0.03 <= lookahead <= 0.2:
@@ -463,272 +191,344 @@ def run_trajectory(
         raise ValueError(f"gain: {gain} outside [100, 2000] (ur_rtde's range)")
     if not deviation_limit > 0:
         raise ValueError(f"deviation_limit: must be positive, got {deviation_limit}")
-    n = int(traj.t.size)
+    n = traj.n
     if not 0 <= start_index < n - 1:
-        raise ValueError(f"start_index: {start_index} outside [0, {n - 2}] for {n} samples")
+        raise ValueError(f"start sample {start_index} outside [0, {n - 2}] for {n} samples")
+    return mode
+
+
+def run_trajectory(
+    traj: Trajectory | str | os.PathLike[str],
+    host: str | None = "127.0.0.1",
+    model: RobotModel | str | None = None,
+    *,
+    mode: str | RunMode = "servoj",
+    lookahead: float = 0.1,
+    gain: float = 300.0,
+    speed_scale: float = 1.0,
+    deviation_limit: float = 0.05,
+    dry_run: bool = False,
+    progress: ProgressFn | None = None,
+    start_index: int = 0,
+    confirm: Callable[[RunPlan], bool] | None = None,
+    approach_speed: float = 0.25,
+    approach_acceleration: float = 0.5,
+    resume_tolerance: float = 0.005,
+    resume_window: float = 1.0,
+    stop_deceleration: float = 4.0,
+    max_latency: float = 0.1,
+    path_tolerance: float = 0.0005,
+    path_blend: float = 0.002,
+    path_acceleration: float = 1.0,
+    actual_path: str | os.PathLike[str] | None = None,
+    watchdog: float = 2.0,
+    heartbeat: float = 1.0,
+    stop_budget: float = 1.0,
+    connect_timeout: float = 15.0,
+) -> RunResult:
+    """Run a joint trajectory on the UR controller at ``host`` (ur_rtde), checked and monitored.
+
+    Parameters
+    ----------
+    traj : the trajectory, or a trajectory CSV path (the recording goes beside it).
+    host : controller address (a robot, URSim, or :class:`~.emulator.Emulator`);
+        None only with ``dry_run`` (the controller is not contacted).
+    model : the robot model or its name; default, and it must agree with, the
+        trajectory's metadata (:func:`ruledrobot.robot.model_for`).
+    mode : ``"servoj"`` (one servoJ per controller period) or ``"path"`` (one blended
+        moveL path through the TCP samples decimated to ``path_tolerance`` m,
+        blend radius ``path_blend`` m); a :class:`RunMode` or its value.
+    lookahead, gain : servoJ parameters (ur_rtde accepts 0.03-0.2 s, 100-2000).
+    speed_scale : play the trajectory this much faster (< 1 slower); the limits
+        are checked at the scaled speed.
+    deviation_limit : largest joint deviation from the plan [rad] before a safe stop.
+    dry_run : check everything (limits, controller, entry) without motion.
+    progress : ``progress(sample, n_samples)`` about 20 times per second, ``sample``
+        the input sample the arm is at; it may raise KeyboardInterrupt (a safe stop).
+    start_index : the sample to start or resume from (``--resume N``); where the
+        run actually enters is decided by :func:`~.run_plan.plan_entry` with
+        ``resume_tolerance`` [rad] and ``resume_window`` [s].
+    confirm : ``confirm(plan) -> bool`` before motion (False: ``"cancelled"``).
+    approach_speed, approach_acceleration : the entry moveJ [rad/s, rad/s^2].
+    stop_deceleration : joint deceleration of the safe stop [rad/s^2].
+    max_latency : how much later than normal the controller's data may arrive [s].
+    actual_path : where to write the recording; default ``<stem>.run-NNN.csv``
+        (the first free number) beside an input file, none for an in-memory one.
+    watchdog : RTDE watchdog frequency [Hz] of the control script: the controller
+        stops the program by itself ``1/watchdog`` s after the last command; 0 off.
+    heartbeat : the longest the ur_rtde process may stay silent while moving [s].
+    stop_budget : the longest the safe stop (servoStop/stopJ, stopScript) may take [s].
+    connect_timeout : the longest a connection step may take [s].
+
+    Returns
+    -------
+    :class:`RunResult`.  Raises ValueError (bad input, limits) and
+    :class:`ControllerError` (the controller cannot be reached) before any motion.
+    """
+    source: Path | None = None
+    if not isinstance(traj, Trajectory):
+        source = Path(traj)
+        traj = read_trajectory(source)
+    planned = model_for(traj.meta)
+    robot = planned if model is None else (load(model) if isinstance(model, str) else model)
+    mode = _validate(traj, robot, planned, mode, lookahead, gain, deviation_limit, start_index)
+    if host is None and not dry_run:
+        raise ValueError("host: a controller address is needed unless dry_run")
     check_trajectory(traj, robot, speed_scale=speed_scale)
-    checks = [f"limits of {robot.name}: positions, speeds, accelerations at speed_scale "
-              f"{speed_scale:g} — ok"]  # fmt: skip
+    n = traj.n
+    checks = [
+        Check(
+            "limits",
+            f"joint limits of the {robot.name} (speed scale {speed_scale:g})",
+            "within",
+            "positions, speeds, accelerations",
+            "",
+            "",
+            True,
+        )
+    ]
+    result = RunResult(
+        "dry_run",
+        "",
+        n,
+        start_index,
+        start_index,
+        float(traj.t[start_index]),
+        requested_index=start_index,
+    )
 
-    t_in = np.asarray(traj.t[start_index:], dtype=float)
-    q_in = np.asarray(traj.q[start_index:], dtype=float)
-    ts_in = (t_in - t_in[0]) / speed_scale
-    dt = float(robot.control_period)
-    frequency = 1.0 / dt
-    t_grid, q_grid = _resample(ts_in, q_in, dt)
-    grid_to_input = np.clip(np.searchsorted(ts_in, t_grid + 1e-9, side="right") - 1, 0, None)
-    window = max(10, math.ceil((3.0 * lookahead + 0.1) / dt))
-    if actual_path is None and source is not None:
-        actual_path = actual_path_for(source)
+    def make_plan(entry: Entry | None) -> RunPlan:
+        return RunPlan(Verdict(tuple(checks)), entry, host, mode, traj, approach_speed, speed_scale)
 
-    result = RunResult("dry_run", "", n, start_index, start_index, float(traj.t[start_index]))
-    result.checks = checks
-
-    if dry_run and host is None:
+    if host is None:
+        checks.append(
+            Check.info(
+                "controller",
+                "controller (model, period, state, entry)",
+                "not contacted (dry run without a host)",
+            )
+        )
+        result.verdict = make_plan(None).verdict
         result.message = "trajectory checked; controller not contacted"
         return result
-
-    sess = _Session(host, robot, frequency, deviation_limit=deviation_limit,
-                    max_latency=max_latency, window=window, watchdog=watchdog)  # fmt: skip
-    sess.connect_receive()
     try:
-        sess.check_ready()
-        qa = np.asarray(sess.r.getActualQ())
-        result.approach_distance = float(np.max(np.abs(qa - q_in[0])))
-        checks.append(f"controller at {host}: robot RUNNING, safety NORMAL — ok")
-        if dry_run:
-            result.message = (
-                f"trajectory and controller checked; approach move of "
-                f"{result.approach_distance:.4f} rad (leading joint) not executed"
-            )
-            return result
-        sess.connect_control()
-        # the controller's TCP and payload are the trajectory's: the recording's TCP
-        # column is then the same frame as the plan's
-        from ..geometry.se3 import ur_vector_from_pose
-
-        sess.c.setTcp([float(x) for x in ur_vector_from_pose(traj.meta.tcp_offset)])
-        sess.c.setPayload(traj.meta.payload.mass, [float(x) for x in traj.meta.payload.cog])
-        sess.arm_watchdog()
-        stop = _execute(
-            sess, mode, q_in, ts_in, t_grid, q_grid, traj, start_index, result,
-            lookahead=lookahead, gain=gain, speed_scale=speed_scale,
-            approach_speed=approach_speed, approach_acceleration=approach_acceleration,
-            path_tolerance=path_tolerance, path_blend=path_blend,
-            path_acceleration=path_acceleration, progress=progress,
-        )  # fmt: skip
-        if stop is None:
-            result.status = "completed"
-            result.message = "trajectory completed"
-            # end of the program: leave the robot idle
-            try:
-                if sess.c.isProgramRunning():
-                    if mode == "servoj":
-                        sess.c.servoStop(stop_deceleration)
-                    sess.c.stopScript()
-            except Exception:
-                pass
-            sess.settle()
-            result.stop_index = n
-            result.stop_time = float(traj.t[-1])
-        else:
-            sess.safe_stop(mode, stop_deceleration)
-            sess.settle()
-            result.status, result.message = stop.status, stop.message
-            # the sample the arm actually reached
-            try:
-                qa = np.asarray(sess.r.getActualQ())
-                lo = max(0, sess.k_match - window)
-                hi = max(lo, min(result.samples_sent, q_grid.shape[0] - 1))
-                d = np.max(np.abs(q_grid[lo : hi + 1] - qa), axis=1)
-                kg = lo + int(np.argmin(d))
-            except Exception:
-                kg = sess.k_match
-            k_in = start_index + int(grid_to_input[min(kg, grid_to_input.size - 1)])
-            result.stop_index = k_in
-            result.stop_time = float(traj.t[k_in])
-        result.max_deviation = sess.max_dev
+        info = query_dashboard(host, timeout=min(connect_timeout, 5.0))
+    except ConnectionError as exc:
+        raise ControllerError(f"controller at {host} not reachable: {exc}") from None
+    checks.extend(controller_checks(traj.meta, info))
+    dt = float(robot.control_period)
+    cfg = {
+        "host": host,
+        "frequency": 1.0 / dt,
+        "watchdog": watchdog,
+        "deviation_limit": deviation_limit,
+        "max_latency": max_latency,
+        "connect_timeout": connect_timeout,
+    }
+    child = Child(cfg)
+    try:
+        return _run(
+            child,
+            traj,
+            source,
+            checks,
+            make_plan,
+            result,
+            mode,
+            host,
+            dt,
+            dict(
+                lookahead=lookahead,
+                gain=gain,
+                speed_scale=speed_scale,
+                dry_run=dry_run,
+                progress=progress,
+                confirm=confirm,
+                approach_speed=approach_speed,
+                approach_acceleration=approach_acceleration,
+                resume_tolerance=resume_tolerance,
+                resume_window=resume_window,
+                stop_deceleration=stop_deceleration,
+                path_tolerance=path_tolerance,
+                path_blend=path_blend,
+                path_acceleration=path_acceleration,
+                actual_path=actual_path,
+                heartbeat=heartbeat,
+                stop_budget=stop_budget,
+                connect_timeout=connect_timeout,
+                watchdog=watchdog,
+            ),
+        )
     finally:
-        sess.disconnect()
-    rec_meta = traj.meta.replace(
-        phases=(), in_stock=(), source=f"recorded by ruledrobot run on {host}: mode {mode}, "
-        f"status {result.status}, input samples {start_index}..{result.stop_index} of {n}",
-    )  # fmt: skip
-    rec = sess.rec.trajectory(rec_meta)
+        child.close()
+
+
+def _run(
+    child: Child,
+    traj: Trajectory,
+    source: Path | None,
+    checks: list[Check],
+    make_plan: Callable[[Entry | None], RunPlan],
+    result: RunResult,
+    mode: str,
+    host: str,
+    dt: float,
+    o: dict,
+) -> RunResult:
+    try:
+        msg = child.wait_for(("state", "error"))
+    except ChildGone as gone:
+        raise ControllerError(
+            f"controller at {host}: the ur_rtde client failed while "
+            f"connecting ({gone}): {child.log_tail(3)}"
+        ) from None
+    if msg[0] == "error":
+        raise ControllerError(msg[1])
+    state = msg[1]
+    checks.append(readiness_check(host, state))
+    entry = plan_entry(
+        traj,
+        np.asarray(state["q"]),
+        result.requested_index,
+        tolerance=o["resume_tolerance"],
+        window=o["resume_window"],
+        approach_speed=o["approach_speed"],
+        approach_acceleration=o["approach_acceleration"],
+    )
+    checks.append(entry.check)
+    plan = make_plan(entry)
+    result.verdict, result.entry = plan.verdict, entry
+    result.approach_distance = entry.distance
+    if not plan.verdict.ok:
+        result.status = "refused"
+        result.message = "; ".join(c.detail or c.label for c in plan.verdict.failed)
+        return result
+    if o["dry_run"]:
+        result.message = (
+            f"trajectory and controller checked; entry: {entry.kind} at sample "
+            f"{entry.sample}, approach of {entry.distance:.4f} rad (leading joint) "
+            "not executed"
+        )
+        return result
+    if o["confirm"] is not None and not o["confirm"](plan):
+        result.status, result.message = "cancelled", "not confirmed: nothing moved"
+        return result
+    return _move(child, traj, source, result, entry, state, mode, host, dt, o)
+
+
+def _move(
+    child: Child,
+    traj: Trajectory,
+    source: Path | None,
+    result: RunResult,
+    entry: Entry,
+    state: dict,
+    mode: str,
+    host: str,
+    dt: float,
+    o: dict,
+) -> RunResult:
+    k0 = entry.sample
+    n = traj.n
+    speed_scale = o["speed_scale"]
+    t_in = np.asarray(traj.t[k0:], dtype=float)
+    ts_in = (t_in - t_in[0]) / speed_scale
+    t_grid, q_grid = resample(ts_in, np.asarray(traj.q[k0:], dtype=float), dt)
+    grid_to_input = np.clip(np.searchsorted(ts_in, t_grid + 1e-9, side="right") - 1, 0, None)
+    window = max(10, math.ceil((3.0 * o["lookahead"] + 0.1) / dt))
+    rows: list[list[float]] = []
+    if mode == "path":
+        tcp = np.asarray(traj.tcp[k0:], dtype=float)
+        keep = decimate_tcp_path(tcp, o["path_tolerance"], 10 * o["path_tolerance"])
+        rows = path_waypoints(
+            tcp, ts_in, keep, blend=o["path_blend"], acceleration=o["path_acceleration"]
+        )
+    from ..geometry.se3 import ur_vector_from_pose
+
+    motion = {
+        "mode": mode,
+        "q_grid": q_grid,
+        "path_rows": rows,
+        "duration": float(ts_in[-1]),
+        "lookahead": o["lookahead"],
+        "gain": o["gain"],
+        "window": window,
+        "approach_speed": o["approach_speed"],
+        "approach_acceleration": o["approach_acceleration"],
+        "stop_deceleration": o["stop_deceleration"],
+        "stop_budget": o["stop_budget"],
+        "heartbeat": o["heartbeat"],
+        "connect_timeout": o["connect_timeout"] + 5.0,
+        "tcp_offset": [float(x) for x in ur_vector_from_pose(traj.meta.tcp_offset)],
+        "mass": traj.meta.payload.mass,
+        "cog": [float(x) for x in traj.meta.payload.cog],
+        "checked_q": state["q"],
+        "moved_tolerance": 1e-3,
+    }
+    result.start_index = k0
+    child.send("go", motion)
+    progress = o["progress"]
+
+    def on_progress(info: dict) -> None:
+        if progress is not None:
+            kg = min(int(info["k_match"]), grid_to_input.size - 1)
+            progress(k0 + int(grid_to_input[kg]), n)
+
+    out = child.supervise(
+        on_progress if progress is not None else None,
+        stop_bound=o["heartbeat"] + o["stop_budget"] + 4.0,
+    )
+    info = out.info
+    result.timeline = out.timeline
+    result.status, result.message = out.status, out.message
+    result.max_deviation = float(info["max_dev"])
+    result.samples_sent = int(info["sent"])
+    if out.status in ("client_died", "client_hung") or out.killed:
+        if o["watchdog"] > 0:
+            result.message += (
+                f"; the controller's RTDE watchdog stops the program "
+                f"{1.0 / o['watchdog']:g} s after the last command it received"
+            )
+        result.client = f"{out.exit}\n{out.log}".strip()
+    rec = _recording(out.chunks, traj, host, mode, result)
+    if result.status == "completed":
+        result.stop_index, result.stop_time = n, float(traj.t[-1])
+        if progress is not None:
+            progress(n, n)
+    else:
+        kg = int(info["k_match"])
+        if rec is not None:
+            lo = max(0, kg - window)
+            hi = max(lo, min(max(int(info["sent"]), kg), q_grid.shape[0] - 1))
+            d = np.max(np.abs(q_grid[lo : hi + 1] - rec.q[-1]), axis=1)
+            kg = lo + int(np.argmin(d))
+        k_in = k0 + int(grid_to_input[min(kg, grid_to_input.size - 1)])
+        result.stop_index, result.stop_time = k_in, float(traj.t[k_in])
+        result.stop = stop_place(traj, k_in)
     result.actual = rec
-    if rec is not None and actual_path is not None:
-        result.actual_path = write_trajectory(actual_path, rec)
+    if rec is not None:
+        if o["actual_path"] is not None:
+            result.actual_path = write_trajectory(o["actual_path"], rec)
+        elif source is not None:
+            result.actual_path = write_trajectory(recording_path_for(source), rec)
     return result
 
 
-def _execute(
-    sess: _Session,
-    mode: str,
-    q_in: np.ndarray,
-    ts_in: np.ndarray,
-    t_grid: np.ndarray,
-    q_grid: np.ndarray,
-    traj: Trajectory,
-    start_index: int,
-    result: RunResult,
-    *,
-    lookahead: float,
-    gain: float,
-    speed_scale: float,
-    approach_speed: float,
-    approach_acceleration: float,
-    path_tolerance: float,
-    path_blend: float,
-    path_acceleration: float,
-    progress: ProgressFn | None,
-) -> _Stop | None:
-    """Approach and motion; returns the reason for stopping, or None when completed."""
-    try:
-        _approach(sess, q_in[0], approach_speed, approach_acceleration)
-        sess.start_clock()
-        if mode == "servoj":
-            _stream(sess, q_grid, lookahead, gain, result, progress)
-        else:
-            _run_path(sess, q_grid, traj, start_index, speed_scale, result, progress,
-                      path_tolerance=path_tolerance, path_blend=path_blend,
-                      path_acceleration=path_acceleration)  # fmt: skip
-    except _Stop as stop:
-        # drop the traceback: its frames hold the ur_rtde interfaces alive
-        return _Stop(stop.status, stop.message)
-    except KeyboardInterrupt:
-        return _Stop("interrupted", "interrupted by the user (Ctrl-C)")
-    except RuntimeError as exc:
-        if sess.connection_lost(exc):
-            return _Stop("connection_lost", f"the connection to the controller was lost: {exc}")
-        return _Stop("command_failed", f"ur_rtde: {exc}")
-    return None
-
-
-def _approach(sess: _Session, q0: np.ndarray, speed: float, acceleration: float) -> None:
-    """moveJ (async, monitored) to the first sample when the arm is not there."""
-    c, r = sess.c, sess.r
-    qa = np.asarray(r.getActualQ())
-    dist = float(np.max(np.abs(qa - q0)))
-    if dist < 1e-4:
-        return
-    if not c.moveJ([float(x) for x in q0], speed, acceleration, True):
-        raise sess.diagnose("approach moveJ")
-    # trapezoid time of the leading axis, plus margin
-    t_move = dist / speed + speed / acceleration
-    deadline = time.monotonic() + 2.0 * t_move + 5.0
-    sess.start_clock()
-    started = time.monotonic()
-    while True:
-        time.sleep(0.005)
-        sess.kick()
-        qa = sess.poll()
-        done = c.getAsyncOperationProgress() < 0
-        if done and float(np.max(np.abs(qa - q0))) < 1e-4:
-            return
-        resting = max(abs(x) for x in r.getActualQd()) < 1e-6
-        if done and resting and time.monotonic() - started > 0.5:
-            raise _Stop(
-                "command_failed",
-                f"approach moveJ ended {np.max(np.abs(qa - q0)):.4f} rad from the start",
-            )
-        if time.monotonic() > deadline:
-            raise _Stop("command_failed", "approach moveJ did not reach the first sample in time")
-
-
-def _stream(
-    sess: _Session,
-    q_grid: np.ndarray,
-    lookahead: float,
-    gain: float,
-    result: RunResult,
-    progress: ProgressFn | None,
-) -> None:
-    """servoJ every controller period, monitored, then hold the last sample until settled."""
-    c = sess.c
-    dt = 1.0 / sess.frequency
-    K = q_grid.shape[0]
-    every = max(1, int(0.1 / dt))
-    sess.rec = _Recorder()  # the recording starts with the trajectory
-    rows = q_grid.tolist()
-    for k in range(K):
-        t0 = c.initPeriod()
-        if not c.servoJ(rows[k], 0.0, 0.0, dt, lookahead, gain):
-            raise sess.diagnose(f"servoJ of sample {k}")
-        result.samples_sent = k
-        qa = sess.poll()
-        sess.check_deviation(q_grid, qa, k)
-        if progress is not None and k % every == 0:
-            progress(k, K)
-        c.waitPeriod(t0)
-    # hold the final target until the filter has converged
-    last = rows[-1]
-    deadline = time.monotonic() + 10.0 * lookahead + 0.5
-    while time.monotonic() < deadline:
-        t0 = c.initPeriod()
-        if not c.servoJ(last, 0.0, 0.0, dt, lookahead, gain):
-            raise sess.diagnose("servoJ (final hold)")
-        qa = sess.poll()
-        sess.check_deviation(q_grid, qa, K - 1)
-        if float(np.max(np.abs(qa - q_grid[-1]))) < 1e-5:
-            break
-        c.waitPeriod(t0)
-    if progress is not None:
-        progress(K, K)
-
-
-def _run_path(
-    sess: _Session,
-    q_grid: np.ndarray,
-    traj: Trajectory,
-    start_index: int,
-    speed_scale: float,
-    result: RunResult,
-    progress: ProgressFn | None,
-    *,
-    path_tolerance: float,
-    path_blend: float,
-    path_acceleration: float,
-) -> None:
-    """One blended moveL path (async), monitored until the arm rests at the end."""
-    c = sess.c
-    tcp = np.asarray(traj.tcp[start_index:], dtype=float)
-    t = (np.asarray(traj.t[start_index:], dtype=float) - traj.t[start_index]) / speed_scale
-    keep = decimate_tcp_path(tcp, path_tolerance, 10 * path_tolerance)
-    rows = _path_waypoints(tcp, t, keep, blend=path_blend, acceleration=path_acceleration)
-    if not rows:
-        return
-    sess.rec = _Recorder()  # the recording starts with the trajectory
-    if not c.moveL(rows, True):
-        raise sess.diagnose("moveL path")
-    sess.arm_watchdog()  # the path upload restarted the control script
-    sess.start_clock()
-    K = q_grid.shape[0]
-    total = len(rows)
-    started = False
-    t_start = time.monotonic()
-    deadline = t_start + 2.0 * float(t[-1]) + 10.0
-    last_report = 0.0
-    while True:
-        t0 = c.initPeriod()
-        sess.kick()
-        qa = sess.poll()
-        sess.check_deviation(q_grid, qa, K - 1)
-        prog = c.getAsyncOperationProgress()
-        if prog >= 0:
-            started = True
-            result.samples_sent = int(keep[min(prog + 1, len(keep) - 1)])
-        now = time.monotonic()
-        if progress is not None and now - last_report > 0.1:
-            last_report = now
-            progress(max(prog, 0), total)
-        if prog < 0 and (started or now - t_start > 0.5):
-            if float(np.max(np.abs(qa - q_grid[-1]))) < 1e-3:
-                break
-            if now - t_start > 1.0 and max(abs(x) for x in sess.r.getActualQd()) < 1e-4:
-                raise _Stop("command_failed", "the moveL path ended away from the last sample")
-        if now > deadline:
-            raise _Stop("command_failed", "the moveL path did not finish in time")
-        c.waitPeriod(t0)
-    result.samples_sent = K - 1
-    if progress is not None:
-        progress(total, total)
+def _recording(
+    chunks: list, traj: Trajectory, host: str, mode: str, result: RunResult
+) -> Trajectory | None:
+    if not chunks:
+        return None
+    t = np.concatenate([c[0] for c in chunks])
+    if t.size < 2:
+        return None
+    q = np.concatenate([c[1] for c in chunks])
+    tcp = np.concatenate([c[2] for c in chunks])
+    meta = traj.meta.replace(
+        phases=(),
+        in_stock=(),
+        source=f"recorded by ruledrobot run on {host}: mode {mode}, "
+        f"status {result.status}, entry {result.entry.kind if result.entry else '-'} at input "
+        f"sample {result.start_index} of {traj.n}",
+    )
+    return Trajectory(t, q, tcp, meta)

@@ -1,4 +1,10 @@
-"""run_trajectory end to end against the emulator: streaming, path mode, checks, faults."""
+"""run_trajectory end to end against the emulator: streaming, path mode, checks, faults.
+
+The ur_rtde session runs in a child process the runner supervises; progress
+reaches the caller in chunks (every 50 ms), so a fault injected from the
+progress callback lands up to a chunk (25 samples at 500 Hz) plus the pipe's
+latency after the sample the callback saw: ``LATE`` bounds that.
+"""
 
 from __future__ import annotations
 
@@ -12,14 +18,16 @@ import pytest
 from ruledrobot.export import ControllerError, RunResult, run_trajectory
 from ruledrobot.export.emulator import DEFAULT_Q, Emulator, KinematicBackend
 from ruledrobot.io.trajectory import read_trajectory, write_trajectory
-from ruledrobot.robot.trajectory import Trajectory
 from ruledrobot.robot import load
+from ruledrobot.robot.trajectory import Trajectory
 
 from .conftest import smooth_trajectory, start_emulator
 
 pytest.importorskip("rtde_control")
 
 MODEL = load("ur5e")
+#: samples the session may be ahead of the progress callback (2 chunks + 20 ms, measured <= 30)
+LATE = 60
 
 
 def _lagged_error(
@@ -50,11 +58,12 @@ def test_servoj_run_follows_the_plan_and_records(emulator: Emulator, tmp_path: P
                          approach_speed=1.0, approach_acceleration=4.0)  # fmt: skip
     assert isinstance(res, RunResult)
     assert res.status == "completed" and res.completed, res
-    assert res.stop_index == traj.t.size
+    assert res.stop_index == traj.t.size and res.stop is None and res.resume_index is None
     assert res.approach_distance == pytest.approx(0.05)  # moveJ to the start first
-    assert calls and calls[-1][0] == calls[-1][1]
+    assert res.entry is not None and res.entry.kind == "approach"
+    assert calls and calls[-1][0] == calls[-1][1] == traj.n
     # the recording: written next to the input, follows the plan with the servo lag
-    assert res.actual_path == tmp_path / "cut.actual.csv"
+    assert res.actual_path == tmp_path / "cut.run-001.csv"
     rec = read_trajectory(res.actual_path)
     assert rec.t.size >= traj.t.size
     err, lag = _lagged_error(traj, rec, max_lag=0.25)
@@ -79,11 +88,16 @@ def test_path_mode_run(emulator: Emulator) -> None:
 def test_dry_run_checks_without_motion(emulator: Emulator) -> None:
     traj = smooth_trajectory(q0=np.array(DEFAULT_Q) + 0.1)
     res = run_trajectory(traj, emulator.host, MODEL, dry_run=True)
-    assert res.status == "dry_run" and res.completed
+    assert res.status == "dry_run" and res.completed and not res.moved
     assert res.approach_distance == pytest.approx(0.1)
-    assert len(res.checks) == 2
-    offline = run_trajectory(traj, None, MODEL, dry_run=True)  # type: ignore[arg-type]
-    assert offline.status == "dry_run" and len(offline.checks) == 1
+    names = [c.name for c in res.checks]
+    assert names == ["limits", "robot_model", "control_period", "kinematics",
+                     "controller_ready", "entry"]  # fmt: skip
+    assert res.verdict is not None and res.verdict.ok
+    offline = run_trajectory(traj, None, MODEL, dry_run=True)
+    assert offline.status == "dry_run" and [c.name for c in offline.checks] == ["limits",
+                                                                               "controller"]
+    assert not offline.checks[1].gating  # information: the controller was not contacted
     np.testing.assert_allclose(emulator.actual_q, DEFAULT_Q, atol=0)
     assert emulator.stats()["programs_received"] == 0  # no control script was uploaded
 
@@ -107,8 +121,11 @@ def test_limit_violations_are_refused_before_motion(emulator: Emulator) -> None:
 
 def test_controller_not_ready_is_refused(emulator: Emulator) -> None:
     emulator.protective_stop("before the run")
-    with pytest.raises(ControllerError, match="safety mode 3"):
-        run_trajectory(smooth_trajectory(), emulator.host, MODEL)
+    res = run_trajectory(smooth_trajectory(), emulator.host, MODEL)
+    assert res.status == "refused" and not res.moved, res
+    assert res.verdict is not None and [c.name for c in res.verdict.failed] == ["controller_ready"]
+    assert "safety mode 3" in res.message
+    assert emulator.stats()["programs_received"] == 0
     with pytest.raises(ControllerError, match="not reachable"):
         run_trajectory(smooth_trajectory(), "127.254.254.254", MODEL)  # nothing listens there
 
@@ -129,12 +146,15 @@ def _run_with_fault(emu: Emulator, inject, **kw) -> tuple[RunResult, Trajectory,
 
 
 def _check_safe_stop(res: RunResult, traj: Trajectory, fired: int, emu: Emulator,
-                     tol: float = 0.01, late: int = 1) -> None:  # fmt: skip
-    assert not res.completed
+                     tol: float = 0.01, late: int = LATE) -> None:  # fmt: skip
+    assert not res.completed and res.moved
     # the reported sample: reached before the fault (about one servo lag behind), or
     # ``late`` samples after it when the fault is only seen later
     assert 0 < res.stop_index <= fired + late
     assert res.stop_time == pytest.approx(traj.t[res.stop_index])
+    assert res.resume_index == res.stop_index
+    assert res.stop is not None and res.stop.sample == res.stop_index
+    assert res.stop.phase == "move" and not res.stop.in_stock  # the synthetic trajectory
     q_stop = emu.actual_q
     assert _at_rest(emu)  # no further motion
     assert np.max(np.abs(q_stop - traj.q[res.stop_index])) < tol
@@ -146,11 +166,13 @@ def test_protective_stop_during_run_then_resume(emulator: Emulator) -> None:
     assert res.status == "protective_stop", res
     _check_safe_stop(res, traj, fired, emulator)
     # the job resumes from the reported sample once the stop is cleared
-    with pytest.raises(ControllerError, match="safety mode 3"):
-        run_trajectory(traj, emulator.host, MODEL, start_index=res.stop_index)
+    refused = run_trajectory(traj, emulator.host, MODEL, start_index=res.stop_index)
+    assert refused.status == "refused" and "safety mode 3" in refused.message
     emulator.clear_faults()
     res2 = run_trajectory(traj, emulator.host, MODEL, start_index=res.stop_index, lookahead=0.05)
-    assert res2.status == "completed" and res2.start_index == res.stop_index, res2
+    assert res2.status == "completed", res2
+    assert res2.entry is not None and res2.entry.kind == "continue"
+    assert abs(res2.start_index - res.stop_index) <= 5  # the sample the arm rests at
     assert res2.approach_distance < 1e-3
     np.testing.assert_allclose(emulator.actual_q, traj.q[-1], atol=1e-4)
 
@@ -162,47 +184,26 @@ def test_emergency_stop_during_run(emulator: Emulator) -> None:
     assert emulator.robot_mode == 3  # power off after the e-stop
 
 
-def _dropped_connection_scenario(nodeid: str) -> None:
-    """The whole dropped-connection scenario; runs in a child process (see below)."""
-    from .conftest import start_emulator
+def test_dropped_connection_during_run(emulator: Emulator) -> None:
+    """The emulator closes every connection mid-run (and refuses new ones for 1 s).  ur_rtde
+    1.6.5 sometimes crashes (SIGSEGV/SIGABRT) on this: the runner survives it, because the
+    session runs in a child process (status ``client_died`` then), and reports either way."""
+    t_fault: list[float] = []
 
-    emu = start_emulator(nodeid, model="ur5e", unlock_delay=0.0)
-    try:
-        res, traj, fired = _run_with_fault(emu, lambda e: e.drop_connections(refuse_for=1.0))
-        assert res.status == "connection_lost", res
-        # the client cannot stop the arm: the RTDE watchdog (2 Hz) stops the program,
-        # after the servo target of the last sample sent: the stop sample is the last
-        # confirmed one, the arm rests a little further along the plan
-        _check_safe_stop(res, traj, fired, emu, tol=0.06)
-        assert any("RTDE watchdog" in e[2] for e in emu.events)
-    finally:
-        emu.close()
+    def inject(e: Emulator) -> None:
+        t_fault.append(time.monotonic())
+        e.drop_connections(refuse_for=1.0)
 
-
-def test_dropped_connection_during_run(request: pytest.FixtureRequest) -> None:
-    """ur_rtde 1.6.5 can crash the whole process (SIGSEGV/SIGABRT in its native
-    reconnect/disconnect) when the controller drops the connection mid-run — a race in
-    the client, not in the runner (docs/rtde.md).  The scenario therefore runs in a child
-    process: an assertion failure there fails this test at once; a death by signal is
-    retried (at most 3 attempts)."""
-    import multiprocessing as mp
-
-    ctx = mp.get_context("spawn")
-    codes = []
-    for attempt in range(3):
-        p = ctx.Process(target=_dropped_connection_scenario,
-                        args=(f"{request.node.nodeid}[{attempt}]",))  # fmt: skip
-        p.start()
-        p.join(60)
-        if p.is_alive():
-            p.kill()
-            pytest.fail("the dropped-connection scenario did not finish within 60 s")
-        codes.append(p.exitcode)
-        if p.exitcode == 0:
-            return
-        if p.exitcode > 0:
-            pytest.fail(f"the dropped-connection scenario failed (exit code {p.exitcode})")
-    pytest.fail(f"the ur_rtde client crashed in every attempt (exit codes {codes})")
+    res, traj, fired = _run_with_fault(emulator, inject)
+    elapsed = time.monotonic() - t_fault[0]
+    assert res.status in ("connection_lost", "client_died"), res
+    assert elapsed < 4.5  # the runner's bound for any stop (docs/rtde.md)
+    # the client cannot stop the arm: the RTDE watchdog (2 Hz) stops the program,
+    # after the servo target of the last sample sent: the stop sample is the last
+    # confirmed one, the arm rests a little further along the plan
+    assert emulator.wait_for(lambda: emulator.runtime_state != 2, timeout=2.0)
+    _check_safe_stop(res, traj, fired, emulator, tol=0.06)
+    assert any("RTDE watchdog" in e[2] for e in emulator.events)
 
 
 def test_slow_controller_during_run(emulator: Emulator) -> None:
@@ -210,7 +211,7 @@ def test_slow_controller_during_run(emulator: Emulator) -> None:
     assert res.status == "controller_slow", res
     emulator.set_slow(0.0)
     # the stream stalls: the runner notices after max_latency, streaming on until then
-    _check_safe_stop(res, traj, fired, emulator, tol=0.06, late=100)
+    _check_safe_stop(res, traj, fired, emulator, tol=0.06, late=100 + LATE)
 
 
 def test_deviation_stop(request: pytest.FixtureRequest) -> None:

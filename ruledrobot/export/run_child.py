@@ -1,0 +1,122 @@
+"""The child process of a run: the only process that loads ur_rtde.
+
+Started by :mod:`.run_supervisor` as ``python -c "...; main(fd)"`` with one end
+of a socket pair.  Protocol (pickled tuples, see :mod:`.run_session`):
+
+1. receives the session config (dict); connects the receive interface; sends
+   ``("state", {...})`` (modes, actual joints) or ``("error", message)``;
+2. waits for ``("go", motion)`` or ``("cancel",)``;
+3. on go: control interface, TCP, payload, watchdog, approach, motion,
+   streaming the recording; on any stop the safe stop; then
+   ``("done", {...})``;
+4. on ``("exit",)`` (or the pipe closing) leaves with ``os._exit`` — the
+   interfaces are not disconnected one by one (ur_rtde's ``disconnect``
+   sleeps 0.5 s each and races with its reconnect thread; the kernel closes
+   the sockets).
+
+The child ignores SIGINT and runs in its own session (the terminal's Ctrl-C
+goes to the supervisor, which asks for a safe stop), and is killed when the
+supervisor dies (``PR_SET_PDEATHSIG``; the controller's watchdog then stops
+the program).
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import sys
+from multiprocessing.connection import Connection
+
+import numpy as np
+
+from .run_motion import approach, run_path, stream
+from .run_session import Link, Session, SessionError, Stop
+
+__all__ = ["main"]
+
+
+def _die_with_parent() -> None:
+    if not sys.platform.startswith("linux"):
+        return
+    try:
+        import ctypes
+
+        libc = ctypes.CDLL(None, use_errno=True)
+        libc.prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG
+        if os.getppid() == 1:  # the parent died before prctl
+            os._exit(3)
+    except Exception:
+        pass
+
+
+def _motion(s: Session, m: dict) -> None:
+    s.link.stage("connecting control", m["connect_timeout"])
+    s.connect_control()
+    s.link.stage("setup", 5.0)
+    s.c.setTcp([float(x) for x in m["tcp_offset"]])
+    s.c.setPayload(float(m["mass"]), [float(x) for x in m["cog"]])
+    s.arm_watchdog()
+    qa = np.asarray(s.r.getActualQ())
+    moved = float(np.max(np.abs(qa - np.asarray(m["checked_q"]))))
+    if moved > m["moved_tolerance"]:
+        raise Stop("command_failed", f"the arm moved {moved:.4f} rad since the checks: run again")
+    q_grid = np.asarray(m["q_grid"])
+    approach(s, q_grid[0], m["approach_speed"], m["approach_acceleration"], m["heartbeat"])
+    if m["mode"] == "servoj":
+        stream(s, q_grid, m["lookahead"], m["gain"], m["heartbeat"])
+    else:
+        run_path(s, q_grid, m["path_rows"], m["duration"], m["heartbeat"])
+
+
+def _run(s: Session, m: dict) -> None:
+    link = s.link
+    s.window = int(m["window"])
+    stop: Stop | None = None
+    try:
+        _motion(s, m)
+    except Stop as st:
+        stop = Stop(st.status, st.message)  # without the traceback (it holds the interfaces)
+    except SessionError as exc:
+        stop = Stop("command_failed", str(exc))
+    except RuntimeError as exc:
+        stop = s.classify("ur_rtde", exc)
+    if stop is None:
+        s.safe_stop(m["mode"], m["stop_deceleration"], m["stop_budget"])  # end of program
+    else:
+        link.send("stopping", stop.status, stop.message)
+        s.safe_stop(m["mode"], m["stop_deceleration"], m["stop_budget"])
+    s.settle()
+    done = {
+        "status": "completed" if stop is None else stop.status,
+        "message": "trajectory completed" if stop is None else stop.message,
+        **s.info(),
+    }
+    link.send("done", done)
+
+
+def main(fd: int) -> None:  # pragma: no cover - runs in the child
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    _die_with_parent()
+    conn = Connection(fd)
+    try:
+        cfg = conn.recv()
+        link = Link(conn)
+        s = Session(link, cfg)
+        link.stage("connecting", cfg["connect_timeout"])
+        try:
+            s.connect_receive()
+            state = s.state()
+        except (SessionError, RuntimeError) as exc:
+            link.send("error", str(exc))
+            return
+        link.send("state", state)
+        msg = conn.recv()
+        if msg[0] == "go":
+            _run(s, msg[1])
+            conn.recv()  # ("exit",)
+    except (EOFError, OSError):
+        pass
+    finally:
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(0)

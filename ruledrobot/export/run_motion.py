@@ -1,0 +1,122 @@
+"""The motions of a run, in the child process: approach moveJ, servoJ stream, moveL path.
+
+Each is monitored every controller period (:meth:`Session.poll`, the deviation,
+a stop request from the supervisor) and raises :class:`~.run_session.Stop` to
+end the motion; the caller then stops the arm safely.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from .run_session import Session, Stop
+
+__all__ = ["approach", "run_path", "stream"]
+
+
+def approach(
+    s: Session, q0: np.ndarray, speed: float, acceleration: float, heartbeat: float
+) -> None:
+    """moveJ (async, monitored) to ``q0`` unless the arm is there already."""
+    c, r = s.c, s.r
+    qa = np.asarray(r.getActualQ())
+    dist = float(np.max(np.abs(qa - q0)))
+    if dist < 1e-4:
+        return
+    s.link.stage("approach", heartbeat + 2.0)
+    if not c.moveJ([float(x) for x in q0], speed, acceleration, True):
+        raise s.classify("approach moveJ")
+    s.link.stage("approach", heartbeat)
+    t_move = dist / speed + speed / acceleration
+    deadline = time.monotonic() + 2.0 * t_move + 5.0
+    s.start_clock()
+    started = time.monotonic()
+    while True:
+        time.sleep(0.005)
+        s.kick()
+        qa = s.poll()
+        s.service()
+        done = c.getAsyncOperationProgress() < 0
+        if done and float(np.max(np.abs(qa - q0))) < 1e-4:
+            return
+        resting = max(abs(x) for x in r.getActualQd()) < 1e-6
+        if done and resting and time.monotonic() - started > 0.5:
+            raise Stop(
+                "command_failed",
+                f"approach moveJ ended {np.max(np.abs(qa - q0)):.4f} rad from the start",
+            )
+        if time.monotonic() > deadline:
+            raise Stop("command_failed", "approach moveJ did not reach the first sample in time")
+
+
+def stream(s: Session, q_grid: np.ndarray, lookahead: float, gain: float, heartbeat: float) -> None:
+    """servoJ every controller period, monitored, then hold the last sample until settled."""
+    c = s.c
+    dt = 1.0 / s.frequency
+    K = q_grid.shape[0]
+    rows = q_grid.tolist()
+    s.link.stage("streaming", heartbeat)
+    s.start_recording()
+    s.start_clock()
+    for k in range(K):
+        t0 = c.initPeriod()
+        if not c.servoJ(rows[k], 0.0, 0.0, dt, lookahead, gain):
+            raise s.classify(f"servoJ of grid sample {k}")
+        s.sent = k
+        qa = s.poll()
+        s.check_deviation(q_grid, qa, k)
+        s.service()
+        c.waitPeriod(t0)
+    # hold the final target until the filter has converged
+    last = rows[-1]
+    deadline = time.monotonic() + 10.0 * lookahead + 0.5
+    while time.monotonic() < deadline:
+        t0 = c.initPeriod()
+        if not c.servoJ(last, 0.0, 0.0, dt, lookahead, gain):
+            raise s.classify("servoJ (final hold)")
+        qa = s.poll()
+        s.check_deviation(q_grid, qa, K - 1)
+        s.service()
+        if float(np.max(np.abs(qa - q_grid[-1]))) < 1e-5:
+            break
+        c.waitPeriod(t0)
+
+
+def run_path(
+    s: Session, q_grid: np.ndarray, rows: list[list[float]], duration: float, heartbeat: float
+) -> None:
+    """One blended moveL path (async), monitored until the arm rests at the end."""
+    c = s.c
+    if not rows:
+        return
+    s.start_recording()
+    s.link.stage("path upload", 15.0)  # moveL(path) re-uploads the control script
+    if not c.moveL(rows, True):
+        raise s.classify("moveL path")
+    s.arm_watchdog()  # the upload restarted the control script
+    s.link.stage("path", heartbeat)
+    s.start_clock()
+    K = q_grid.shape[0]
+    s.sent = K - 1
+    started = False
+    t_start = time.monotonic()
+    deadline = t_start + 2.0 * duration + 10.0
+    while True:
+        t0 = c.initPeriod()
+        s.kick()
+        qa = s.poll()
+        s.check_deviation(q_grid, qa, K - 1)
+        s.service()
+        prog = c.getAsyncOperationProgress()
+        started = started or prog >= 0
+        now = time.monotonic()
+        if prog < 0 and (started or now - t_start > 0.5):
+            if float(np.max(np.abs(qa - q_grid[-1]))) < 1e-3:
+                break
+            if now - t_start > 1.0 and max(abs(x) for x in s.r.getActualQd()) < 1e-4:
+                raise Stop("command_failed", "the moveL path ended away from the last sample")
+        if now > deadline:
+            raise Stop("command_failed", "the moveL path did not finish in time")
+        c.waitPeriod(t0)

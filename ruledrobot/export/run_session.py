@@ -1,0 +1,311 @@
+"""The ur_rtde side of a run, in the child process: interfaces, monitoring, recording,
+safe stop.
+
+Everything here runs in the process :mod:`.run_child` starts; ur_rtde may hang
+(its ``servoStop`` has no timeout) or crash (SIGSEGV in its native reconnect)
+there without taking the runner with it.  The session talks to the supervisor
+through a :class:`Link`:
+
+* ``("stage", name, timeout)`` before every step: the supervisor kills the
+  child when no message follows within ``timeout`` seconds;
+* ``("rec", t, q, tcp, info)`` every ``CHUNK`` seconds while recording: the
+  recording so far (controller time, actual joints, actual TCP), plus the
+  progress (``info``: matched grid sample, samples sent, largest deviation);
+  it doubles as the heartbeat; ``("beat", info)`` when not recording;
+* ``("stopping", status, message)`` when the session stops on a fault.
+
+The supervisor may send ``("stop", status, message)`` (Ctrl-C) at any time;
+:meth:`Link.check` raises it as :class:`Stop` in the next period.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from typing import Any
+
+import numpy as np
+
+__all__ = ["CHUNK", "Link", "Session", "SessionError", "Stop"]
+
+#: seconds between recording chunks / heartbeats
+CHUNK = 0.05
+RUNTIME_PLAYING = 2
+
+
+class Stop(Exception):
+    """End the motion: ``status`` and ``message`` go into the run's result."""
+
+    def __init__(self, status: str, message: str) -> None:
+        super().__init__(message)
+        self.status = status
+        self.message = message
+
+
+class SessionError(RuntimeError):
+    """The controller cannot be used (not reachable, control interface refused)."""
+
+
+class Link:
+    """The child's end of the pipe to the supervisor."""
+
+    def __init__(self, conn: Any) -> None:
+        self.conn = conn
+        self.stop: Stop | None = None
+
+    def send(self, *msg: Any) -> None:
+        try:
+            self.conn.send(msg)
+        except (OSError, EOFError):
+            self.stop = self.stop or Stop("supervisor_lost", "the runner's supervisor went away")
+
+    def stage(self, name: str, timeout: float) -> None:
+        self.send("stage", name, float(timeout))
+
+    def check(self) -> None:
+        """Raise :class:`Stop` when the supervisor asked to stop (or went away)."""
+        if self.stop is None:
+            try:
+                while self.conn.poll(0):
+                    msg = self.conn.recv()
+                    if msg and msg[0] == "stop":
+                        self.stop = Stop(str(msg[1]), str(msg[2]))
+                    elif msg and msg[0] == "exit":
+                        self.stop = Stop("supervisor_lost", "the runner ended the session")
+            except (OSError, EOFError):
+                self.stop = Stop("supervisor_lost", "the runner's supervisor went away")
+        if self.stop is not None:
+            raise Stop(self.stop.status, self.stop.message)
+
+
+class Session:
+    """The two ur_rtde interfaces of one run, its monitoring and its recording."""
+
+    def __init__(self, link: Link, cfg: dict) -> None:
+        self.link = link
+        self.host: str = cfg["host"]
+        self.frequency = float(cfg["frequency"])
+        self.watchdog = float(cfg["watchdog"])
+        self.deviation_limit = float(cfg["deviation_limit"])
+        self.max_latency = float(cfg["max_latency"])
+        self.r: Any = None
+        self.c: Any = None
+        self.max_dev = 0.0
+        self.k_match = 0
+        self.sent = 0
+        self.window = 10
+        self.recording = False
+        self._buf: list[tuple[float, list[float], list[float]]] = []
+        self._last_ts = -math.inf
+        self._ts0: float | None = None
+        self._last_flush = 0.0
+        self._lag_min = math.inf
+        self._wall0 = 0.0
+        self._clock_ts0 = 0.0
+
+    # ------------------------------------------------------------ connection
+
+    def connect_receive(self) -> None:
+        import rtde_receive
+
+        try:
+            self.r = rtde_receive.RTDEReceiveInterface(self.host, self.frequency)
+        except RuntimeError as exc:
+            raise SessionError(f"controller at {self.host} not reachable: {exc}") from None
+
+    def state(self) -> dict:
+        r = self.r
+        return {
+            "robot_mode": int(r.getRobotMode()),
+            "safety_mode": int(r.getSafetyMode()),
+            "protective": bool(r.isProtectiveStopped()),
+            "emergency": bool(r.isEmergencyStopped()),
+            "runtime_state": int(r.getRuntimeState()),
+            "q": [float(x) for x in r.getActualQ()],
+        }
+
+    def connect_control(self) -> None:
+        import rtde_control
+
+        try:
+            self.c = rtde_control.RTDEControlInterface(self.host, self.frequency)
+        except RuntimeError as exc:
+            raise SessionError(f"controller at {self.host}: control interface: {exc}") from None
+
+    def arm_watchdog(self) -> None:
+        """The control script stops the program when no command arrives for 1/watchdog s."""
+        if self.watchdog > 0:
+            self.c.setWatchdog(self.watchdog)
+
+    def kick(self) -> None:
+        if self.watchdog > 0:
+            self.c.kickWatchdog()
+
+    # ------------------------------------------------------------ recording
+
+    def start_recording(self) -> None:
+        self.recording = True
+        self._ts0 = None
+        self._last_ts = -math.inf
+
+    def record(self, ts: float, q: list[float], tcp: list[float]) -> None:
+        if self.recording and ts > self._last_ts:
+            if self._ts0 is None:
+                self._ts0 = ts
+            self._last_ts = ts
+            self._buf.append((ts - self._ts0, q, tcp))
+
+    def snapshot(self) -> tuple[float, list[float], list[float]]:
+        """(controller time, actual q, actual TCP) of one data package: ur_rtde's getters
+        each read the newest package, so a package arriving between them would mix two;
+        the timestamp read again tells."""
+        r = self.r
+        for _ in range(4):
+            ts = r.getTimestamp()
+            q, tcp = r.getActualQ(), r.getActualTCPPose()
+            if r.getTimestamp() == ts:
+                break
+        return ts, q, tcp
+
+    def info(self) -> dict:
+        return {"k_match": self.k_match, "sent": self.sent, "max_dev": self.max_dev}
+
+    def flush(self, force: bool = False) -> None:
+        """Send the recording so far (and the progress) at most every CHUNK seconds."""
+        now = time.monotonic()
+        if not force and now - self._last_flush < CHUNK:
+            return
+        self._last_flush = now
+        if self._buf:
+            t = np.array([b[0] for b in self._buf])
+            q = np.array([b[1] for b in self._buf])
+            tcp = np.array([b[2] for b in self._buf])
+            self._buf = []
+            self.link.send("rec", t, q, tcp, self.info())
+        else:
+            self.link.send("beat", self.info())
+
+    def service(self) -> None:
+        """Once per period: send what is due, obey a stop request."""
+        self.flush()
+        self.link.check()
+
+    # ------------------------------------------------------------ monitoring
+
+    def start_clock(self) -> None:
+        self._wall0 = time.monotonic()
+        self._clock_ts0 = self.r.getTimestamp()
+        self._lag_min = math.inf
+
+    def connected(self) -> bool:
+        try:
+            return bool(self.r.isConnected() and (self.c is None or self.c.isConnected()))
+        except Exception:
+            return False
+
+    def poll(self) -> np.ndarray:
+        """Read the state, record it, raise :class:`Stop` on a fault; returns actual q."""
+        r = self.r
+        if not self.connected():
+            raise Stop("connection_lost", "the RTDE connection to the controller was lost")
+        if r.isEmergencyStopped():
+            raise Stop("emergency_stop", "the robot is emergency stopped")
+        if r.isProtectiveStopped():
+            raise Stop("protective_stop", "the robot is protective stopped")
+        ts, qa, tcp = self.snapshot()
+        self.record(ts, qa, tcp)
+        lag = (time.monotonic() - self._wall0) - (ts - self._clock_ts0)
+        self._lag_min = min(self._lag_min, lag)
+        if lag - self._lag_min > self.max_latency:
+            raise Stop(
+                "controller_slow",
+                f"controller data {1e3 * (lag - self._lag_min):.0f} ms late (limit "
+                f"{1e3 * self.max_latency:.0f} ms): the controller stopped answering "
+                "in time",
+            )
+        if r.getRuntimeState() != RUNTIME_PLAYING:
+            raise Stop("program_stopped", "the control script stopped running on the controller")
+        return np.asarray(qa)
+
+    def check_deviation(self, plan: np.ndarray, qa: np.ndarray, upto: int) -> None:
+        """Deviation of ``qa`` from the plan samples [k_match, upto]; advances ``k_match``."""
+        lo = self.k_match
+        hi = min(upto, lo + self.window) + 1
+        d = np.max(np.abs(plan[lo:hi] - qa), axis=1)
+        j = int(np.argmin(d))
+        self.k_match = lo + j
+        dev = float(d[j])
+        self.max_dev = max(self.max_dev, dev)
+        if dev > self.deviation_limit:
+            raise Stop(
+                "deviation",
+                f"joint deviation {dev:.4f} rad from the plan exceeds the "
+                f"limit {self.deviation_limit:.4f} rad",
+            )
+
+    def classify(self, what: str, exc: Exception | None = None) -> Stop:
+        """Why did a command fail or return False?  (The stream may be a period behind.)"""
+        deadline = time.monotonic() + 0.1
+        while time.monotonic() < deadline:
+            try:
+                self.poll()
+            except Stop as stop:
+                return Stop(stop.status, f"{what}: {stop.message}")
+            except Exception as e:
+                return Stop("connection_lost", f"{what}: {e}")
+            time.sleep(0.004)
+        if not self.connected():
+            return Stop("connection_lost", f"{what}: the connection to the controller was lost")
+        if exc is not None:
+            return Stop("command_failed", f"{what}: ur_rtde: {exc}")
+        return Stop("command_failed", f"{what} was refused by the controller")
+
+    # ------------------------------------------------------------ stopping
+
+    def safe_stop(self, mode: str, deceleration: float, budget: float) -> None:
+        """servoStop / stopJ, then stopScript; each best effort, the whole within
+        ``budget`` seconds (else the supervisor kills this process)."""
+        self.link.stage("stopping", budget)
+        c = self.c
+        if c is None:
+            return
+        try:
+            if c.isConnected() and c.isProgramRunning():
+                if mode == "servoj":
+                    c.servoStop(deceleration)
+                else:
+                    c.stopJ(deceleration, False)
+        except Exception:
+            pass
+        try:
+            if c.isConnected() and c.isProgramRunning():
+                c.stopScript()
+        except Exception:
+            pass
+
+    def settle(self, timeout: float = 1.5) -> None:
+        """Record until the arm rests (speed < 1e-3 rad/s for 50 ms) or ``timeout``."""
+        self.link.stage("settling", timeout + 1.0)
+        r = self.r
+        deadline = time.monotonic() + timeout
+        quiet = 0.0
+        while time.monotonic() < deadline:
+            try:
+                if not r.isConnected():
+                    break
+                self.record(*self.snapshot())
+                qd = max(abs(x) for x in r.getActualQd())
+            except Exception:
+                break
+            self.flush()
+            quiet = quiet + 0.002 if qd < 1e-3 else 0.0
+            if quiet >= 0.05:
+                break
+            time.sleep(0.002)
+        self.flush(force=True)
+
+    def disconnect(self) -> None:
+        """Destroy the interfaces (control first).  ur_rtde's ``disconnect()`` sleeps
+        0.5 s and its destructor calls it again: dropping the last reference is one."""
+        self.c = None
+        self.r = None
