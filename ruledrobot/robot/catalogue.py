@@ -36,9 +36,15 @@ Sources (collected in the project's research notes, ``mujoco.md`` section 1):
 
 from __future__ import annotations
 
+import os
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from .model import DEFAULT_ACCELERATION, RobotModel
+
+if TYPE_CHECKING:
+    from .calibration import Calibration
 
 _DEG = np.pi / 180.0
 # Elbow (joint 3) position limit [rad] of every catalogue model: the arm
@@ -127,12 +133,16 @@ _LIMITS: dict[str, tuple[tuple[float, ...], tuple[float, ...], bool, float, floa
 MODEL_NAMES: tuple[str, ...] = tuple(_DH)
 
 
-def load(name: str) -> RobotModel:
+def load(name: str, calibration: Calibration | str | os.PathLike | None = None) -> RobotModel:
     """The catalogue model ``name`` (case-insensitive): one of :data:`MODEL_NAMES`.
 
     ``ur3, ur5, ur10`` (CB3, 125 Hz) and ``ur3e, ur5e, ur10e, ur16e, ur20,
     ur30`` (e-Series, 500 Hz).  No base and no tool are set; use
     :meth:`RobotModel.with_base` / :meth:`RobotModel.with_tool`.
+
+    ``calibration``: the robot's factory calibration (a
+    :class:`~ruledrobot.robot.Calibration` or the path of a calibration file), see
+    :meth:`RobotModel.with_calibration`; None gives the nominal arm.
     """
     key = name.strip().lower() if isinstance(name, str) else None
     if key not in _DH:
@@ -144,7 +154,7 @@ def load(name: str) -> RobotModel:
     limit[2] = _ELBOW_LIMIT
     if j6_free:
         limit[5] = np.inf
-    return RobotModel(
+    model = RobotModel(
         name=key,
         d=np.array([d1, 0.0, 0.0, d4, d5, d6]),
         a=np.array([0.0, a2, a3, 0.0, 0.0, 0.0]),
@@ -161,3 +171,4 @@ def load(name: str) -> RobotModel:
         payload=payload,
         reach=reach,
     )
+    return model if calibration is None else model.with_calibration(calibration)

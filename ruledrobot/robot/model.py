@@ -16,13 +16,20 @@ Frames (see ``docs/robot.md``):
 
 ``fk`` maps joints to TCP poses in the world, ``ik`` and ``path_ik`` map TCP
 poses in the world to joints: ``T_world_tcp = base @ A_1 ... A_n @ tool``.
+
+A catalogue arm can carry its factory calibration
+(:meth:`RobotModel.with_calibration`, ``load(name, calibration=...)``): its DH
+columns are then the controller's *effective* values, FK is exact for that robot,
+and ``ik`` refines the nominal closed form on the calibrated chain
+(:mod:`ruledrobot.robot.calibrated_ik`).
 """
 
 from __future__ import annotations
 
 import dataclasses
+import os
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Literal, overload
+from typing import TYPE_CHECKING, Any, Literal, overload
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -39,6 +46,7 @@ from ._checks import (
 from .kinematics import dh_fk, dh_jacobian, dh_skeleton
 
 if TYPE_CHECKING:
+    from .calibration import Calibration
     from .path import PathIKResult
 
 #: Default joint acceleration limit [rad/s^2].  UR publishes none; this is the
@@ -97,6 +105,10 @@ class RobotModel:
         the flange frame [m].
     payload : rated payload [kg] (datasheet), or None.
     reach : nominal reach [m] (datasheet), or None.
+    calibration : the robot's factory calibration (:class:`~ruledrobot.robot.Calibration`),
+        or None for the nominal arm.  When set, ``theta_offset, a, d, alpha`` are its
+        effective values (use :meth:`with_calibration`; a table that differs from the
+        calibration's is refused) and :attr:`nominal` is the arm without it.
     """
 
     name: str
@@ -118,12 +130,16 @@ class RobotModel:
     tool_com: FloatArray = field(default_factory=lambda: readonly(np.zeros(3)))
     payload: float | None = None
     reach: float | None = None
+    calibration: Calibration | None = None
 
     # derived, filled in __post_init__
     _ur: _ik.URGeometry | None = field(init=False, repr=False, default=None)
     _ur_problem: str = field(init=False, repr=False, default="")
     _base_inv: FloatArray | None = field(init=False, repr=False, default=None)
     _tool_inv: FloatArray | None = field(init=False, repr=False, default=None)
+    # the table the closed form seeds from (nominal for a calibrated arm): d, a, alpha, offset
+    _seed_dh: tuple[FloatArray, ...] = field(init=False, repr=False, default=())
+    _refine: bool = field(init=False, repr=False, default=False)  # calibrated: Newton finish
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str) or not self.name:
@@ -179,9 +195,15 @@ class RobotModel:
                 if v <= 0.0:
                     raise ValueError(f"{f}: must be positive or None, got {v}")
                 put(self, f, v)
-        ur, problem = _ur_geometry(self.d, self.a, self.alpha)
+        seed_dh = (self.d, self.a, self.alpha, self.theta_offset)
+        refine = False
+        if self.calibration is not None:
+            seed_dh, refine = _check_calibration(self)
+        ur, problem = _ur_geometry(seed_dh[0], seed_dh[1], seed_dh[2])
         put(self, "_ur", ur)
         put(self, "_ur_problem", problem)
+        put(self, "_seed_dh", seed_dh)
+        put(self, "_refine", refine)
         eye = np.eye(4)
         put(self, "_base_inv", None if np.array_equal(self.base, eye) else _inverse(self.base))
         put(self, "_tool_inv", None if np.array_equal(self.tool, eye) else _inverse(self.tool))
@@ -268,6 +290,51 @@ class RobotModel:
         """A copy whose base frame sits at ``base`` (4x4 or UR pose vector) in the world."""
         return dataclasses.replace(self, base=as_pose_or_vector(base, "base"))
 
+    def with_calibration(self, calibration: Calibration | str | os.PathLike | None) -> RobotModel:
+        """A copy that carries ``calibration`` (its effective DH table); None: the nominal arm.
+
+        ``calibration`` is a :class:`~ruledrobot.robot.Calibration` or the path of a
+        calibration file (:func:`~ruledrobot.robot.load_calibration`).  It must be a
+        calibration of this model (``ValueError`` otherwise).  Base, tool, limits and
+        masses are kept.  FK is then the DH chain with the effective parameters; ``ik``
+        seeds every branch with the nominal closed form and finishes on the calibrated
+        chain; a nominal calibration gives the closed form's answer bit for bit.
+        """
+        from .calibration import Calibration, load_calibration
+
+        if calibration is None:
+            return self.nominal
+        if isinstance(calibration, (str, os.PathLike)):
+            calibration = load_calibration(calibration)
+        if not isinstance(calibration, Calibration):
+            raise ValueError(
+                f"calibration: expected a Calibration, a file path or None, got "
+                f"{type(calibration).__name__}"
+            )
+        if calibration.model != self.name:
+            raise ValueError(
+                f"calibration: it belongs to a {calibration.model} (source "
+                f"{calibration.source!r}), this model is a {self.name}"
+            )
+        return dataclasses.replace(
+            self,
+            calibration=calibration,
+            theta_offset=calibration.theta_offset,
+            a=calibration.a,
+            d=calibration.d,
+            alpha=calibration.alpha,
+        )
+
+    @property
+    def nominal(self) -> RobotModel:
+        """This arm without its calibration (the catalogue table); ``self`` when uncalibrated."""
+        if self.calibration is None:
+            return self
+        d, a, alpha, offset = self._seed_dh
+        return dataclasses.replace(
+            self, calibration=None, theta_offset=offset, a=a, d=d, alpha=alpha
+        )
+
     def with_limits(
         self,
         *,
@@ -300,12 +367,19 @@ class RobotModel:
 
     @property
     def has_analytic_ik(self) -> bool:
-        """True when the DH table has the UR structure the closed-form IK needs."""
+        """True when the DH table has the UR structure the closed-form IK needs.
+
+        Also True for a calibrated catalogue arm: its IK starts from the closed form of
+        its nominal table and finishes on the calibrated chain.
+        """
         return self._ur is not None
 
     @property
     def ur_geometry(self) -> _ik.URGeometry:
-        """``(d1, a2, a3, d4 + d2 + d3, d5, d6)``; ValueError for a non-UR table."""
+        """``(d1, a2, a3, d4 + d2 + d3, d5, d6)``; ValueError for a non-UR table.
+
+        A calibrated arm gives the numbers of its nominal table.
+        """
         if self._ur is None:
             raise ValueError(f"model {self.name!r}: no analytic IK: {self._ur_problem}")
         return self._ur
@@ -316,6 +390,8 @@ class RobotModel:
             extra += ", base set"
         if self._tool_inv is not None:
             extra += f", tool set ({self.tool_mass:g} kg)"
+        if self.calibration is not None:
+            extra += f", calibrated ({self.calibration.source or 'no source'})"
         return f"RobotModel({self.name!r}, {self.n_joints} joints{extra})"
 
     # ------------------------------------------------------------------ kinematics
@@ -426,6 +502,8 @@ class RobotModel:
             raise ValueError(
                 f"q6_seed: expected a scalar or the batch shape {shape}, got {seed.shape}"
             ) from None
+        if self._refine:
+            return self._ik_calibrated(flat, shape, seed, return_info)
         seed = seed + self.theta_offset[5]
         out = np.empty((n, 8, 6))
         info = np.empty((n, 8, 3)) if return_info else None
@@ -452,16 +530,50 @@ class RobotModel:
             measure=measure,
         )
 
+    def _ik_calibrated(
+        self, flat: FloatArray, shape: tuple, seed: FloatArray, return_info: bool
+    ) -> FloatArray | _ik.IKSolutions:
+        """Nominal closed-form seeds refined on the calibrated chain (see ``calibrated_ik``)."""
+        from . import calibrated_ik as _cik
+
+        g = self.ur_geometry
+        offset = self._seed_dh[3]
+        seeds, _ = _cik.nominal_seeds(g, flat, seed + offset[5])
+        ok = ~np.isnan(seeds[..., 0])
+        seeds[ok] = _ik.wrap_angle(seeds[ok] - offset)
+        q, conv, res, its = _cik.refine_solutions(
+            self.d, self.a, self.alpha, self.theta_offset, flat, seeds
+        )
+        q = q.reshape(*shape, 8, 6)
+        if not return_info:
+            return q
+        f = self.singularity_factors(np.where(conv.reshape(*shape, 8)[..., None], q, 0.0))
+        nan = np.where(conv, 0.0, np.nan).reshape(*shape, 8)
+        wrist, elbow, shoulder = (f[..., k] + nan for k in range(3))
+        return _cik.CalibratedIKSolutions(
+            q=q,
+            valid=conv.reshape(*shape, 8),
+            wrist=wrist,
+            elbow=elbow,
+            shoulder=shoulder,
+            measure=wrist * elbow * shoulder / _measure_scale(g),
+            converged=conv.reshape(*shape, 8),
+            seeded=ok.reshape(*shape, 8),
+            residual=res.reshape(*shape, 8),
+            iterations=its.reshape(*shape, 8),
+        )
+
     def singularity_factors(self, q: ArrayLike) -> FloatArray:
         """(..., 3) singularity factors of joint configurations (..., 6).
 
         ``[|sin q5|, |sin q3|, |a2 c2 + a3 c23 + d5 sin q234|]`` (DH angles):
         wrist, elbow and shoulder (metres: distance of the wrist point from the
         plane of the base z axis and the shoulder axis).  Each is 0 at its
-        singularity; ``det J = a2 a3 sin q3 sin q5 s``.
+        singularity; ``det J = a2 a3 sin q3 sin q5 s``.  A calibrated arm uses its
+        nominal table (its singularities lie within about 1e-2 rad of those).
         """
         g = self.ur_geometry
-        th = self._joints(q) + self.theta_offset
+        th = self._joints(q) + self._seed_dh[3]
         t2, t3, t4 = th[..., 1], th[..., 2], th[..., 3]
         s = g.a2 * np.cos(t2) + g.a3 * np.cos(t2 + t3) + g.d5 * np.sin(t2 + t3 + t4)
         return np.stack([np.abs(np.sin(th[..., 4])), np.abs(np.sin(t3)), np.abs(s)], axis=-1)
@@ -480,13 +592,16 @@ class RobotModel:
         Point 0 is the base frame origin; joint ``i`` adds the point reached by
         ``d_i`` along the previous z axis and then its frame origin (``a_i`` along
         x_i).  Consecutive points bound the arm's links (the segments a collision
-        model puts capsules on); zero-length legs repeat a point.
+        model puts capsules on); zero-length legs repeat a point.  A calibrated arm
+        uses its nominal table: the DH legs of a calibrated table run metres to
+        hundreds of metres along the nearly parallel axes 2-4, the nominal skeleton
+        lies within millimetres of the real arm.
         """
         q = self._joints(q)
         shape = q.shape[:-1]
         base = None if self._base_inv is None else self.base
-        pts = dh_skeleton(q.reshape(-1, self.n_joints), self.d, self.a, self.alpha,
-                          self.theta_offset, base)  # fmt: skip
+        d, a, alpha, offset = self._seed_dh
+        pts = dh_skeleton(q.reshape(-1, self.n_joints), d, a, alpha, offset, base)
         return pts.reshape(*shape, 2 * self.n_joints + 1, 3)
 
     def within_limits(self, q: ArrayLike, tol: float = 0.0) -> np.ndarray:
@@ -519,6 +634,33 @@ class RobotModel:
             weights=weights,
             max_messages=max_messages,
         )
+
+
+def _check_calibration(model: RobotModel) -> tuple[tuple[FloatArray, ...], bool]:
+    """The nominal table (d, a, alpha, offset) of a calibrated model and whether its IK
+    needs the Newton finish; ValueError when the calibration does not fit the model."""
+    from .calibration import Calibration
+    from .catalogue import load
+
+    cal: Any = model.calibration
+    if not isinstance(cal, Calibration):
+        raise ValueError(f"calibration: expected a Calibration or None, got {type(cal).__name__}")
+    if cal.model != model.name:
+        raise ValueError(
+            f"calibration: it belongs to a {cal.model} (source {cal.source!r}), this model is "
+            f"a {model.name}"
+        )
+    for f in ("theta_offset", "a", "d", "alpha"):
+        mine, theirs = getattr(model, f), getattr(cal, f)
+        if not np.array_equal(mine, theirs):
+            i = int(np.argmax(mine != theirs))
+            raise ValueError(
+                f"{f}[{i}] = {mine[i]!r} is not the calibration's effective value {theirs[i]!r}; "
+                "attach calibrations with with_calibration()"
+            )
+    nom = load(cal.model)
+    seed_dh = (nom.d, nom.a, nom.alpha, nom.theta_offset)
+    return seed_dh, not cal.is_nominal
 
 
 def _measure_scale(g: _ik.URGeometry) -> float:
