@@ -530,12 +530,30 @@ def random_calibration(
     axis 6 and turned about it, each joint zero is offset by about ``3e-5 * scale`` rad,
     and the DH table is then read off the perturbed axes (:func:`dh_from_axes`).  As in
     real calibrations, the nearly parallel axes 2-4 get large, nearly cancelling
-    ``d2..d4`` and ``theta2..4``.  Axis 1 stays the base z axis.  ``scale`` > 3 or so
-    gives calibrations the bounds refuse.
+    ``d2..d4`` and ``theta2..4``.  Axis 1 stays the base z axis.  A draw the checks
+    refuse (at ``scale`` 1 rarely: ``d`` beyond 10 km when two axes come out parallel
+    to 1e-7 rad) is drawn again, up to 20 times; at ``scale`` 10 nearly all are
+    refused and the last refusal is raised.
     """
     name = model if isinstance(model, str) else model.name
     nom = _nominal_model(name)
     rng = np.random.default_rng(seed)
+    source = f"seeded random (seed {seed}" + (f", scale {scale:g})" if scale != 1.0 else ")")
+    for attempt in range(_ATTEMPTS):
+        try:
+            return _random_attempt(nom, rng, scale, source)
+        except CalibrationError:
+            if attempt == _ATTEMPTS - 1:
+                raise
+    raise AssertionError("unreachable")  # pragma: no cover
+
+
+_ATTEMPTS = 20
+
+
+def _random_attempt(
+    nom: RobotModel, rng: np.random.Generator, scale: float, source: str
+) -> Calibration:
     F = zero_frames(nom.theta_offset, nom.a, nom.d, nom.alpha)
     points = F[:6, :3, 3].copy()
     dirs = F[:6, :3, 2].copy()
@@ -557,7 +575,6 @@ def random_calibration(
     table = dh_from_axes(points, dirs, flange, reference_x=F[1:, :3, 0])
     table[:, 0] += rng.normal(0.0, 3e-5 * scale, 6)
     table[:, 0] = [_wrap(v) for v in table[:, 0]]
-    source = f"seeded random (seed {seed}" + (f", scale {scale:g})" if scale != 1.0 else ")")
     checksum = tuple(int(c) for c in rng.integers(0, 2**32, 6))
     return Calibration.from_dh(nom.name, table, checksum=checksum, source=source, status=2)
 

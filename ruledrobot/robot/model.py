@@ -539,10 +539,8 @@ class RobotModel:
         g = self.ur_geometry
         offset = self._seed_dh[3]
         seeds, _ = _cik.nominal_seeds(g, flat, seed + offset[5])
-        ok = ~np.isnan(seeds[..., 0])
-        seeds[ok] = _ik.wrap_angle(seeds[ok] - offset)
         q, conv, res, its = _cik.refine_solutions(
-            self.d, self.a, self.alpha, self.theta_offset, flat, seeds
+            self.d, self.a, self.alpha, self.theta_offset, flat, seeds, offset
         )
         q = q.reshape(*shape, 8, 6)
         if not return_info:
@@ -558,7 +556,7 @@ class RobotModel:
             shoulder=shoulder,
             measure=wrist * elbow * shoulder / _measure_scale(g),
             converged=conv.reshape(*shape, 8),
-            seeded=ok.reshape(*shape, 8),
+            seeded=~np.isnan(seeds[..., 0]).reshape(*shape, 8),
             residual=res.reshape(*shape, 8),
             iterations=its.reshape(*shape, 8),
         )
@@ -655,7 +653,8 @@ def _check_calibration(model: RobotModel) -> tuple[tuple[FloatArray, ...], bool]
         if not np.array_equal(mine, theirs):
             i = int(np.argmax(mine != theirs))
             raise ValueError(
-                f"{f}[{i}] = {mine[i]!r} is not the calibration's effective value {theirs[i]!r}; "
+                f"{f}[{i}] = {float(mine[i])!r} is not the calibration's effective value "
+                f"{float(theirs[i])!r}; "
                 "attach calibrations with with_calibration()"
             )
     nom = load(cal.model)
