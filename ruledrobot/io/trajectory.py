@@ -87,6 +87,8 @@ def meta_to_dict(meta: TrajectoryMeta) -> dict[str, Any]:
         "kinematics": {
             "source": meta.kinematics.source,
             "checksum": meta.kinematics.checksum,
+            "controller_checksum": None if meta.kinematics.controller_checksum is None
+            else list(meta.kinematics.controller_checksum),
             "dh": {c: dh[:, i].tolist() for i, c in enumerate(_DH_COLUMNS)},
         },
         "base": _ur(meta.base),
@@ -161,9 +163,14 @@ def meta_from_dict(doc: Any, where: str = "trajectory metadata") -> TrajectoryMe
             raise d.fail("kinematics", 'expected {"source": ..., "checksum": ..., "dh": {...}}')
         cols = [d.numbers(f"kinematics.dh.{c}", kin["dh"].get(c), model.n_joints)
                 for c in _DH_COLUMNS]  # fmt: skip
+        cc = kin.get("controller_checksum")
+        if cc is not None and not (isinstance(cc, list) and len(cc) == 6 and all(
+                isinstance(c, int) and 0 <= c < 2**32 for c in cc)):  # fmt: skip
+            raise d.fail("kinematics.controller_checksum", f"expected 6 uint32 or null, got {cc!r}")
         try:
             kinematics = KinematicsRef(np.stack(cols, axis=1), str(kin.get("source", "?")),
-                                       str(kin.get("checksum", "")))  # fmt: skip
+                                       str(kin.get("checksum", "")),
+                                       None if cc is None else tuple(cc))  # fmt: skip
         except ValueError as exc:
             raise ValueError(f"{where}: {exc}") from None
     phases = []

@@ -73,12 +73,15 @@ class KinematicsRef:
 
     ``dh`` (J, 4): per joint ``[theta_offset, a, d, alpha]`` (standard DH, m and
     rad); ``source``: ``"nominal"`` (the catalogue table) or where a calibration
-    came from; ``checksum``: :func:`kinematics_checksum` of ``dh``.
+    came from; ``checksum``: :func:`kinematics_checksum` of ``dh``;
+    ``controller_checksum``: the controller's six per-joint checksums of that
+    calibration (KinematicsInfo), when known — what the runner compares.
     """
 
     dh: FloatArray
     source: str = "nominal"
     checksum: str = ""
+    controller_checksum: tuple[int, ...] | None = None
 
     def __post_init__(self) -> None:
         dh = as_array(self.dh, "kinematics.dh", (4,))
@@ -93,9 +96,13 @@ class KinematicsRef:
         object.__setattr__(self, "checksum", expected)
 
     @classmethod
-    def of(cls, model: RobotModel, source: str = "nominal") -> KinematicsRef:
+    def of(cls, model: RobotModel) -> KinematicsRef:
+        """The kinematics of ``model``: nominal, or its calibration (source, checksums)."""
         dh = np.stack([model.theta_offset, model.a, model.d, model.alpha], axis=1)
-        return cls(dh, source)
+        cal = getattr(model, "calibration", None)
+        if cal is None or cal.is_nominal:
+            return cls(dh, "nominal")
+        return cls(dh, cal.source or "calibration", "", cal.checksum)
 
 
 @dataclass(frozen=True, eq=False)
@@ -192,9 +199,11 @@ def model_for(meta: TrajectoryMeta) -> RobotModel:
                          f"trajectory's table has shape {dh.shape}")  # fmt: skip
     nominal = KinematicsRef.of(model)
     if meta.kinematics.checksum != nominal.checksum:
-        model = dataclasses.replace(
-            model, theta_offset=dh[:, 0], a=dh[:, 1], d=dh[:, 2], alpha=dh[:, 3]
-        )
+        from .calibration import Calibration
+
+        cal = Calibration.from_dh(meta.robot, dh, checksum=meta.kinematics.controller_checksum,
+                                  source=meta.kinematics.source)  # fmt: skip
+        model = model.with_calibration(cal)
     if abs(meta.control_period - model.control_period) > 1e-12:
         raise ValueError(f"control_period: {meta.control_period} s, but a {meta.robot} runs at "
                          f"{model.control_period} s")  # fmt: skip

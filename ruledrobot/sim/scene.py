@@ -122,12 +122,10 @@ class Scene:
     @classmethod
     def from_job(cls, job: Any, robot: RobotModel | None = None, **kw: Any) -> Scene:
         """The cell of a cut job (``ruledrobot.wirecut.job.Job``, read by attribute):
-        ``job.robot.model`` / ``job.robot.base`` (unless ``robot`` is given), the bow
+        ``job.robot_model()`` (model, calibration, base; unless ``robot`` is given), the bow
         of ``job.tool`` (:meth:`BowTool.from_spec`) and ``job.stock``."""
         if robot is None:
-            from ..robot import load
-
-            robot = load(job.robot.model).with_base(job.robot.base)
+            robot = job.robot_model()
         return cls(robot, tool=BowTool.from_spec(job.tool), stock=job.stock, **kw)
 
     def mjcf(self) -> str:

@@ -23,6 +23,7 @@ A job describes, in the robot base frame (metres, radians, seconds)::
     speed_scale = 1.0          # fraction of the catalogue joint speed limits
     acceleration = 1.4         # rad/s^2, one value or six
     # home = [3.14, -1.57, 1.57, -1.57, -1.57, 0.0]   # optional (rad): start and end here
+    # calibration = "robot.calib.json"   # the robot's own kinematics (ruledrobot calibration fetch)
 
     [tool]                     # the hot-wire bow, in the flange frame
     wire_start = [-0.2, 0.0, 0.25]
@@ -92,6 +93,7 @@ class RobotSpec:
     speed_scale: float = 1.0
     acceleration: np.ndarray | None = None
     home: np.ndarray | None = field(default=None, repr=False)
+    calibration: Path | None = None
 
 
 @dataclass(frozen=True)
@@ -129,6 +131,15 @@ class Job:
     tool: ToolSpec
     cut: CutSpec
     source: Path | None = None
+
+    def robot_model(self):
+        """The job's robot: the catalogue model with its calibration (if the job names
+        one) and its base; the arm every stage plans and checks with."""
+        from ..robot import load
+
+        return load(self.robot.model).with_calibration(self.robot.calibration).with_base(
+            self.robot.base
+        )
 
     def input_lines(self) -> Lines:
         """The input rulings in the robot base frame."""
@@ -216,6 +227,28 @@ class _Section:
                 f"{self.where}: [{self.name}] unknown field(s) {', '.join(extra)}; "
                 f"expected some of {', '.join(sorted(self.used))}"
             )
+
+
+def _calibration(sec: _Section, model: str, base_dir: Path | None) -> Path | None:
+    """``[robot] calibration``: a calibration file of this robot (checked on reading)."""
+    value = sec.get("calibration")
+    if value is None:
+        return None
+    if not isinstance(value, str):
+        raise sec.fail("calibration", f"expected a path string, got {value!r}")
+    path = Path(value)
+    if not path.is_absolute() and base_dir is not None:
+        path = base_dir / path
+    from ..robot.calibration import load_calibration
+
+    try:
+        cal = load_calibration(path)
+    except (OSError, ValueError) as exc:
+        raise sec.fail("calibration", str(exc)) from None
+    if cal.model != model:
+        raise sec.fail("calibration", f"{path} is a calibration of a {cal.model}, the job's "
+                       f"robot is a {model}")  # fmt: skip
+    return path
 
 
 def _pose(sec: _Section, key: str) -> np.ndarray:
@@ -329,6 +362,7 @@ def parse_job(doc: dict, where: str = "job", base_dir: Path | None = None) -> Jo
         speed_scale=r.number("speed_scale", 1.0, lo=0.0, hi=1.0, strict_lo=True),
         acceleration=acceleration,
         home=r.vector("home", 6) if r.get("home") is not None else None,
+        calibration=_calibration(r, model, base_dir),
     )
     r.done()
 

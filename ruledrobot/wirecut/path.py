@@ -138,10 +138,9 @@ def _extend(F: FloatArray, grown: Box, limit: int = 400) -> tuple[FloatArray, in
 def cut_path(job: Job, model=None, **search: float) -> CutPath:
     """The geometric cut of ``job`` (see the module doc); ``search`` goes to the
     redundancy search.  ``model`` defaults to the job's robot (flange, no tool)."""
-    from ..robot import load
 
     if model is None:
-        model = load(job.robot.model).with_base(job.robot.base)
+        model = job.robot_model()
     F, steps = refine_for_job(job)
     lead = max(job.cut.lead_in, job.cut.lead_out)
     grown = Box(job.stock.centre, job.stock.size + 2.0 * lead, job.stock.rotation)

@@ -32,7 +32,7 @@ from ..geometry.interp import interp_linear
 from ..io.atomic import atomic_write_bytes, atomic_write_text
 from ..io.lines import save_lines
 from ..io.trajectory import write_trajectory
-from ..robot import load, wrap_angle
+from ..robot import wrap_angle
 from ..robot.trajectory import Trajectory
 from ..robot.verdict import Check, Verdict
 from .checks import Measurements, collision_sentence, plan_verdict
@@ -178,7 +178,7 @@ def plan(
     try:
         t0 = time.perf_counter()
         timings: dict[str, float] = {}
-        model = load(job.robot.model).with_base(job.robot.base)
+        model = job.robot_model()
         dt = float(model.control_period)
 
         say("refining the rulings and choosing the wire motion")
