@@ -10,10 +10,11 @@ module refines all of them at once:
    of the flange pose gives up to 8 seeds.  Branches the nominal arm cannot reach
    (the pose lies just beyond its reach, inside its shoulder cylinder or closer than
    its folded elbow) are seeded from the closed form of a nominal arm that reaches
-   1 cm further in each direction (:func:`fallback_geometry`), so that poses only the
-   calibrated arm reaches are solved too.  This matters: near the stretched elbow a
-   millimetre of reach is a wide band of ``q3`` (``dD ~ q3^2``), and about 2.5 % of
-   the (pose, branch) pairs of random configurations of a calibrated UR5e lie there.
+   1 cm further in each direction (:func:`fallback_geometry`; 3 cm for poses with no
+   seed at all), so that poses only the calibrated arm reaches are solved too.  This
+   matters: near the stretched elbow a millimetre of reach is a wide band of ``q3``
+   (``dD ~ q3^2``), and about 2.5 % of the (pose, branch) pairs of random
+   configurations of a calibrated UR5e lie there.
 2. **Newton / Levenberg-Marquardt** on the calibrated DH chain, vectorised over all
    (pose, branch) pairs, chunk by chunk (no loop over poses).  The residual is the
    flange's position error and its rotation error (the small rotation vector), both
@@ -54,11 +55,11 @@ DEFAULT_TOL = 1e-11
 DEFAULT_MAX_ITER = 40
 _CHUNK = 8192  # (pose, branch) pairs per chunk
 _MAX_STEP = 0.5  # rad: a longer step is shortened (trust region)
-_LAMBDA0 = 1e-3  # damping factor: mu^2 = lambda * |e|
+_LAMBDA0 = 1e-6  # damping factor: mu^2 = lambda * |e|
 _FALLBACK = 0.01  # m: links lengthened / shoulder shortened for the fallback seeds
-_REJECT = 1e3  # a residual above this many times the best undoes the step
 _BULK = 5  # iterations per chunk; the pairs still open then are iterated together
-_STALL = 4  # iterations without reducing the best residual by 30 % before a pair is given up
+_REJECT = 1e3  # a residual above this many times the best halves the step
+_STALL = 8  # iterations without reducing the best residual by 30 % before a pair is given up
 
 
 @dataclass(frozen=True, eq=False)
@@ -89,15 +90,13 @@ class CalibratedIKSolutions(_ik.IKSolutions):
 # ---------------------------------------------------------------------- seeds
 
 
-def fallback_geometry(g: _ik.URGeometry) -> _ik.URGeometry:
+def fallback_geometry(g: _ik.URGeometry, e: float = 0.01) -> _ik.URGeometry:
     """A nominal geometry that reaches a little further than ``g`` in every direction.
 
-    The longer link gets ``_FALLBACK`` more, the shorter twice that (the stretched arm
-    reaches ``3 * _FALLBACK`` further out, the folded one ``_FALLBACK`` further in) and
-    the shoulder offset ``d4`` is shortened by ``_FALLBACK`` (wrist points just inside
-    the shoulder cylinder).
+    The longer link gets ``e`` [m] more, the shorter twice that (the stretched arm
+    reaches ``3 e`` further out, the folded one ``e`` further in) and the shoulder
+    offset ``d4`` is shortened by ``e`` (wrist points just inside the shoulder cylinder).
     """
-    e = _FALLBACK
 
     def longer(x: float, by: float) -> float:
         return float(x + np.copysign(by, x))
@@ -122,14 +121,18 @@ def nominal_seeds(
         hi = min(lo + _ik._CHUNK, n)
         _ik.ur_ik_chunk(g, flange[lo:hi], seed6[lo:hi], out[lo:hi], None)
     exact = ~np.isnan(out[..., 0])
-    missing = np.flatnonzero(~exact.all(axis=1))
-    if missing.size:
-        gf = fallback_geometry(g)
+    # 1 cm further for every pose with a missing branch, 3 cm for poses with none
+    for e in (_FALLBACK, 3 * _FALLBACK):
+        have = ~np.isnan(out[..., 0])
+        missing = np.flatnonzero(~have.any(axis=1) if e > _FALLBACK else ~have.all(axis=1))
+        if missing.size == 0:
+            continue
+        gf = fallback_geometry(g, e)
         sub = np.empty((missing.size, 8, 6))
         for lo in range(0, missing.size, _ik._CHUNK):
             rows = missing[lo : lo + _ik._CHUNK]
             _ik.ur_ik_chunk(gf, flange[rows], seed6[rows], sub[lo : lo + rows.size], None)
-        hole = ~exact[missing]
+        hole = ~have[missing]
         blk = out[missing]
         blk[hole] = sub[hole]
         out[missing] = blk
@@ -324,14 +327,14 @@ def _solve(cols, e, mu2):
 class _Batch:
     """Iteration state of a batch of (pose, branch) pairs; angles stored as (6, m)."""
 
-    def __init__(self, idx, th, tgt, best_th=None, best_r=None, lam=None, stall=None):
+    def __init__(self, idx, th, tgt, best_th=None, best_r=None, step=None, stall=None):
         m = idx.shape[0]
         self.idx = idx
         self.th = th
         self.tgt = tgt
         self.best_th = th.copy() if best_th is None else best_th
         self.best_r = np.full(m, np.inf) if best_r is None else best_r
-        self.lam = np.full(m, _LAMBDA0) if lam is None else lam
+        self.step = np.zeros_like(th) if step is None else step
         self.stall = np.zeros(m, dtype=np.int16) if stall is None else stall
 
     def take(self, keep: np.ndarray) -> _Batch:
@@ -341,7 +344,7 @@ class _Batch:
             tuple(tuple(v[keep] for v in col) for col in self.tgt),
             self.best_th[:, keep],
             self.best_r[keep],
-            self.lam[keep],
+            self.step[:, keep],
             self.stall[keep],
         )
 
@@ -355,7 +358,7 @@ class _Batch:
             tgt,
             cat([b.best_th for b in batches], axis=1),
             cat([b.best_r for b in batches]),
-            cat([b.lam for b in batches]),
+            cat([b.step for b in batches], axis=1),
             cat([b.stall for b in batches]),
         )
 
@@ -363,8 +366,10 @@ class _Batch:
 def _iterate(ch: _Chain, b: _Batch, out: tuple, tol: float, first: int, last: int, final: bool):
     """Newton / LM iterations ``first..last`` on batch ``b``; finished pairs go to ``out``.
 
-    A pair whose residual grows beyond ``_REJECT`` times its best is sent back to its
-    best iterate with ten times the damping; a pair that has not reduced its best
+    The iteration is not monotone (a Newton step may raise the residual for a while
+    and still converge, and often does next to singularities); a step that raises a
+    pair's residual beyond ``_REJECT`` times its best is halved and taken again from
+    the best iterate; a pair that has not reduced its best
     residual by 30 % for ``_STALL`` iterations is given up, and with ``final`` every pair still
     open after iteration ``last``.  Returns the batch of the pairs still open (or None).
     """
@@ -399,14 +404,14 @@ def _iterate(ch: _Chain, b: _Batch, out: tuple, tol: float, first: int, last: in
             cols = [tuple(_take(part, keep) for part in col) for col in cols]
         if it == last:
             return b
-        b.lam = np.where(reject, b.lam * 10.0, np.maximum(b.lam * 0.3, _LAMBDA0))
-        dq = _solve(cols, e, b.lam * r)
+        dq = _solve(cols, e, _LAMBDA0 * r)
         step = np.stack([np.broadcast_to(v, r.shape) for v in dq])
         big = np.abs(step).max(axis=0)
         step *= np.minimum(1.0, _MAX_STEP / np.maximum(big, 1e-300))
-        if reject.any():  # back to the best iterate, no step from the rejected one
-            step[:, reject] = 0.0
+        if reject.any():  # back to the best iterate, half the step taken from it
+            step = np.where(reject, 0.5 * b.step, step)
             b.th = np.where(reject, b.best_th, b.th)
+        b.step = step
         b.th = b.th + step
     return b
 

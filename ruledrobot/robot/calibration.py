@@ -525,7 +525,7 @@ def random_calibration(
     """A seeded, realistic factory calibration of ``model`` (for tests and demos).
 
     Built the way a real one arises: the nominal joint axes at ``q = 0`` are tilted
-    (each by a random rotation of about ``2.5e-3 * scale`` rad per component, normal to
+    (each by a random rotation of about ``1.5e-3 * scale`` rad per component, normal to
     it) and moved (about ``0.3 mm * scale`` per component), the flange is moved along
     axis 6 and turned about it, each joint zero is offset by about ``3e-5 * scale`` rad,
     and the DH table is then read off the perturbed axes (:func:`dh_from_axes`).  As in
@@ -557,7 +557,7 @@ def _random_attempt(
     F = zero_frames(nom.theta_offset, nom.a, nom.d, nom.alpha)
     points = F[:6, :3, 3].copy()
     dirs = F[:6, :3, 2].copy()
-    tilt, shift = 2.5e-3 * scale, 3e-4 * scale
+    tilt, shift = 1.5e-3 * scale, 3e-4 * scale
     for i in range(1, 6):
         dirs[i] = _small_rotation(rng, dirs[i], tilt) @ dirs[i]
         dirs[i] /= np.linalg.norm(dirs[i])

@@ -206,10 +206,10 @@ def test_random_calibration_scale_is_refused_when_large() -> None:
     refused = 0
     for seed in range(10):
         try:
-            random_calibration("ur5e", seed, scale=10.0)
+            random_calibration("ur5e", seed, scale=20.0)
         except CalibrationError:
             refused += 1
-    assert refused >= 5  # even after 20 draws each
+    assert refused >= 8  # even after 20 draws each
 
 
 @pytest.mark.parametrize("model", MODEL_NAMES)
@@ -322,7 +322,7 @@ def test_attach_and_detach() -> None:
     np.testing.assert_array_equal(back.d, nom.d)
     assert m.with_calibration(None).calibration is None
     assert m.with_tool(np.eye(4)).calibration is cal  # kept through copies
-    ref = KinematicsRef.of(m, source=cal.source)
+    ref = KinematicsRef.of(m)
     np.testing.assert_array_equal(ref.dh, cal.dh())
     with pytest.raises(
         ValueError, match=r"d\[0\] = 0\.1625 is not the calibration's effective value"
