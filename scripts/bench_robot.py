@@ -1,7 +1,7 @@
 """Benchmark of the robot layer: analytic IK, FK, Jacobian, path IK; MuJoCo playback.
 
 Run:  .venv/bin/python scripts/bench_robot.py [--model ur5e] [--n 100000] [--repeat 5]
-      [--sim-duration 60] [--no-sim] [--no-render]
+      [--sim-duration 60] [--no-sim] [--no-render] [--no-calibrated] [--calibration-seed 1]
 
 Prints plain numbers (best of ``--repeat`` runs); no assertions on time.
 The comparison uses ``ur_analytic_ik`` (C++/Eigen, one pose per call) when
@@ -51,6 +51,8 @@ def main() -> None:
     parser.add_argument("--render-frames", type=int, default=200)
     parser.add_argument("--no-sim", action="store_true", help="skip MuJoCo playback/render")
     parser.add_argument("--no-render", action="store_true", help="skip rendering")
+    parser.add_argument("--no-calibrated", action="store_true", help="skip the calibrated IK")
+    parser.add_argument("--calibration-seed", type=int, default=1)
     args = parser.parse_args()
 
     robot = load(args.model)
@@ -124,9 +126,72 @@ def main() -> None:
         f"max step {res.max_step:.2e} rad, max |q - q_ref| {np.abs(res.q - qp).max():.1e})"
     )
 
+    # --- calibrated arm: nominal seeds + batched Newton on the calibrated chain -------
+    if not args.no_calibrated:
+        bench_calibrated(args, robot, t_ik)
+
     # --- MuJoCo playback and rendering (ruledrobot.sim) -----------------------------
     if not args.no_sim:
         bench_sim(args)
+
+
+def bench_calibrated(args: argparse.Namespace, robot, t_ik: float) -> None:
+    """All 8 branches of a calibrated arm on the same poses: time, ratio, residuals, rates."""
+    from ruledrobot.robot import calibrated_ik, random_calibration
+
+    n = args.n
+    cal = random_calibration(robot.name, args.calibration_seed)
+    arm = robot.with_calibration(cal)
+    rng = np.random.default_rng(1)
+    q = rng.uniform(-np.pi, np.pi, size=(n, 6))
+    T = arm.fk(q)
+    t_nom = best_time(lambda: robot.ik(T), args.repeat)
+    t_cal = best_time(lambda: arm.ik(T), max(1, args.repeat // 2))
+    info = arm.ik(T, return_info=True)
+    v = info.valid
+    F = arm.fk(np.where(v[..., None], info.q, 0.0))
+    dp = np.linalg.norm(F[..., :3, 3] - T[:, None, :3, 3], axis=-1)[v]
+    R = np.einsum(
+        "...ji,...jk->...ik",
+        F[..., :3, :3],
+        np.broadcast_to(T[:, None, :3, :3], F[..., :3, :3].shape),
+    )
+    w = 0.5 * np.stack([R[..., 2, 1] - R[..., 1, 2], R[..., 0, 2] - R[..., 2, 0],
+                        R[..., 1, 0] - R[..., 0, 1]], axis=-1)[v]  # fmt: skip
+    rot = np.arcsin(np.minimum(np.linalg.norm(w, axis=-1), 1.0))
+    _, exact = calibrated_ik.nominal_seeds(robot.ur_geometry, arm.flange_poses(T), np.zeros(n))
+    seeded = info.seeded
+    print(
+        f"\ncalibrated {robot.name} ({cal.source}; FK up to "
+        f"{np.linalg.norm(T[:, :3, 3] - robot.fk(q)[:, :3, 3], axis=-1).max() * 1e3:.1f} mm "
+        f"from nominal), {n} random configurations"
+    )
+    print(
+        f"IK nominal (8 sol.)     {t_nom * 1e3:8.2f} ms  {t_nom / n * 1e6:.3f} us/pose  "
+        f"(first run above: {t_ik * 1e3:.2f} ms)"
+    )
+    print(
+        f"IK calibrated (8 sol.)  {t_cal * 1e3:8.2f} ms  {t_cal / n * 1e6:.3f} us/pose  "
+        f"ratio {t_cal / t_nom:.1f} x nominal (target 5 x)"
+    )
+    print(
+        f"  residual max {dp.max():.1e} m, {rot.max():.1e} rad over {v.sum()} solutions; "
+        f"poses solved {v.any(axis=1).mean() * 100:.2f} %"
+    )
+    print(
+        f"  converged: {(v & exact).sum() / exact.sum() * 100:.3f} % of the nominal closed "
+        f"form's branches, {(v & ~exact).sum() / max(1, (seeded & ~exact).sum()) * 100:.1f} % "
+        f"of the fallback seeds; not converged (NaN, flagged) {(seeded & ~v).sum()}"
+    )
+    its = info.iterations[v]
+    print(
+        f"  Newton iterations: mean {its.mean():.2f}, "
+        + ", ".join(
+            f"{k}: {c / its.size * 100:.1f} %"
+            for k, c in enumerate(np.bincount(its))
+            if c / its.size > 0.001
+        )
+    )
 
 
 def cell_trajectory(
