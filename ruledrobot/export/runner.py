@@ -26,7 +26,6 @@ from __future__ import annotations
 import math
 import os
 from collections.abc import Callable
-from dataclasses import dataclass, field
 from enum import Enum
 from pathlib import Path
 from typing import Any
@@ -42,132 +41,18 @@ from .limits import check_trajectory
 from .run_checks import controller_checks, query_dashboard, readiness_check
 from .run_plan import (
     Entry,
-    StopPlace,
     path_waypoints,
     plan_entry,
     recording_path_for,
     resample,
     stop_place,
 )
+from .run_result import ControllerError, RunMode, RunPlan, RunResult
 from .run_supervisor import Child, ChildGone
 
 __all__ = ["ControllerError", "RunMode", "RunPlan", "RunResult", "run_trajectory"]
 
 ProgressFn = Callable[[int, int], Any]
-
-
-class RunMode(str, Enum):
-    """How the motion is sent: one servoJ per controller period, or one blended moveL path."""
-
-    servoj = "servoj"
-    path = "path"
-
-
-class ControllerError(RuntimeError):
-    """The controller cannot be asked (not reachable, no answer): nothing was checked."""
-
-
-@dataclass(frozen=True)
-class RunPlan:
-    """What a run will do, shown before it moves: the checks and the entry move."""
-
-    verdict: Verdict
-    entry: Entry | None
-    host: str | None
-    mode: str
-    trajectory: Trajectory
-    approach_speed: float
-    speed_scale: float
-
-    def describe(self) -> list[str]:
-        """The approach move in words (one line each)."""
-        e = self.entry
-        if e is None:
-            return ["approach move: not known (the controller was not contacted)"]
-        lines = [f"entry: {e.kind} — {e.note}"]
-        if e.distance < 1e-4:
-            lines.append(f"approach move: none (the arm is at sample {e.sample})")
-        else:
-            lines.append(
-                f"approach move: moveJ to sample {e.sample}, leading joint q{e.joint} "
-                f"{e.distance:.4f} rad at {self.approach_speed:g} rad/s, about "
-                f"{e.approach_time:.1f} s"
-            )
-        if e.replay_time > 0:
-            lines.append(
-                f"replay of the kerf: samples {e.sample}..{e.requested} "
-                f"({e.replay_time / self.speed_scale:.1f} s) before the cut goes on"
-            )
-        traj = self.trajectory
-        rest = (traj.t[-1] - traj.t[e.sample]) / self.speed_scale
-        lines.append(f"motion: samples {e.sample}..{traj.n - 1} ({rest:.1f} s, mode {self.mode})")
-        return lines
-
-
-@dataclass
-class RunResult:
-    """What :func:`run_trajectory` did.
-
-    ``status``: ``"completed"``, ``"dry_run"``, ``"refused"`` (a check failed;
-    nothing moved), ``"cancelled"`` (not confirmed), or why the motion stopped:
-    ``"deviation"``, ``"protective_stop"``, ``"emergency_stop"``,
-    ``"connection_lost"``, ``"controller_slow"``, ``"program_stopped"``,
-    ``"command_failed"``, ``"interrupted"``, ``"client_died"`` (the ur_rtde
-    process crashed), ``"client_hung"`` (it stopped answering and was killed).
-    ``start_index``: the first sample streamed (the entry), ``requested_index``:
-    the sample asked for; ``stop_index``: the input sample the arm reached
-    (``n_samples`` when completed) — resume with it; ``stop``: where, in words
-    (time, phase, wire in the stock); ``verdict``: the checks before motion;
-    ``entry``: how the run entered; ``actual``/``actual_path``: the recording
-    and its file (``<stem>.run-NNN.csv``); ``client``: how the ur_rtde process
-    ended and the tail of its output, when it did not end normally;
-    ``timeline``: (``time.monotonic()``, event) of the supervised steps.
-    """
-
-    status: str
-    message: str
-    n_samples: int
-    start_index: int = 0
-    stop_index: int = 0
-    stop_time: float = 0.0
-    samples_sent: int = 0
-    max_deviation: float = 0.0
-    approach_distance: float = 0.0
-    actual: Trajectory | None = None
-    actual_path: Path | None = None
-    verdict: Verdict | None = None
-    entry: Entry | None = None
-    requested_index: int = 0
-    stop: StopPlace | None = None
-    client: str = ""
-    timeline: list[tuple[float, str]] = field(default_factory=list)
-
-    @property
-    def completed(self) -> bool:
-        return self.status in ("completed", "dry_run")
-
-    @property
-    def moved(self) -> bool:
-        """Whether motion was started (not a dry run, refusal or cancellation)."""
-        return self.status not in ("dry_run", "refused", "cancelled")
-
-    @property
-    def checks(self) -> tuple[Check, ...]:
-        return () if self.verdict is None else self.verdict.checks
-
-    @property
-    def resume_index(self) -> int | None:
-        """The sample to resume from (``--resume``), None when completed or nothing moved."""
-        return self.stop_index if self.moved and self.status != "completed" else None
-
-    def __str__(self) -> str:
-        text = f"{self.status}: {self.message}"
-        if self.moved:
-            text += (
-                f" (samples {self.start_index}..{self.stop_index} of {self.n_samples}, max "
-                f"deviation {self.max_deviation:.4f} rad)"
-            )
-        return text
 
 
 def _validate(
