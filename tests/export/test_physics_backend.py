@@ -10,8 +10,8 @@ import pytest
 from ruledrobot.export import run_trajectory
 from ruledrobot.export.emulator.physics import MujocoBackend
 from ruledrobot.io.trajectory import read_trajectory, write_trajectory
-from ruledrobot.robot.trajectory import Trajectory
 from ruledrobot.robot import load
+from ruledrobot.robot.trajectory import Trajectory
 
 from .conftest import start_emulator
 
