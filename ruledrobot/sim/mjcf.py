@@ -28,6 +28,7 @@ The compiled model's kinematics equal ``model.fk`` to rounding (tested to 1e-9).
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import os
 import xml.etree.ElementTree as ET
@@ -227,6 +228,31 @@ class _Segment:
     rgba: str
 
 
+def _body_frames(model: RobotModel) -> list[FloatArray]:
+    """Poses (4, 4) of the link bodies at q = 0 in the base frame (body k: DH frame k-1
+    turned by the joint's zero offset)."""
+    out, T = [], np.eye(4)
+    for k in range(model.n_joints):
+        B = T @ _rz(float(model.theta_offset[k]))
+        out.append(B)
+        T = B @ _dh_tail(float(model.d[k]), float(model.a[k]), float(model.alpha[k]))
+    return out
+
+
+def _body_corrections(model: RobotModel, shape: RobotModel) -> list[FloatArray]:
+    """Per body the constant pose of ``shape``'s body frame in ``model``'s (identity for an
+    uncalibrated arm): both frames are fixed to the same link, so the map holds for every q."""
+    if shape is model:
+        return [np.eye(4)] * model.n_joints
+    return [np.linalg.inv(c) @ s for c, s in zip(_body_frames(model), _body_frames(shape),
+                                                    strict=True)]  # fmt: skip
+
+
+def _moved(seg: _Segment, C: FloatArray) -> _Segment:
+    R, t = C[:3, :3], C[:3, 3]
+    return dataclasses.replace(seg, a=R @ seg.a + t, b=R @ seg.b + t)
+
+
 def _link_geometry(model: RobotModel, radii: FloatArray) -> tuple[list[list[_Segment]], float]:
     """Primitive geometry per link body (in the body frame) and the base height [m].
 
@@ -355,8 +381,13 @@ def build_robot(
     dt = physics_timestep(model.control_period) if timestep is None else float(timestep)
     if not dt > 0.0:
         raise ValueError(f"timestep: must be positive, got {dt}")
-    radii = link_radii(model)
-    geometry, base_h = _link_geometry(model, radii)
+    radii = link_radii(model.nominal)
+    # a calibrated arm: the bodies follow the calibrated chain (exact kinematics); the
+    # links keep their nominal shape, carried by the calibrated frames (its DH numbers
+    # run metres along the nearly parallel axes 2-4, the metal does not)
+    shape = model.nominal
+    geometry, base_h = _link_geometry(shape, radii)
+    carry = _body_corrections(model, shape)
 
     root = ET.Element("mujoco", model=comment_model)
     sub(root, "compiler", angle="radian", autolimits="true", inertiafromgeom="auto")
@@ -392,7 +423,8 @@ def build_robot(
         body = placed(
             parent, "body", parent_tail @ _rz(float(model.theta_offset[k])), name=name, gravcomp=1
         )
-        com, inertia = _link_inertial(model, k, float(radii[k]))
+        com, inertia = _link_inertial(shape, k, float(radii[k]))
+        com = carry[k][:3, :3] @ com + carry[k][:3, 3]
         if model.link_mass[k] > 0.0:
             sub(body, "inertial", pos=com, mass=float(model.link_mass[k]), diaginertia=inertia)
         lo, hi = float(model.lower[k]), float(model.upper[k])
@@ -413,7 +445,7 @@ def build_robot(
             actuatorfrcrange=[-tau, tau] if np.isfinite(tau) else None,
         )
         for j, seg in enumerate(geometry[k]):
-            _add_segment(body, f"{name}_g{j}", seg)
+            _add_segment(body, f"{name}_g{j}", _moved(seg, carry[k]))
         names.append(name)
         parent = body
         parent_tail = _dh_tail(float(model.d[k]), float(model.a[k]), float(model.alpha[k]))

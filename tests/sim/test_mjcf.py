@@ -205,3 +205,27 @@ def test_committed_models_are_current(tmp_path):
         if text_new != text_old:
             _equivalent(ET.fromstring(text_old), ET.fromstring(text_new), p.name)
         mujoco.MjModel.from_xml_path(str(committed))
+
+
+def test_a_calibrated_arm_has_its_kinematics_and_its_nominal_shape():
+    """Bodies follow the calibrated chain (TCP site = calibrated FK to 1e-9); the links keep
+    their nominal shape: geoms within a few millimetres of the nominal arm's."""
+    from ruledrobot.robot.calibration import random_calibration
+
+    nominal = load("ur5e").with_tool([0.0, 0.0, 0.2, 0.0, 0.0, 0.0])
+    cal = nominal.with_calibration(random_calibration("ur5e", seed=3))
+    q = np.random.default_rng(0).uniform(-2, 2, (20, 6))
+    positions = []
+    for model in (cal, nominal):
+        m = mujoco.MjModel.from_xml_string(mjcf.robot_mjcf(model))
+        d = mujoco.MjData(m)
+        tcp, geoms = [], []
+        for qk in q:
+            d.qpos[:] = qk
+            mujoco.mj_forward(m, d)
+            tcp.append(d.site("tcp").xpos.copy())
+            geoms.append(d.geom_xpos.copy())
+        positions.append((np.array(tcp), np.array(geoms)))
+    np.testing.assert_allclose(positions[0][0], cal.fk(q)[:, :3, 3], atol=1e-9)
+    assert np.abs(positions[0][0] - nominal.fk(q)[:, :3, 3]).max() > 1e-4  # not the nominal
+    assert np.linalg.norm(positions[0][1] - positions[1][1], axis=-1).max() < 0.02
