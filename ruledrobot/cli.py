@@ -431,11 +431,19 @@ def ursim(
     physics: str = typer.Option(
         "kinematic", help="The arm behind the controller: kinematic, or mujoco (simulated)."
     ),
+    calibration: str | None = typer.Option(
+        None,
+        help="The robot's factory calibration: a ruledrobot.calibration/1 file, or random:SEED "
+        "(a seeded realistic one).  The emulator then serves its KinematicsInfo on 30001/30002 "
+        "and uses the calibrated kinematics for everything (default: nominal).",
+    ),
 ) -> None:
-    """Run the controller emulator (RTDE 30004, dashboard 29999, script 30003) until Ctrl-C,
-    optionally with faults on a timer or on a signal (docs/rtde.md)."""
+    """Run the controller emulator (RTDE 30004, dashboard 29999, script 30003, primary 30001,
+    secondary 30002) until Ctrl-C, optionally calibrated and with faults on a timer or on a
+    signal (docs/rtde.md)."""
     from .export import serve
     from .export.emulator.faults import FaultSchedule, parse_fault
+    from .export.emulator.server import emulated_model
 
     if physics not in ("kinematic", "mujoco"):
         raise typer.BadParameter(f"expected kinematic or mujoco, got {physics!r}",
@@ -444,15 +452,32 @@ def ursim(
         specs = [parse_fault(f) for f in fault]
     except ValueError as exc:
         raise _fail(f"--fault: {exc}") from None
+    arm = None
+    if calibration is not None:
+        from .robot import random_calibration
+
+        try:
+            if calibration.startswith("random:"):
+                seed_text = calibration[len("random:") :]
+                if not seed_text.isdigit():
+                    raise ValueError(f"random:SEED needs a seed >= 0, got {seed_text!r}")
+                arm = emulated_model(model, random_calibration(model, int(seed_text)))
+            else:  # the file is read, and another model's calibration refused, here
+                arm = emulated_model(model, calibration)
+        except ValueError as exc:
+            raise _fail(f"--calibration: {exc}") from None
+    kinematics = ("nominal kinematics" if arm is None or arm.calibration is None
+                  else f"calibrated kinematics ({arm.calibration.source})")  # fmt: skip
     schedule = FaultSchedule(specs, on_fire=lambda s: console.print(
         f"fault: {s.describe()}", highlight=False, markup=False))  # fmt: skip
 
     def ready(emu) -> None:  # printed once the ports are bound, never before
         p = emu.ports
         console.print(
-            f"UR controller emulator ({model}, {physics}) listening on {host}: RTDE "
-            f"{p['rtde']}, dashboard {p['dashboard']}, script {p['script']}; programs in "
-            f"{emu.programs_dir}; Ctrl-C to stop", highlight=False, markup=False,
+            f"UR controller emulator ({model}, {physics}, {kinematics}) listening on {host}: "
+            f"RTDE {p['rtde']}, dashboard {p['dashboard']}, script {p['script']}, primary "
+            f"{p['primary']}, secondary {p['secondary']}; programs in {emu.programs_dir}; "
+            "Ctrl-C to stop", highlight=False, markup=False,
         )  # fmt: skip
         for s in specs:
             console.print(f"scheduled fault: {s.describe()}", highlight=False, markup=False)
@@ -463,6 +488,8 @@ def ursim(
         from .export.emulator.physics import MujocoBackend
 
         options["backend"] = MujocoBackend
+    if arm is not None:
+        options["calibration"] = arm.calibration
     try:
         serve(host, model, duration=duration, ready=ready, **options)
     except KeyboardInterrupt:
@@ -548,6 +575,71 @@ def demo(
             raise typer.Exit(code=1)
     console.print(f"job file: {out / 'job.toml'} (edit it and run: ruledrobot plan)",
                   highlight=False, markup=False)  # fmt: skip
+
+
+calibration_app = typer.Typer(
+    help="A robot's own kinematics: fetch it from a controller, show a calibration file.",
+    no_args_is_help=True,
+)
+app.add_typer(calibration_app, name="calibration")
+
+
+@calibration_app.command(
+    "fetch",
+    epilog="Example:  ruledrobot calibration fetch --host 192.168.1.10 --out robot.calib.json",
+)
+def calibration_fetch(
+    host: str = typer.Option(..., help="Controller address (primary interface port 30001)."),
+    out: Path = typer.Option(Path("robot.calib.json"), "--out", "-o", help="Calibration file."),
+    model: str | None = typer.Option(None, help="Robot model; default: ask the dashboard."),
+    timeout: float = typer.Option(5.0, min=0.5, help="Give up after this many seconds."),
+) -> None:
+    """Read the controller's calibrated kinematics (KinematicsInfo) and write them as a
+    calibration file for the job's ``[robot] calibration``."""
+    from .export.fetch_calibration import fetch_calibration
+    from .robot.calibration import save_calibration
+
+    try:
+        cal = fetch_calibration(host, model, timeout=timeout)
+        path = save_calibration(out, cal)
+    except (ValueError, OSError) as exc:
+        raise _fail(str(exc)) from None
+    _show_calibration(cal)
+    console.print(f"wrote {path}", highlight=False, markup=False)
+
+
+@calibration_app.command("show", epilog="Example:  ruledrobot calibration show robot.calib.json")
+def calibration_show(path: Path = typer.Argument(..., help="Calibration file.")) -> None:
+    """Print a calibration: model, source, status and its deviations from the nominal arm."""
+    from .robot.calibration import load_calibration
+
+    try:
+        cal = load_calibration(path)
+    except ValueError as exc:
+        raise _fail(str(exc)) from None
+    _show_calibration(cal)
+
+
+def _show_calibration(cal) -> None:
+    import numpy as np
+
+    from .robot.calibration import calibration_deviations
+
+    dev = calibration_deviations(cal)
+    lines = [repr(cal)]
+    if "axis_tilt" in dev:
+        lines += [
+            "  joint axes tilted (mrad): " + " ".join(f"{1e3 * v:.2f}" for v in dev["axis_tilt"]),
+            "  joint axes moved (mm):    " + " ".join(f"{1e3 * v:.2f}" for v in dev["axis_offset"]),
+            f"  flange at q = 0: {1e3 * dev['flange_position']:.2f} mm and "
+            f"{1e3 * dev['flange_rotation']:.2f} mrad from the nominal arm",
+            f"  d2 + d3 + d4 - nominal: {1e3 * dev['d_sum']:.3f} mm; theta2 + theta3 + theta4: "
+            f"{1e3 * dev['theta_sum']:.3f} mrad",
+        ]
+    lines.append("  effective DH [theta_offset, a, d, alpha] per joint:")
+    lines += [f"    {k + 1}: " + np.array2string(r, precision=9) for k, r in enumerate(cal.dh())]
+    for line in lines:
+        console.print(line, highlight=False, markup=False)
 
 
 def main() -> None:
