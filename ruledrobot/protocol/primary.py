@@ -23,6 +23,19 @@ kinematics — the nominal DH table with the robot's factory calibration::
     double[6] dh_alpha    # rad
     uint32    calibration_status
 
+Robot mode data (sub-package 0; UR's "Client Interface" documentation for 3.x and
+5.x, and the Universal Robots Client Library's ``RobotModeData``)::
+
+    uint64    timestamp
+    bool      isRealRobotConnected, isRealRobotEnabled, isRobotPowerOn,
+              isEmergencyStopped, isProtectiveStopped, isProgramRunning, isProgramPaused
+    int8      robotMode         # the RTDE robot modes: -1 no controller ... 7 running
+    uint8     controlMode       # 0 position, 1 teach, 2 force, 3 torque
+    double    targetSpeedFraction, speedScaling, targetSpeedFractionLimit
+    uint8     reserved          # 5.x only (47 bytes in all; 46 on 3.x)
+
+(bools are one byte each).  UR documents the timestamp's type, not its unit.
+
 A robot message (type 20) starts with ``uint64 timestamp, int8 source, uint8
 message type``; the version message (type 3) then holds ``uint8 n, char[n]
 project name, uint8 major, uint8 minor, int32 bugfix, int32 build, string
@@ -48,16 +61,20 @@ __all__ = [
     "MAX_MESSAGE_SIZE",
     "PRIMARY_PORT",
     "ROBOT_MESSAGE",
+    "ROBOT_MODE_DATA",
     "ROBOT_STATE",
     "SECONDARY_PORT",
     "KinematicsInfo",
     "PrimaryProtocolError",
+    "RobotModeData",
     "Version",
     "kinematics_info_subpackage",
     "parse_kinematics_info",
+    "parse_robot_mode_data",
     "parse_robot_state",
     "parse_version",
     "read_kinematics_info",
+    "robot_mode_subpackage",
     "robot_state_message",
     "split_messages",
     "version_message",
@@ -80,6 +97,10 @@ ROBOT_MESSAGE_VERSION = 3
 VERSION_SOURCE = -2
 
 _KIN_BODY = struct.Struct(">6I6d6d6d6dI")
+_MODE_BODY = struct.Struct(">Q7?bBddd")  # 41 bytes; 5.x appends one reserved byte
+#: robot mode data sub-package size (header included): 3.x, 5.x
+ROBOT_MODE_DATA_SIZE_V3 = 5 + _MODE_BODY.size  # 46
+ROBOT_MODE_DATA_SIZE_V5 = ROBOT_MODE_DATA_SIZE_V3 + 1  # 47
 KINEMATICS_INFO_SIZE = 5 + _KIN_BODY.size  # 225
 #: Largest message accepted (a robot-state message is about 1.5 kB).
 MAX_MESSAGE_SIZE = 1 << 20
@@ -108,6 +129,25 @@ class KinematicsInfo:
 
 
 @dataclass(frozen=True)
+class RobotModeData:
+    """Robot mode data (sub-package 0): power, stops, program state, modes, speed slider."""
+
+    timestamp: int
+    real_robot_connected: bool
+    real_robot_enabled: bool
+    power_on: bool
+    emergency_stopped: bool
+    protective_stopped: bool
+    program_running: bool
+    program_paused: bool
+    robot_mode: int
+    control_mode: int
+    target_speed_fraction: float
+    speed_scaling: float
+    target_speed_fraction_limit: float
+
+
+@dataclass(frozen=True)
 class Version:
     """The controller software version (``major.minor.bugfix.build``)."""
 
@@ -132,6 +172,21 @@ def kinematics_info_subpackage(info: KinematicsInfo) -> bytes:
                           *map(float, info.a), *map(float, info.d), *map(float, info.alpha),
                           int(info.calibration_status))  # fmt: skip
     return _SUB_HEADER.pack(KINEMATICS_INFO_SIZE, KINEMATICS_INFO) + body
+
+
+def robot_mode_subpackage(data: RobotModeData, *, reserved: bool = True) -> bytes:
+    """The robot mode data sub-package: 47 bytes with the reserved byte of 5.x
+    (``reserved=True``), 46 bytes as 3.x sends it."""
+    body = _MODE_BODY.pack(int(data.timestamp), bool(data.real_robot_connected),
+                           bool(data.real_robot_enabled), bool(data.power_on),
+                           bool(data.emergency_stopped), bool(data.protective_stopped),
+                           bool(data.program_running), bool(data.program_paused),
+                           int(data.robot_mode), int(data.control_mode),
+                           float(data.target_speed_fraction), float(data.speed_scaling),
+                           float(data.target_speed_fraction_limit))  # fmt: skip
+    if reserved:
+        body += b"\x00"
+    return _SUB_HEADER.pack(_SUB_HEADER.size + len(body), ROBOT_MODE_DATA) + body
 
 
 def robot_state_message(subpackages: list[bytes]) -> bytes:
@@ -199,6 +254,20 @@ def parse_kinematics_info(body: bytes) -> KinematicsInfo:
     if not np.isfinite(arr).all():
         raise PrimaryProtocolError("KinematicsInfo: DH values contain NaN or infinity")
     return KinematicsInfo(tuple(v[:6]), arr[0], arr[1], arr[2], arr[3], int(v[30]))
+
+
+def parse_robot_mode_data(body: bytes) -> RobotModeData:
+    """A robot mode data sub-package body (without its header): the 41 bytes of the
+    documented fields; what follows (5.x's reserved byte, fields a later version adds)
+    is ignored, as UR asks clients to do."""
+    if len(body) < _MODE_BODY.size:
+        raise PrimaryProtocolError(f"robot mode data: {len(body) + 5} bytes, expected at least "
+                                   f"{ROBOT_MODE_DATA_SIZE_V3}")  # fmt: skip
+    v = _MODE_BODY.unpack_from(body, 0)
+    if not all(np.isfinite(v[10:13])):
+        raise PrimaryProtocolError("robot mode data: speed fractions contain NaN or infinity")
+    return RobotModeData(int(v[0]), *(bool(b) for b in v[1:8]), int(v[8]), int(v[9]),
+                         float(v[10]), float(v[11]), float(v[12]))  # fmt: skip
 
 
 def parse_version(body: bytes) -> Version | None:

@@ -1,13 +1,15 @@
 """A UR controller emulator that the real ``ur_rtde`` client can drive.
 
-``Emulator(host, model)`` serves RTDE (30004), the dashboard (29999) and the
-script port (30003) on a loopback address, with a simulated arm behind them
-(:class:`KinematicBackend` by default; any :class:`ArmBackend` plugs in).
+``Emulator(host, model, calibration=None)`` serves RTDE (30004), the dashboard
+(29999), the script port (30003) and the primary and secondary client
+interfaces (30001, 30002) on a loopback address, with a simulated arm behind
+them (:class:`KinematicBackend` by default; any :class:`ArmBackend` plugs in);
+with a calibration it is that robot (its KinematicsInfo, its FK and IK).
 See ``docs/rtde.md`` for the protocol coverage, faults and timing.
 
 Modules, one job each: ``rtde_types`` (variable/type table), ``protocol``
-(RTDE packets and recipes), ``rtde_server``, ``dashboard``, ``script_port``
-(the three servers), ``program`` (URScript parsing), ``handshake`` (ur_rtde's
+(RTDE packets and recipes), ``rtde_server``, ``dashboard``, ``script_port``,
+``primary_port`` (the servers), ``program`` (URScript parsing), ``handshake`` (ur_rtde's
 control-script register protocol), ``script_runner`` (standalone programs),
 ``controller`` (state machine), ``motion`` (trajectory generator),
 ``backend`` (the arm), ``kinematics``, ``server`` (:class:`ThreadedEmulator`,

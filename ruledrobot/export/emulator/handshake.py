@@ -191,6 +191,7 @@ class ControlScript:
         self.async_motion: PathMotion | StopMotion | None = None
         self.async_progress = -1
         self._servoc_target: tuple | None = None
+        self._servol: tuple[tuple, np.ndarray] | None = None  # last servoL target, solution
         self._speedl: tuple[np.ndarray, float] | None = None
         self.out_int(0, READY)
         self.signal_async(-1)
@@ -323,11 +324,16 @@ class ControlScript:
             c.set_servo(q, self.in_d(9), self.in_d(10))
         elif cmd == Command.SERVOL:
             pose = self.in_vec(0)
-            q = c.kin.ik_nearest(pose, self._q_now())
-            if q is None:
-                raise MotionError(
-                    f"servol: no inverse kinematics solution for p{pose.round(6).tolist()}"
-                )
+            key = tuple(pose.tolist())
+            if self._servol is not None and self._servol[0] == key:
+                q = self._servol[1]  # the same target again: its solution (IK once per target)
+            else:
+                q = c.kin.ik_nearest(pose, self._q_now())
+                if q is None:
+                    raise MotionError(
+                        f"servol: no inverse kinematics solution for p{pose.round(6).tolist()}"
+                    )
+                self._servol = (key, q)
             c.set_servo(q, self.in_d(9), self.in_d(10))
         elif cmd == Command.SPEEDJ:
             c.set_speed(self.in_vec(0), self.in_d(6))

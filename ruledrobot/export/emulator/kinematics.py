@@ -6,6 +6,14 @@ sample, so the per-tick work here is plain Python float arithmetic (~20 us).
 IK goes through :meth:`RobotModel.ik` (all 8 analytic solutions) and picks
 the solution nearest a given configuration, as URScript's
 ``get_inverse_kin(x, qnear)`` does.
+
+A calibrated model (:meth:`RobotModel.with_calibration`) gives the calibrated
+chain everywhere: the TCP pose and speed, FK, IK (the model's IK refines the
+nominal closed form on the calibrated chain).  Only the elbow position comes
+from the nominal table: the DH frames of a calibrated table sit on the common
+normals of the nearly parallel axes 2-4, metres away from the arm (frame 3 of
+a calibrated UR5e can lie 175 m out), while the nominal elbow is within
+millimetres of the real one.
 """
 
 from __future__ import annotations
@@ -32,6 +40,37 @@ def _mat_mul(A: Sequence[Sequence[float]], B: Sequence[Sequence[float]]) -> list
         ]
         for i in range(4)
     ]
+
+
+_DHRow = tuple[float, float, float, float, float]
+
+
+def _dh_rows(model: RobotModel) -> list[_DHRow]:
+    """Per joint ``(d, a, cos alpha, sin alpha, theta_offset)``."""
+    return [
+        (float(d), float(a), math.cos(al), math.sin(al), float(off))
+        for d, a, al, off in zip(model.d, model.a, model.alpha, model.theta_offset, strict=True)
+    ]
+
+
+def _chain(
+    base: list[list[float]], rows: Sequence[_DHRow], q: Sequence[float]
+) -> list[list[list[float]]]:
+    """World poses (rows) of DH frames 0..len(rows) (pure Python floats)."""
+    T = base
+    out = [T]
+    for (d, a, ca, sa, off), qi in zip(rows, q, strict=False):
+        th = qi + off
+        ct, st = math.cos(th), math.sin(th)
+        A = (
+            (ct, -st * ca, st * sa, a * ct),
+            (st, ct * ca, -ct * sa, a * st),
+            (0.0, sa, ca, d),
+            (0.0, 0.0, 0.0, 1.0),
+        )
+        T = _mat_mul(T, A)
+        out.append(T)
+    return out
 
 
 def rotvec_from_rows(R: Sequence[Sequence[float]]) -> Vec:
@@ -81,10 +120,9 @@ class ArmKinematics:
     def __init__(self, model: RobotModel) -> None:
         if model.n_joints != 6:
             raise ValueError(f"model {model.name!r}: the emulator needs 6 joints")
-        self._dh = [
-            (float(d), float(a), math.cos(al), math.sin(al), float(off))
-            for d, a, al, off in zip(model.d, model.a, model.alpha, model.theta_offset, strict=True)
-        ]
+        self._dh = _dh_rows(model)
+        # the elbow (frame 3) of the nominal table for a calibrated arm (see the module doc)
+        self._elbow_dh = None if model.calibration is None else _dh_rows(model.nominal)[:3]
         self._base = [list(map(float, row)) for row in model.base]
         self.set_model(model)
 
@@ -102,20 +140,8 @@ class ArmKinematics:
 
     def frames(self, q: Sequence[float]) -> list[list[list[float]]]:
         """World poses (rows) of DH frames 0..6 and the TCP (8 entries)."""
-        T = self._base
-        out = [T]
-        for (d, a, ca, sa, off), qi in zip(self._dh, q, strict=True):
-            th = qi + off
-            ct, st = math.cos(th), math.sin(th)
-            A = (
-                (ct, -st * ca, st * sa, a * ct),
-                (st, ct * ca, -ct * sa, a * st),
-                (0.0, sa, ca, d),
-                (0.0, 0.0, 0.0, 1.0),
-            )
-            T = _mat_mul(T, A)
-            out.append(T)
-        out.append(_mat_mul(T, self._tool))
+        out = _chain(self._base, self._dh, q)
+        out.append(_mat_mul(out[-1], self._tool))
         return out
 
     def tcp_vector(self, q: Sequence[float]) -> Vec:
@@ -140,7 +166,8 @@ class ArmKinematics:
             vx += (z[1] * r[2] - z[2] * r[1]) * w
             vy += (z[2] * r[0] - z[0] * r[2]) * w
             vz += (z[0] * r[1] - z[1] * r[0]) * w
-        elbow = (F[3][0][3], F[3][1][3], F[3][2][3])
+        E = F[3] if self._elbow_dh is None else _chain(self._base, self._elbow_dh, q)[-1]
+        elbow = (E[0][3], E[1][3], E[2][3])
         return (*p, *rotvec_from_rows(T)), (vx, vy, vz, wx, wy, wz), elbow
 
     def fk_vector(self, q: ArrayLike, tcp: ArrayLike | None = None) -> np.ndarray:

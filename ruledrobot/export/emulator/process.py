@@ -31,9 +31,10 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ...robot import RobotModel
+from ...protocol.primary import KinematicsInfo
+from ...robot import Calibration, RobotModel
 from .backend import ArmBackend
-from .server import ThreadedEmulator
+from .server import ThreadedEmulator, emulated_model
 from .states import RobotMode, RuntimeState, SafetyMode
 
 __all__ = ["Emulator"]
@@ -65,6 +66,8 @@ _PROPS = frozenset(
         "ports",
         "popup",
         "programs_dir",
+        "calibration",
+        "kinematics_info",
     }
 )
 
@@ -118,7 +121,8 @@ def _child_entry(fd: int) -> None:  # pragma: no cover - runs in the child
 
 
 class Emulator:
-    """A UR controller emulator on ``host`` (RTDE 30004, dashboard 29999, script 30003).
+    """A UR controller emulator on ``host`` (RTDE 30004, dashboard 29999, script 30003,
+    primary 30001, secondary 30002).
 
     The real ur_rtde client (RTDEReceiveInterface, RTDEControlInterface,
     RTDEIOInterface, DashboardClient) connects to it as to a robot.
@@ -127,14 +131,17 @@ class Emulator:
     ----------
     host : loopback address to bind, e.g. ``"127.0.0.2"`` (see ``allow_remote``).
     model : robot model name (``"ur5e"``, ...) or a :class:`RobotModel`.
+    calibration : the robot's factory calibration (a :class:`~ruledrobot.robot.Calibration`
+        or a ``ruledrobot.calibration/1`` file) or None (nominal kinematics).  Checked
+        here: a calibration of another model raises ValueError before anything starts.
     in_process : run on threads of this process instead of a child process
         (never with a ur_rtde client in this process: it would deadlock).
     start_timeout : seconds to wait for the child to listen.
     **options : passed to :class:`~.server.ThreadedEmulator`: ``backend`` (an
         :class:`ArmBackend`, or a picklable factory ``model -> backend`` for the
         child process), ``q0``, ``rtde_port``, ``dashboard_port``,
-        ``script_port``, ``version``, ``serial_number``, ``unlock_delay``,
-        ``allow_remote``.
+        ``script_port``, ``primary_port``, ``secondary_port``, ``version``,
+        ``serial_number``, ``unlock_delay``, ``allow_remote``.
 
     Use as a context manager, or call :meth:`start` / :meth:`close`.
     """
@@ -148,6 +155,7 @@ class Emulator:
         start_timeout: float = 20.0,
         backend: ArmBackend | Callable[[RobotModel], ArmBackend] | None = None,
         q0: ArrayLike | None = None,
+        calibration: Calibration | str | os.PathLike | None = None,
         **options: Any,
     ) -> None:
         self.host = host
@@ -155,6 +163,8 @@ class Emulator:
         self.in_process = in_process
         self.start_timeout = float(start_timeout)
         self._kwargs: dict[str, Any] = dict(options, host=host, model=model, backend=backend)
+        if calibration is not None:  # refused here, before a child process starts
+            self._kwargs["calibration"] = emulated_model(model, calibration).calibration
         if q0 is not None:
             self._kwargs["q0"] = np.asarray(q0, dtype=float).tolist()
         self._local: ThreadedEmulator | None = None
@@ -335,6 +345,16 @@ class Emulator:
     def programs_dir(self) -> str:
         """The folder the dashboard's ``load`` serves programs from."""
         return str(self._call("programs_dir"))
+
+    @property
+    def calibration(self) -> Calibration | None:
+        """The calibration the emulator runs with (None: nominal kinematics)."""
+        return self._call("calibration")
+
+    @property
+    def kinematics_info(self) -> KinematicsInfo:
+        """The KinematicsInfo the primary interface serves."""
+        return self._call("kinematics_info")
 
     @property
     def popup(self) -> str | None:

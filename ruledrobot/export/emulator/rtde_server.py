@@ -37,7 +37,6 @@ import contextlib
 import logging
 import math
 import random
-import select
 import socket
 import struct
 import threading
@@ -67,7 +66,7 @@ from .protocol import (
     parse_output_setup,
 )
 from .rtde_types import TYPE_SIZES
-from .tcp import Connection, TcpServer
+from .tcp import Connection, QueuedConnection, TcpServer, writable_fds
 
 __all__ = ["RTDEConnection", "RTDEServer", "StreamStats", "due"]
 
@@ -96,24 +95,6 @@ def due(tick: int, ratio: float) -> bool:
     return math.floor(tick * ratio + 1e-9) != math.floor((tick - 1) * ratio + 1e-9)
 
 
-def _writable(conns: list[RTDEConnection]) -> set[int]:
-    """File descriptors of ``conns`` whose socket takes data now (one system call)."""
-    if not conns:
-        return set()
-    fds = [c.sock.fileno() for c in conns]
-    fds = [fd for fd in fds if fd >= 0]
-    poll = getattr(select, "poll", None)
-    try:
-        if poll is None:  # pragma: no cover - not Linux
-            return set(select.select([], fds, [], 0.0)[1])
-        p = poll()
-        for fd in fds:
-            p.register(fd, select.POLLOUT)
-        return {fd for fd, ev in p.poll(0) if ev & select.POLLOUT}
-    except (OSError, ValueError):
-        return set()
-
-
 def _fit(reply: bytes) -> bytes:
     """A setup reply that fits a packet; one that does not (thousands of ``NOT_FOUND``)
     becomes a bare failure (recipe id 0, no types)."""
@@ -126,11 +107,12 @@ class StreamStats:
     def __init__(self) -> None:
         self.packages = 0
         self.bytes = 0
-        self.dropped_backlog = 0
 
 
-class RTDEConnection(Connection):
+class RTDEConnection(QueuedConnection):
     """Protocol state of one RTDE client."""
+
+    kind = "rtde"
 
     def __init__(self, sock: socket.socket, addr: tuple) -> None:
         super().__init__(sock, addr)
@@ -138,56 +120,13 @@ class RTDEConnection(Connection):
         self.output: OutputRecipe | None = None
         self.inputs: dict[int, InputRecipe] = {}
         self.started = False
-        self.backlog = bytearray()
         self.delayed: deque[tuple[float, bytes]] = deque()
         self.stats = StreamStats()
         self.owned: set[str] = set()
-        self.broken = False  # a send failed or the backlog overflowed: close
 
     def idle_for(self, now: float) -> float:
         """A started stream is in use (it receives data every period), never idle."""
         return 0.0 if self.started and not self.broken else now - self.last_rx
-
-    @property
-    def closing(self) -> bool:
-        """Broken: the connection's own thread closes it (closing a socket with megabytes
-        unsent costs milliseconds, which the clock thread must not pay)."""
-        return self.broken
-
-    def push(self, data: bytes, max_backlog: int, send: bool = True) -> None:
-        """Queue bytes and send what the socket takes now, never blocking; beyond
-        ``max_backlog`` queued bytes the connection is marked broken (closed by its thread).
-
-        ``send=False``: only queue (the socket is known not to be writable: a send
-        attempt would only cost a GIL hand-off)."""
-        with self.write_lock:
-            if self.closed or self.broken:
-                return
-            self.backlog += data
-            if send:
-                self._flush_locked()
-            if len(self.backlog) > max_backlog:
-                self.stats.dropped_backlog += 1
-                log.warning("rtde: client %s does not read its data (%d bytes queued): closing",
-                            self.peer, len(self.backlog))  # fmt: skip
-                self.backlog = bytearray()
-                self.broken = True
-
-    def flush(self) -> None:
-        with self.write_lock:
-            if not self.closed and not self.broken and self.backlog:
-                self._flush_locked()
-
-    def _flush_locked(self) -> None:
-        try:
-            n = self.sock.send(self.backlog, socket.MSG_DONTWAIT)
-        except (BlockingIOError, InterruptedError):
-            return
-        except OSError:
-            self.backlog = bytearray()
-            self.broken = True
-            return
-        del self.backlog[:n]
 
     def reply(self, kind: int, payload: bytes, max_backlog: int = MAX_BACKLOG) -> None:
         """Queue a reply (never blocks; a client that does not read them is closed)."""
@@ -348,7 +287,7 @@ class RTDEServer(TcpServer):
                  if isinstance(c, RTDEConnection) and not c.closed and not c.broken]  # fmt: skip
         # connections with queued bytes: one poll() for all of them instead of a send
         # attempt each (every socket call hands the GIL to whichever thread wants it)
-        writable = _writable([c for c in conns if c.backlog])
+        writable = writable_fds([c for c in conns if c.backlog])
         # at most SEND_BUDGET of the period for socket calls; the rest is queued and goes
         # out next period; the order rotates so that no connection is always last
         deadline = time.perf_counter() + SEND_BUDGET * period

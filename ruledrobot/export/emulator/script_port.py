@@ -15,12 +15,13 @@ from __future__ import annotations
 
 import codecs
 import logging
+from collections.abc import Callable
 
 from .controller import Controller
 from .program import ProgramSplitter
 from .tcp import Connection, TcpServer
 
-__all__ = ["ScriptPortServer"]
+__all__ = ["ProgramReceiver", "ScriptPortServer", "receive_programs"]
 
 log = logging.getLogger("ruledrobot.export.emulator")
 
@@ -37,16 +38,44 @@ class ScriptPortServer(TcpServer):
         self.last_program: str = ""
 
     def handle(self, conn: Connection) -> None:
-        splitter = ProgramSplitter()
-        decoder = codecs.getincrementaldecoder("utf-8")(errors="replace")
+        def received(text: str) -> None:
+            self.programs_received += 1
+            self.last_program = text[:4096]
 
-        def on_data(data: bytes) -> None:
-            for text in splitter.feed(decoder.decode(data)):
-                self.programs_received += 1
-                self.last_program = text[:4096]
-                self.controller.load_script(text)
+        receive_programs(self, conn, self.controller, received)
 
-        try:
-            self.recv_loop(conn, on_data, bufsize=1 << 18)
-        except ValueError as exc:  # beyond MAX_PROGRAM_BYTES / MAX_LINE_BYTES
-            self.controller.log(f"{exc}: refused, connection from {conn.peer} closed", level=1)
+
+class ProgramReceiver:
+    """Cuts one connection's URScript into programs and hands each to the controller
+    (``received(text)`` is called first).  :meth:`feed` raises ValueError beyond
+    :data:`~.program.MAX_PROGRAM_BYTES` or :data:`~.program.MAX_LINE_BYTES` (the
+    connection must then close: the stream cannot be resynchronised)."""
+
+    def __init__(
+        self, controller: Controller, received: Callable[[str], None] | None = None
+    ) -> None:
+        self.controller = controller
+        self.received = received
+        self._splitter = ProgramSplitter()
+        self._decoder = codecs.getincrementaldecoder("utf-8")(errors="replace")
+
+    def feed(self, data: bytes) -> None:
+        for text in self._splitter.feed(self._decoder.decode(data)):
+            if self.received is not None:
+                self.received(text)
+            self.controller.load_script(text)
+
+
+def receive_programs(
+    server: TcpServer,
+    conn: Connection,
+    controller: Controller,
+    received: Callable[[str], None] | None = None,
+) -> None:
+    """Read URScript from ``conn`` until it closes (:class:`ProgramReceiver`); a program or
+    line beyond the bounds is refused: logged at error level, the connection closed."""
+    receiver = ProgramReceiver(controller, received)
+    try:
+        server.recv_loop(conn, receiver.feed, bufsize=1 << 18)
+    except ValueError as exc:  # beyond MAX_PROGRAM_BYTES / MAX_LINE_BYTES
+        controller.log(f"{exc}: refused, connection from {conn.peer} closed", level=1)

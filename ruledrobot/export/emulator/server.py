@@ -1,10 +1,10 @@
-"""The emulator core: a controller, its clock, and the three servers ur_rtde talks to.
+"""The emulator core: a controller, its clock, and the servers clients talk to.
 
 Ports default to the controller's (RTDE 30004, dashboard 29999, script
-30003).  ur_rtde's Python bindings cannot change them, so parallel emulators
-use distinct loopback addresses (127.0.0.2, 127.0.0.3, ...; all of
-127.0.0.0/8 is loopback on Linux).  The emulator binds to loopback only
-unless ``allow_remote=True``.
+30003, primary 30001, secondary 30002).  ur_rtde's Python bindings cannot
+change them, so parallel emulators use distinct loopback addresses
+(127.0.0.2, 127.0.0.3, ...; all of 127.0.0.0/8 is loopback on Linux).  The
+emulator binds to loopback only unless ``allow_remote=True``.
 """
 
 from __future__ import annotations
@@ -13,6 +13,7 @@ import contextlib
 import gc
 import ipaddress
 import logging
+import os
 import shutil
 import socket
 import sys
@@ -27,16 +28,26 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ...robot import RobotModel, load
-from .backend import ArmBackend
+from ...protocol.primary import KinematicsInfo
+from ...robot import Calibration, RobotModel, load, load_calibration
+from .backend import ArmBackend, KinematicBackend
 from .controller import Controller
 from .dashboard import DashboardServer
+from .primary_port import PrimaryPublisher, PrimaryServer
 from .rtde_server import RTDEServer
 from .script_port import ScriptPortServer
 from .states import RobotMode, RuntimeState, SafetyMode
 from .tcp import try_realtime_priority
 
-__all__ = ["CB3_VERSION", "E_SERIES_VERSION", "ClockStats", "ThreadedEmulator", "serve"]
+__all__ = [
+    "CB3_VERSION",
+    "E_SERIES_VERSION",
+    "ClockStats",
+    "ThreadedEmulator",
+    "emulated_model",
+    "kinematics_info_of",
+    "serve",
+]
 
 log = logging.getLogger("ruledrobot.export.emulator")
 
@@ -104,8 +115,50 @@ def _check_host(host: str, allow_remote: bool) -> None:
         )
 
 
+def emulated_model(
+    model: str | RobotModel, calibration: Calibration | str | os.PathLike | None = None
+) -> RobotModel:
+    """The arm an emulator runs: ``model`` (a catalogue name or a :class:`RobotModel`) with
+    ``calibration`` (a :class:`~ruledrobot.robot.Calibration` or a ``ruledrobot.calibration/1``
+    file) attached.  ValueError (naming both models) for a calibration of another model,
+    :class:`~ruledrobot.robot.CalibrationError` for a bad file."""
+    arm = load(model) if isinstance(model, str) else model
+    if not isinstance(arm, RobotModel):
+        raise ValueError(f"model: expected a model name or a RobotModel, got {type(arm).__name__}")
+    if calibration is None:
+        return arm
+    if isinstance(calibration, (str, os.PathLike)):
+        cal, where = load_calibration(calibration), f"{os.fspath(calibration)}: "
+    else:
+        cal, where = calibration, ""
+    if not isinstance(cal, Calibration):
+        raise ValueError(f"calibration: expected a Calibration or a file, got {type(cal).__name__}")
+    if cal.model != arm.name:
+        raise ValueError(
+            f"{where}a calibration of a {cal.model} (source {cal.source!r}), but the emulator "
+            f"is a {arm.name}: refused"
+        )
+    return arm.with_calibration(cal)
+
+
+def kinematics_info_of(model: RobotModel) -> KinematicsInfo:
+    """The KinematicsInfo an emulator of ``model`` serves: its calibration's (effective table,
+    checksums, status; checksums 0 and status 2 where the calibration has none), or for
+    an uncalibrated model its DH table with checksums 0 and status 2 ("linearised": the
+    table is the emulated arm's exact kinematics)."""
+    if model.calibration is not None:
+        return model.calibration.kinematics_info()
+    if model.n_joints != 6:
+        raise ValueError(f"model {model.name!r}: KinematicsInfo needs 6 joints")
+    return KinematicsInfo(
+        checksum=(0,) * 6, theta=np.array(model.theta_offset), a=np.array(model.a),
+        d=np.array(model.d), alpha=np.array(model.alpha), calibration_status=2,
+    )  # fmt: skip
+
+
 class ThreadedEmulator:
-    """A UR controller on ``host`` in this process: RTDE, dashboard, script port, simulated arm.
+    """A UR controller on ``host`` in this process: RTDE, dashboard, script port, primary
+    and secondary interfaces, simulated arm.
 
     Runs on threads of the calling process.  ur_rtde's Python bindings hold
     the GIL while they wait for the controller, so a ur_rtde client in the
@@ -118,9 +171,15 @@ class ThreadedEmulator:
     host : address to bind (loopback, e.g. ``"127.0.0.2"``, unless ``allow_remote``).
     model : robot model name or :class:`RobotModel` (its control period sets the
         clock: 500 Hz e-Series, 125 Hz CB3; its tool is the initial TCP).
+    calibration : the robot's factory calibration (:class:`~ruledrobot.robot.Calibration`
+        or a ``ruledrobot.calibration/1`` file), or None: the emulator is then that
+        robot (its KinematicsInfo, its FK and IK in everything it reports and does).
+        A calibration of another model is refused (ValueError).
     backend : arm backend, or a factory called with the model (default: kinematic).
+        It simulates the joints of the nominal arm (its dynamics).
     q0 : initial joint positions [rad].
-    rtde_port, dashboard_port, script_port : ports (0 picks free ones).
+    rtde_port, dashboard_port, script_port, primary_port, secondary_port : ports (0
+        picks free ones).
     version : controller version reported to clients (default 5.11.1 for
         e-Series models, 3.15.7 for CB3).
     serial_number : digits, reported by ``get serial number``.
@@ -145,9 +204,12 @@ class ThreadedEmulator:
         *,
         backend: ArmBackend | Callable[[RobotModel], ArmBackend] | None = None,
         q0: ArrayLike | None = None,
+        calibration: Calibration | str | os.PathLike | None = None,
         rtde_port: int = 30004,
         dashboard_port: int = 29999,
         script_port: int = 30003,
+        primary_port: int = 30001,
+        secondary_port: int = 30002,
         version: tuple[int, int, int, int] | None = None,
         serial_number: str = "20235500001",
         unlock_delay: float = 5.0,
@@ -160,7 +222,9 @@ class ThreadedEmulator:
         _check_host(host, allow_remote)
         self.realtime = realtime
         self.realtime_clock = False
-        self.model = load(model) if isinstance(model, str) else model
+        self.model = emulated_model(model, calibration)
+        self.calibration: Calibration | None = self.model.calibration
+        self.kinematics_info = kinematics_info_of(self.model)
         if not serial_number.isdigit():
             raise ValueError(f"serial_number: digits only, got {serial_number!r}")
         if version is None:
@@ -168,13 +232,15 @@ class ThreadedEmulator:
         self.version = tuple(int(x) for x in version)
         self.host = host
         if isinstance(backend, type) or (callable(backend) and not hasattr(backend, "state")):
-            backend = backend(self.model)  # a factory: called with the model
+            backend = backend(self.model.nominal)  # a factory: called with the (nominal) model
         self._own_programs = programs_dir is None
         if programs_dir is None:
             programs_dir = tempfile.mkdtemp(prefix="ruledrobot-programs-")
         elif not Path(programs_dir).is_dir():
             raise ValueError(f"programs_dir: {programs_dir!r} is not a folder")
         self.programs_dir = str(programs_dir)
+        if backend is None:
+            backend = KinematicBackend(self.model.nominal)
         self.controller = Controller(self.model, backend, q0=q0, unlock_delay=unlock_delay,
                                      programs_dir=self.programs_dir)  # fmt: skip
         limits = {"max_connections": max_connections, "idle_timeout": idle_timeout}
@@ -186,7 +252,16 @@ class ThreadedEmulator:
         self.script = ScriptPortServer(host, script_port, self.controller, **limits)
         self.frozen = threading.Event()  # the frozen-controller fault
         self._thaw: threading.Timer | None = None
-        for srv in (self.rtde, self.dashboard, self.script):
+        self.primary = PrimaryServer(host, primary_port, self.controller, self._hello,
+                                     name="primary", **limits)  # fmt: skip
+        self.secondary = PrimaryServer(host, secondary_port, self.controller, self._hello,
+                                       name="secondary", **limits)  # fmt: skip
+        major, minor, bugfix, build = self.version
+        self.publisher = PrimaryPublisher(self.controller, (self.primary, self.secondary),
+                                          self.kinematics_info, (major, minor, bugfix, build),
+                                          self.frozen)  # fmt: skip
+        self._servers = (self.rtde, self.dashboard, self.script, self.primary, self.secondary)
+        for srv in self._servers:
             srv.realtime = realtime
             srv.frozen = self.frozen
         self.stats = ClockStats(lateness=deque(maxlen=20000), gaps=deque(maxlen=20000))
@@ -202,20 +277,22 @@ class ThreadedEmulator:
             return self
         started = []
         try:
-            for srv in (self.rtde, self.dashboard, self.script):
+            for srv in self._servers:
                 srv.start()
                 started.append(srv)
         except OSError:
             for srv in started:
                 srv.close(timeout=1.0)
             raise
+        self.publisher.start()
         _acquire_switch_interval()
         gc.callbacks.append(self._gc_timer)
         self._started = True
         self._clock = threading.Thread(target=self._run_clock, name="emu-clock", daemon=True)
         self._clock.start()
-        log.info("emulator %s on %s: rtde %d, dashboard %d, script %d", self.model.name,
-                 self.host, self.rtde.port, self.dashboard.port, self.script.port)  # fmt: skip
+        log.info("emulator %s on %s: rtde %d, dashboard %d, script %d, primary %d, secondary %d",
+                 self.model.name, self.host, self.rtde.port, self.dashboard.port,
+                 self.script.port, self.primary.port, self.secondary.port)  # fmt: skip
         return self
 
     def close(self, timeout: float = 3.0) -> None:
@@ -228,8 +305,9 @@ class ThreadedEmulator:
         self._stop.set()
         if self._clock is not None:
             self._clock.join(max(0.1, deadline - time.monotonic()))
-        for srv in (self.rtde, self.dashboard, self.script):
-            srv.close(timeout=max(0.1, (deadline - time.monotonic()) / 3))
+        self.publisher.close(timeout=max(0.1, (deadline - time.monotonic()) / 6))
+        for srv in self._servers:
+            srv.close(timeout=max(0.1, (deadline - time.monotonic()) / 6))
         with contextlib.suppress(ValueError):
             gc.callbacks.remove(self._gc_timer)
         _release_switch_interval()
@@ -245,6 +323,9 @@ class ThreadedEmulator:
     @property
     def running(self) -> bool:
         return self._started and self._clock is not None and self._clock.is_alive()
+
+    def _hello(self) -> bytes:
+        return self.publisher.hello()
 
     # ------------------------------------------------------------ clock
 
@@ -337,7 +418,7 @@ class ThreadedEmulator:
     def drop_connections(self, refuse_for: float = 0.0) -> int:
         """Fault: close every client connection; refuse new ones for ``refuse_for`` s."""
         n = 0
-        for srv in (self.rtde, self.dashboard, self.script):
+        for srv in self._servers:
             n += srv.drop_all(refuse_for)
         self.controller.log(f"dropped {n} connections (refusing for {refuse_for:g} s)", level=2)
         return n
@@ -422,11 +503,14 @@ class ThreadedEmulator:
 
     @property
     def ports(self) -> dict[str, int]:
-        """The bound ports: ``{"rtde": ..., "dashboard": ..., "script": ...}``."""
+        """The bound ports: ``{"rtde": ..., "dashboard": ..., "script": ..., "primary": ...,
+        "secondary": ...}``."""
         return {
             "rtde": self.rtde.port,
             "dashboard": self.dashboard.port,
             "script": self.script.port,
+            "primary": self.primary.port,
+            "secondary": self.secondary.port,
         }
 
     def stats_summary(self) -> dict[str, float]:
@@ -435,8 +519,15 @@ class ThreadedEmulator:
         out["rtde_protocol_errors"] = float(self.rtde.protocol_errors)
         out["publish_errors"] = float(self.rtde.publish_errors + self.stats.publish_errors)
         out["rtde_connections"] = float(len(self.rtde.connections()))
-        out["programs_received"] = float(self.script.programs_received)
-        servers = (self.rtde, self.dashboard, self.script)
+        out["programs_received"] = float(self.script.programs_received
+                                         + self.primary.programs_received
+                                         + self.secondary.programs_received)  # fmt: skip
+        out["primary_connections"] = float(len(self.primary.connections())
+                                           + len(self.secondary.connections()))  # fmt: skip
+        out["primary_messages"] = float(self.publisher.sent)
+        out["primary_dropped"] = float(self.primary.dropped + self.secondary.dropped)
+        out["primary_errors"] = float(self.publisher.errors)
+        servers = self._servers
         out["refused_connections"] = float(sum(s.refused for s in servers))
         out["evicted_connections"] = float(sum(s.evicted for s in servers))
         out["limit_events"] = float(self.controller.limit_events)

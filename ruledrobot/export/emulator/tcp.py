@@ -1,6 +1,8 @@
 """A small threaded TCP server: accept loop, one reader thread per connection, clean shutdown.
 
-Subclasses implement :meth:`TcpServer.handle` (the per-connection loop).  Every
+Subclasses implement :meth:`TcpServer.handle` (the per-connection loop), or, with
+``single_thread`` set, :meth:`TcpServer.on_data`: one selector thread then reads every
+connection of the server (for servers that mostly send: no thread per client).  Every
 socket has a short timeout so threads notice :meth:`TcpServer.close` within
 ``POLL`` seconds; ``close`` is bounded in time.  :meth:`TcpServer.drop_all`
 closes every connection and refuses new ones for a while (the "dropped
@@ -23,13 +25,14 @@ from __future__ import annotations
 import contextlib
 import logging
 import os
+import select
 import selectors
 import socket
 import threading
 import time
 from collections.abc import Callable
 
-__all__ = ["IDLE_WAIT", "POLL", "Connection", "TcpServer"]
+__all__ = ["IDLE_WAIT", "POLL", "Connection", "QueuedConnection", "TcpServer", "writable_fds"]
 
 log = logging.getLogger("ruledrobot.export.emulator")
 
@@ -87,6 +90,86 @@ class Connection:
             self.sock.close()
 
 
+class QueuedConnection(Connection):
+    """A connection whose sends never wait: bytes the socket does not take are queued.
+
+    Used by the streaming servers (RTDE, primary interface): the thread that sends
+    (the clock, the publisher) must never block on one client.  Beyond a bound the
+    connection is marked ``broken`` and its own thread closes it.
+    """
+
+    #: the server's name in log lines
+    kind = "tcp"
+
+    def __init__(self, sock: socket.socket, addr: tuple) -> None:
+        super().__init__(sock, addr)
+        self.backlog = bytearray()
+        self.broken = False  # a send failed or the backlog overflowed: close
+        self.dropped_backlog = 0
+        self.last_tx = time.monotonic()  # when the socket last took bytes
+
+    @property
+    def closing(self) -> bool:
+        """Broken: the connection's own thread closes it (closing a socket with megabytes
+        unsent costs milliseconds, which the sending thread must not pay)."""
+        return self.broken
+
+    def push(self, data: bytes, max_backlog: int, send: bool = True) -> None:
+        """Queue bytes and send what the socket takes now, never blocking; beyond
+        ``max_backlog`` queued bytes the connection is marked broken (closed by its thread).
+
+        ``send=False``: only queue (the socket is known not to be writable: a send
+        attempt would only cost a GIL hand-off)."""
+        with self.write_lock:
+            if self.closed or self.broken:
+                return
+            self.backlog += data
+            if send:
+                self._flush_locked()
+            if len(self.backlog) > max_backlog:
+                self.dropped_backlog += 1
+                log.warning("%s: client %s does not read its data (%d bytes queued): closing",
+                            self.kind, self.peer, len(self.backlog))  # fmt: skip
+                self.backlog = bytearray()
+                self.broken = True
+
+    def flush(self) -> None:
+        with self.write_lock:
+            if not self.closed and not self.broken and self.backlog:
+                self._flush_locked()
+
+    def _flush_locked(self) -> None:
+        try:
+            n = self.sock.send(self.backlog, socket.MSG_DONTWAIT)
+        except (BlockingIOError, InterruptedError):
+            return
+        except OSError:
+            self.backlog = bytearray()
+            self.broken = True
+            return
+        if n:
+            self.last_tx = time.monotonic()
+        del self.backlog[:n]
+
+
+def writable_fds(conns: list[QueuedConnection]) -> set[int]:
+    """File descriptors of ``conns`` whose socket takes data now (one system call)."""
+    if not conns:
+        return set()
+    fds = [c.sock.fileno() for c in conns]
+    fds = [fd for fd in fds if fd >= 0]
+    poll = getattr(select, "poll", None)
+    try:
+        if poll is None:  # pragma: no cover - not Linux
+            return set(select.select([], fds, [], 0.0)[1])
+        p = poll()
+        for fd in fds:
+            p.register(fd, select.POLLOUT)
+        return {fd for fd, ev in p.poll(0) if ev & select.POLLOUT}
+    except (OSError, ValueError):
+        return set()
+
+
 def try_realtime_priority(priority: int) -> bool:
     """Give the calling thread ``SCHED_FIFO`` ``priority`` if allowed (Linux, CAP_SYS_NICE)."""
     setter = getattr(os, "sched_setscheduler", None)
@@ -111,6 +194,9 @@ class TcpServer:
     realtime = False
     #: non-blocking sockets (no send ever waits; :meth:`recv_loop` waits in a selector)
     nonblocking = False
+    #: one selector thread reads every connection (:meth:`on_data`) instead of a thread
+    #: each running :meth:`handle`; the sockets are non-blocking
+    single_thread = False
 
     def __init__(
         self, host: str, port: int, *, max_connections: int = 32, idle_timeout: float = 10.0
@@ -132,6 +218,9 @@ class TcpServer:
         self._refuse_until = 0.0
         self._listener: socket.socket | None = None
         self._accept_thread: threading.Thread | None = None
+        self._select_thread: threading.Thread | None = None
+        self._new: list[Connection] = []  # accepted, to be registered by the selector thread
+        self._wake: tuple[socket.socket, socket.socket] | None = None
         #: set: a frozen controller (nothing accepted, read or answered; sockets stay open)
         self.frozen = threading.Event()
         self.accepted = 0
@@ -153,6 +242,14 @@ class TcpServer:
         s.settimeout(POLL)
         self.port = s.getsockname()[1]
         self._listener = s
+        if self.single_thread:
+            self._wake = socket.socketpair()
+            for w in self._wake:
+                w.setblocking(False)
+            self._select_thread = threading.Thread(
+                target=self._select_loop, name=f"emu-{self.name}-read", daemon=True
+            )
+            self._select_thread.start()
         self._accept_thread = threading.Thread(
             target=self._accept_loop, name=f"emu-{self.name}-accept", daemon=True
         )
@@ -170,8 +267,9 @@ class TcpServer:
                 self._listener.close()
         for c in self.connections():
             c.close()
+        self._wakeup()
         deadline = time.monotonic() + timeout
-        threads = [self._accept_thread, *self._threads]
+        threads = [self._accept_thread, self._select_thread, *self._threads]
         for t in threads:
             if t is not None and t is not threading.current_thread():
                 t.join(max(0.0, deadline - time.monotonic()))
@@ -186,6 +284,7 @@ class TcpServer:
         conns = self.connections()
         for c in conns:
             c.close()
+        self._wakeup()
         return len(conns)
 
     # ------------------------------------------------------------ internals
@@ -211,7 +310,7 @@ class TcpServer:
                 with contextlib.suppress(OSError):
                     sock.close()
                 continue
-            if self.nonblocking:
+            if self.nonblocking or self.single_thread:
                 sock.setblocking(False)
             else:
                 sock.settimeout(POLL)
@@ -219,6 +318,12 @@ class TcpServer:
                 sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
             conn = self.make_connection(sock, addr)
             self.accepted += 1
+            if self.single_thread:
+                with self._lock:
+                    self._conns[id(conn)] = conn
+                    self._new.append(conn)
+                self._wakeup()
+                continue
             with self._lock:
                 self._conns[id(conn)] = conn
                 self._threads = [t for t in self._threads if t.is_alive()]
@@ -248,6 +353,87 @@ class TcpServer:
                  victim.idle_for(now))  # fmt: skip
         victim.close()
         return True
+
+    def _wakeup(self) -> None:
+        """Make the selector thread look at its connections now (new, closed, closing)."""
+        if self._wake is not None:
+            with contextlib.suppress(OSError):
+                self._wake[1].send(b"\0")
+
+    def _select_loop(self) -> None:
+        """The ``single_thread`` reader: every connection of this server, one selector."""
+        assert self._wake is not None
+        if self.realtime:
+            try_realtime_priority(5)
+        wake = self._wake[0]
+        sel = selectors.DefaultSelector()
+        sel.register(wake, selectors.EVENT_READ)
+        mine: dict[int, Connection] = {}
+        try:
+            while not self._stop.is_set():
+                # first the connections closed elsewhere (their fd numbers may be reused by
+                # the newcomers), then the newcomers
+                for key in [k for k, c in mine.items() if c.closed or c.closing]:
+                    self._finish(sel, mine.pop(key))
+                with self._lock:
+                    new, self._new = self._new, []
+                for conn in new:
+                    for attempt in range(2):
+                        try:
+                            sel.register(conn.sock, selectors.EVENT_READ, conn)
+                        except KeyError:  # its fd number is a connection closed just now
+                            for key in [k for k, c in mine.items() if c.closed]:
+                                self._finish(sel, mine.pop(key))
+                            if attempt == 0:
+                                continue
+                            self._finish(sel, conn)
+                        except (OSError, ValueError):
+                            self._finish(sel, conn)
+                        else:
+                            mine[id(conn)] = conn
+                        break
+                if self.frozen.is_set():  # nothing read; the kernel buffers what arrives
+                    self._stop.wait(POLL)
+                    continue
+                for key, _ in sel.select(IDLE_WAIT):
+                    if key.fileobj is wake:
+                        with contextlib.suppress(OSError):
+                            while wake.recv(4096):
+                                pass
+                        continue
+                    conn = key.data
+                    try:
+                        data = conn.sock.recv(65536)
+                    except (BlockingIOError, InterruptedError):
+                        continue
+                    except OSError:
+                        data = b""
+                    if not data:
+                        conn.close()
+                        continue
+                    conn.last_rx = time.monotonic()
+                    try:
+                        self.on_data(conn, data)
+                    except Exception as exc:
+                        self.errors += 1
+                        log.warning("%s server: connection %s closed after an error: %s",
+                                    self.name, conn.peer, exc)  # fmt: skip
+                        conn.close()
+        finally:
+            for conn in mine.values():
+                self._finish(sel, conn)
+            sel.close()
+            for w in self._wake:
+                with contextlib.suppress(OSError):
+                    w.close()
+
+    def _finish(self, sel: selectors.BaseSelector, conn: Connection) -> None:
+        with contextlib.suppress(KeyError, ValueError, OSError):
+            sel.unregister(conn.sock)
+        conn.close()
+        with self._lock:
+            self._conns.pop(id(conn), None)
+        self.on_close(conn)
 
     def _run(self, conn: Connection) -> None:
         if self.realtime:
@@ -318,6 +504,10 @@ class TcpServer:
         return Connection(sock, addr)
 
     def handle(self, conn: Connection) -> None:
+        raise NotImplementedError
+
+    def on_data(self, conn: Connection, data: bytes) -> None:
+        """``single_thread`` servers: bytes arrived on ``conn`` (raise to close it)."""
         raise NotImplementedError
 
     def on_close(self, conn: Connection) -> None:
