@@ -130,7 +130,7 @@ def test_export_urscript_and_dry_run(tmp_path):
 
 def test_run_streams_to_the_embedded_emulator(tmp_path):
     traj = _small_trajectory(tmp_path)
-    result = runner.invoke(app, ["run", str(traj)])
+    result = runner.invoke(app, ["run", str(traj), "--yes"])
     assert result.exit_code == 0, result.output
     assert "completed" in result.output
-    assert (tmp_path / "t.actual.csv").exists()
+    assert (tmp_path / "t.run-001.csv").exists()
