@@ -374,9 +374,10 @@ def test_truncated_and_closing_primary_clients_do_not_disturb_rtde(
     assert np.count_nonzero(during > 0.010) <= 3 + 3 * np.count_nonzero(base > 0.010)
     assert stats["tick_errors"] == 0 and stats["publish_errors"] == 0
     assert stats["primary_errors"] == 0 and stats["missed_fraction"] < 0.02, stats
-    # the well-behaved primary client kept its (dense) stream
-    gaps = np.diff([t for t, _ in good.states()])
-    assert len(gaps) > 500 and float(gaps.max()) < 0.1, float(gaps.max())
+    # the well-behaved primary client kept its (dense) stream (the first gap is the old
+    # 100 ms period the publisher was waiting out when the test changed it)
+    gaps = np.diff([t for t, _ in good.states()][2:])
+    assert len(gaps) > 500 and float(gaps.max()) < 0.05, float(gaps.max())
     # the clients that never read were dropped while the test ran; now all are gone
     assert stats["primary_dropped"] >= 1, stats
     assert _wait(lambda: stats_now(local)["primary_connections"] == 0, 5.0)
