@@ -316,6 +316,9 @@ def run(
     ),
     yes: bool = typer.Option(False, "--yes", "-y", help="Start without asking (scripts)."),
     dry_run: bool = typer.Option(False, "--dry-run", help="Check everything, move nothing."),
+    force: bool = typer.Option(
+        False, "--force", help="Run although the controller's kinematics differ from the plan's."
+    ),
 ) -> None:
     """Stream a planned trajectory to a UR controller through RTDE (ur_rtde): checks the
     controller (robot model, period, state) and shows the approach move before asking to
@@ -326,8 +329,13 @@ def run(
 
     if not (yes or dry_run or sys.stdin.isatty()):
         raise _fail("no terminal to confirm the motion on: pass --yes to start without asking")
+    if force:
+        err.print("--force: the controller's kinematics are NOT checked against the plan's; "
+                  "the wire may miss the cut", style="bold red", highlight=False,
+                  markup=False)  # fmt: skip
     result = _stream(trajectory, host, yes=yes, mode=mode.value, speed_scale=speed_scale,
-                     dry_run=dry_run, start_index=resume or 0)  # fmt: skip
+                     dry_run=dry_run, start_index=resume or 0,
+                     force_kinematics=force)  # fmt: skip
     if not result.completed or (result.verdict is not None and not result.verdict.ok):
         raise typer.Exit(code=1)
 

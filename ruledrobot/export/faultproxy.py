@@ -1,6 +1,7 @@
 """A loopback TCP proxy that can freeze or drop a controller's connections, for fault tests.
 
-ur_rtde connects to fixed ports (RTDE 30004, dashboard 29999, script 30003)
+The runner and ur_rtde connect to fixed ports (RTDE 30004, dashboard 29999, script 30003,
+primary 30001)
 on one host, so the proxy listens on another loopback address with the same
 ports and forwards to the controller's (an :class:`~.emulator.Emulator`, or
 URSim on loopback)::
@@ -37,7 +38,7 @@ from multiprocessing.connection import Connection
 __all__ = ["UR_PORTS", "FaultProxy"]
 
 #: the ports ur_rtde uses: RTDE, dashboard, script
-UR_PORTS = (30004, 29999, 30003)
+UR_PORTS = (30004, 29999, 30003, 30001)  # + primary interface (KinematicsInfo)
 _BUF = 1 << 16
 
 

@@ -17,7 +17,9 @@ import socket
 import time
 from dataclasses import dataclass
 
-from ..robot.trajectory import TrajectoryMeta
+import numpy as np
+
+from ..robot.trajectory import KinematicsRef, TrajectoryMeta
 from ..robot.verdict import Check
 
 __all__ = [
@@ -123,7 +125,8 @@ def query_dashboard(
 
 
 def controller_checks(meta: TrajectoryMeta, info: ControllerInfo) -> list[Check]:
-    """Robot model and control period against the trajectory's; kinematics (hook)."""
+    """Robot model and control period against the trajectory's (the kinematics:
+    :func:`kinematics_check`)."""
     checks = []
     said = f"dashboard said {info.model_reply!r} and {info.version_reply!r}"
     robot = info.robot
@@ -176,18 +179,69 @@ def controller_checks(meta: TrajectoryMeta, info: ControllerInfo) -> list[Check]
             "" if ok else detail,
         )
     )
-    # HOOK(kinematics): compare the controller's calibrated kinematics with
-    # meta.kinematics.checksum once the primary interface's KinematicsInfo
-    # package (port 30001) is read; until then this is information, not a pass.
-    checks.append(
-        Check.info(
-            "kinematics",
-            f"kinematics (trajectory's: {meta.kinematics.source}, "
-            f"{meta.kinematics.checksum[:15]}...)",
-            "not checked (controller kinematics not read yet)",
-        )
-    )
     return checks
+
+
+def kinematics_check(meta: TrajectoryMeta, host: str, *, timeout: float = 3.0,
+                     force: bool = False) -> tuple[Check, KinematicsRef | None]:  # fmt: skip
+    """The controller's kinematics (KinematicsInfo, primary interface) against the ones
+    the trajectory was planned with: the same DH table (to 1e-12) and, when the
+    trajectory knows them, the same per-joint checksums.  ``force`` turns a mismatch
+    into information (a conscious choice, shown as such).  Also returns the
+    controller's kinematics (None when not read): a recording is in *its* frame."""
+    check, info = _kinematics_check(meta, host, timeout, force)
+    if info is None:
+        return check, None
+    nominal = not np.any(np.abs(info.dh() - _nominal_dh(meta.robot)) > 1e-12)
+    ref = KinematicsRef(info.dh(), "nominal" if nominal else f"controller {host}", "",
+                        None if nominal else tuple(int(c) for c in info.checksum))  # fmt: skip
+    return check, ref
+
+
+def _kinematics_check(meta: TrajectoryMeta, host: str, timeout: float, force: bool):
+    from ..protocol.primary import PrimaryProtocolError, read_kinematics_info
+
+    label = f"kinematics (planned with: {meta.kinematics.source})"
+    try:
+        info, _ = read_kinematics_info(host, timeout=timeout)
+    except (OSError, PrimaryProtocolError) as exc:
+        detail = f"the controller's kinematics could not be read: {exc}"
+        if force:
+            return Check.info("kinematics", label, "not read (--force)", detail=detail), None
+        failed = Check("kinematics", label, "not read", "the trajectory's", relation="==",
+                       ok=False, detail=detail + "; --force runs without this check")  # fmt: skip
+        return failed, None
+    planned = meta.kinematics.dh
+    diff = info.dh() - planned
+    names = ("theta_offset", "a", "d", "alpha")
+    off = np.argwhere(np.abs(diff) > 1e-12)[:4]
+    problems = [f"joint {j + 1} {names[c]}: controller {info.dh()[j, c]:.9g}, planned "
+                f"{planned[j, c]:.9g}" for j, c in off]  # fmt: skip
+    want = meta.kinematics.controller_checksum
+    if want is not None and tuple(info.checksum) != tuple(want):
+        bad = [j + 1 for j in range(6) if info.checksum[j] != want[j]]
+        problems.append(f"checksums of joints {bad} differ (controller {list(info.checksum)}, "
+                        f"planned {list(want)})")  # fmt: skip
+    source = "nominal" if not np.any(np.abs(
+        info.dh() - _nominal_dh(meta.robot)) > 1e-12) else "calibrated"  # fmt: skip
+    value = f"{source}, checksums {list(info.checksum)}"
+    if not problems:
+        return Check("kinematics", label, value, "the trajectory's", relation="==", ok=True), info
+    detail = ("the trajectory was planned for other kinematics than the controller's: "
+              + "; ".join(problems) + ". Fetch the calibration (ruledrobot calibration fetch) "
+              "and plan again")  # fmt: skip
+    if force:
+        return Check.info("kinematics", label, value + " — MISMATCH ignored (--force)",
+                          detail=detail), info  # fmt: skip
+    return Check("kinematics", label, value, "the trajectory's", relation="==", ok=False,
+                 detail=detail), info  # fmt: skip
+
+
+def _nominal_dh(robot: str) -> np.ndarray:
+    from ..robot import load
+
+    m = load(robot)
+    return np.stack([m.theta_offset, m.a, m.d, m.alpha], axis=1)
 
 
 def readiness_check(host: str, state: dict) -> Check:

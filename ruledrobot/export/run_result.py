@@ -7,7 +7,7 @@ from dataclasses import dataclass, field
 from enum import Enum
 from pathlib import Path
 
-from ..robot.trajectory import Trajectory
+from ..robot.trajectory import KinematicsRef, Trajectory
 from ..robot.verdict import Check, Verdict
 from .run_plan import Entry, StopPlace
 
@@ -94,6 +94,8 @@ class RunResult:
     actual: Trajectory | None = None
     actual_path: Path | None = None
     verdict: Verdict | None = None
+    #: the controller's kinematics as read before motion (the recording's frame)
+    controller_kinematics: KinematicsRef | None = None
     entry: Entry | None = None
     requested_index: int = 0
     stop: StopPlace | None = None

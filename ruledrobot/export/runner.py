@@ -38,7 +38,7 @@ from ..robot.trajectory import Trajectory
 from ..robot.verdict import Check, Verdict
 from .decimate import decimate_tcp_path
 from .limits import check_trajectory
-from .run_checks import controller_checks, query_dashboard, readiness_check
+from .run_checks import controller_checks, kinematics_check, query_dashboard, readiness_check
 from .run_plan import (
     Entry,
     path_waypoints,
@@ -96,6 +96,7 @@ def run_trajectory(
     progress: ProgressFn | None = None,
     start_index: int = 0,
     confirm: Callable[[RunPlan], bool] | None = None,
+    force_kinematics: bool = False,
     approach_speed: float = 0.25,
     approach_acceleration: float = 0.5,
     resume_tolerance: float = 0.005,
@@ -134,6 +135,8 @@ def run_trajectory(
         run actually enters is decided by :func:`~.run_plan.plan_entry` with
         ``resume_tolerance`` [rad] and ``resume_window`` [s].
     confirm : ``confirm(plan) -> bool`` before motion (False: ``"cancelled"``).
+    force_kinematics : run although the controller's kinematics (KinematicsInfo) differ
+        from the trajectory's or cannot be read (the check becomes information).
     approach_speed, approach_acceleration : the entry moveJ [rad/s, rad/s^2].
     stop_deceleration : joint deceleration of the safe stop [rad/s^2].
     max_latency : how much later than normal the controller's data may arrive [s].
@@ -201,6 +204,11 @@ def run_trajectory(
     except ConnectionError as exc:
         raise ControllerError(f"controller at {host} not reachable: {exc}") from None
     checks.extend(controller_checks(traj.meta, info))
+    kin_check, controller_kin = kinematics_check(
+        traj.meta, host, timeout=min(connect_timeout, 5.0), force=force_kinematics
+    )
+    checks.append(kin_check)
+    result.controller_kinematics = controller_kin
     dt = float(robot.control_period)
     cfg = {
         "host": host,
@@ -412,6 +420,8 @@ def _recording(
     meta = traj.meta.replace(
         phases=(),
         in_stock=(),
+        # the controller reports its TCP through its own kinematics
+        kinematics=result.controller_kinematics or traj.meta.kinematics,
         source=f"recorded by ruledrobot run on {host}: mode {mode}, "
         f"status {result.status}, entry {result.entry.kind if result.entry else '-'} at input "
         f"sample {result.start_index} of {traj.n}",

@@ -23,7 +23,7 @@ from ruledrobot.robot import load
 from ruledrobot.robot.trajectory import Trajectory
 
 #: hard limit per test [s]
-TEST_DEADLINE = float(os.environ.get("RULEDROBOT_EXPORT_TEST_DEADLINE", "45"))
+TEST_DEADLINE = float(os.environ.get("RULEDROBOT_EXPORT_TEST_DEADLINE", "90"))
 
 
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:

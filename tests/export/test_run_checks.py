@@ -1,5 +1,5 @@
 """The runner's controller checks: robot model and period from the dashboard, the
-kinematics hook reported as information, a silent dashboard bounded in time, refusal
+kinematics (KinematicsInfo) compared, a silent dashboard bounded in time, refusal
 of a trajectory planned for another robot, confirmation."""
 
 from __future__ import annotations
@@ -33,13 +33,10 @@ def test_controller_info_names_the_catalogue_model(model, version, robot, period
     assert info.robot == robot and info.control_period == period
 
 
-def test_model_and_period_mismatch_fail_kinematics_is_information() -> None:
+def test_model_and_period_mismatch_fail() -> None:
     e5 = ControllerInfo("127.0.0.9", "UR5", "URSoftware 5.11.1.108318 (x)", (5, 11, 1))
     ok = {c.name: c for c in controller_checks(TrajectoryMeta.for_model(load("ur5e")), e5)}
     assert ok["robot_model"].ok and ok["control_period"].ok
-    kin = ok["kinematics"]
-    assert not kin.gating and kin.value == "not checked (controller kinematics not read yet)"
-    assert kin.limit_text == "information"  # not a pass
     ur10e = {c.name: c for c in controller_checks(TrajectoryMeta.for_model(load("ur10e")), e5)}
     assert not ur10e["robot_model"].ok and ur10e["control_period"].ok
     assert "planned for a ur10e" in ur10e["robot_model"].detail
@@ -85,7 +82,7 @@ def test_a_ur10e_trajectory_is_refused_by_a_ur5e_controller(emulator: Emulator) 
     traj = smooth_trajectory(model="ur10e")
     res = run_trajectory(traj, emulator.host)
     assert res.status == "refused" and not res.moved, res
-    assert [c.name for c in res.verdict.failed] == ["robot_model"]
+    assert [c.name for c in res.verdict.failed] == ["robot_model", "kinematics"]  # UR10e DH too
     assert "planned for a ur10e" in res.message and "is a ur5e" in res.message
     assert emulator.stats()["programs_received"] == 0  # no control script, no motion
 
