@@ -104,9 +104,12 @@ def refine_for_job(job: Job) -> tuple[FloatArray, int]:
         gap = _gaps(F, job.stock)
         if gap <= job.surface.spacing:
             return F, steps
+    if not np.isfinite(gap):
+        raise ValueError(f"{where} spacing: no two consecutive rulings cross the stock: the "
+                         "surface misses the block (check [surface] pose, [stock] centre)")
     raise ValueError(
         f"{where} spacing: {job.surface.spacing} m not reached after {MAX_STEPS} steps "
-        f"({len(F)} rulings, largest gap {_gaps(F, job.stock):.3g} m)"
+        f"({len(F)} rulings, largest gap {gap:.3g} m)"
     )
 
 
