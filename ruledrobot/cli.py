@@ -345,9 +345,10 @@ def _stream(trajectory: Path, host: str | None, *, yes: bool = False, **options)
     confirmation, progress bar, where it stopped and the resume command."""
     from rich.text import Text
 
-    from .export import ControllerError, Emulator, run_trajectory
+    from .export import ControllerError, run_trajectory
     from .export.run_report import RunProgress, resume_command
     from .io.trajectory import read_trajectory
+    from .ursim import Emulator
 
     try:
         traj = read_trajectory(trajectory)
@@ -378,7 +379,7 @@ def _stream(trajectory: Path, host: str | None, *, yes: bool = False, **options)
             target = "127.0.0.42"
             console.print(f"no --host: starting the embedded MuJoCo-backed controller emulator "
                           f"on {target}")  # fmt: skip
-            from .export.emulator.physics import MujocoBackend
+            from .ursim.physics import MujocoBackend
 
             emulator = Emulator(target, traj.meta.robot, q0=traj.q[0], backend=MujocoBackend)
             emulator.start()
@@ -449,9 +450,9 @@ def ursim(
     """Run the controller emulator (RTDE 30004, dashboard 29999, script 30003, primary 30001,
     secondary 30002) until Ctrl-C, optionally calibrated and with faults on a timer or on a
     signal (docs/rtde.md)."""
-    from .export import serve
-    from .export.emulator.faults import FaultSchedule, parse_fault
-    from .export.emulator.server import emulated_model
+    from .ursim import serve
+    from .ursim.faults import FaultSchedule, parse_fault
+    from .ursim.server import emulated_model
 
     if physics not in ("kinematic", "mujoco"):
         raise typer.BadParameter(f"expected kinematic or mujoco, got {physics!r}",
@@ -493,7 +494,7 @@ def ursim(
 
     options: dict = {} if programs is None else {"programs_dir": str(programs)}
     if physics == "mujoco":
-        from .export.emulator.physics import MujocoBackend
+        from .ursim.physics import MujocoBackend
 
         options["backend"] = MujocoBackend
     if arm is not None:
@@ -605,7 +606,7 @@ def calibration_fetch(
     """Read the controller's calibrated kinematics (KinematicsInfo) and write them as a
     calibration file for the job's ``[robot] calibration``."""
     from .export.fetch_calibration import fetch_calibration
-    from .robot.calibration import save_calibration
+    from .io.calibration import save_calibration
 
     try:
         cal = fetch_calibration(host, model, timeout=timeout)
@@ -619,7 +620,7 @@ def calibration_fetch(
 @calibration_app.command("show", epilog="Example:  ruledrobot calibration show robot.calib.json")
 def calibration_show(path: Path = typer.Argument(..., help="Calibration file.")) -> None:
     """Print a calibration: model, source, status and its deviations from the nominal arm."""
-    from .robot.calibration import load_calibration
+    from .io.calibration import load_calibration
 
     try:
         cal = load_calibration(path)

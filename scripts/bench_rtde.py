@@ -30,8 +30,8 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from ruledrobot.export.emulator import Emulator
-from ruledrobot.export.emulator.rawclient import (
+from ruledrobot.ursim import Emulator
+from tests.support.rawclient import (
     UR_RTDE_RECEIVE_RECIPE,
     RawRTDEClient,
 )
@@ -93,7 +93,7 @@ def _stats(arrivals: np.ndarray, stamps: np.ndarray, period: float) -> dict[str,
 
 
 def _backend(physics: str):
-    from ruledrobot.export.emulator.physics import MujocoBackend
+    from ruledrobot.ursim.physics import MujocoBackend
 
     return MujocoBackend if physics == "mujoco" else None
 

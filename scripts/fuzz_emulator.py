@@ -3,7 +3,7 @@
     python scripts/fuzz_emulator.py --duration 60 --seed 3 --host 127.0.0.50
 
 Starts an emulator (child process) on a loopback address, streams a 500 Hz
-client beside the fuzzer (``ruledrobot.export.emulator.fuzz``), and prints the
+client beside the fuzzer (``tests.support.fuzz``), and prints the
 cases sent, the stream's worst gap, the clock's statistics and the controller
 log's errors.  Exit status 1 when a controller period or a publish failed or
 the stream stalled for more than 100 ms.  The emulator is always stopped.
@@ -15,9 +15,9 @@ import argparse
 import threading
 import time
 
-from ruledrobot.export.emulator import Emulator
-from ruledrobot.export.emulator.fuzz import check_loopback, fuzz
-from ruledrobot.export.emulator.rawclient import RawRTDEClient
+from ruledrobot.ursim import Emulator
+from tests.support.fuzz import check_loopback, fuzz
+from tests.support.rawclient import RawRTDEClient
 
 
 def main() -> int:

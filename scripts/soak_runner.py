@@ -1,7 +1,7 @@
 """Soak the runner under faults: many runs through a loopback fault proxy, each faulted.
 
 Each trial streams a 2 s trajectory with ``run_trajectory`` to an emulator behind a
-:class:`~ruledrobot.export.faultproxy.FaultProxy` and injects one fault a third of the
+:class:`~tests.support.faultproxy.FaultProxy` and injects one fault a third of the
 way in; it measures the time from the fault to the runner's return and counts how the
 ur_rtde client ended (crashed: ``client_died``, killed after a hang: ``client_hung`` or
 a reported stop after which the client was killed) and whether the runner itself hung
@@ -127,12 +127,11 @@ def main() -> int:
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
     import numpy as np
 
-    from ruledrobot.export import Emulator
-    from ruledrobot.export.emulator import DEFAULT_Q
-    from ruledrobot.export.faultproxy import FaultProxy
     from ruledrobot.io.trajectory import write_trajectory
     from ruledrobot.robot import load
     from ruledrobot.robot.trajectory import Trajectory
+    from ruledrobot.ursim import DEFAULT_Q, Emulator
+    from tests.support.faultproxy import FaultProxy
 
     t = np.arange(0.0, 2.0 + 1e-9, 0.002)
     s = np.sin(np.pi * t / 2.0) ** 2

@@ -16,10 +16,13 @@ import re
 import socket
 import time
 from dataclasses import dataclass
+from enum import IntEnum
 
 import numpy as np
 
+from ..protocol.modes import RobotMode, SafetyMode
 from ..robot.trajectory import KinematicsRef, TrajectoryMeta
+from ..robot.ur_tables import nominal_dh
 from ..robot.verdict import Check
 
 __all__ = [
@@ -31,8 +34,6 @@ __all__ = [
 ]
 
 DASHBOARD_PORT = 29999
-ROBOT_MODE_RUNNING = 7
-SAFETY_MODE_NORMAL = 1
 
 _VERSION_RE = re.compile(r"(\d+)\.(\d+)\.(\d+)(?:\.(\d+))?")
 
@@ -238,27 +239,33 @@ def _kinematics_check(meta: TrajectoryMeta, host: str, timeout: float, force: bo
 
 
 def _nominal_dh(robot: str) -> np.ndarray:
-    from ..robot import load
-
-    m = load(robot)
+    m = nominal_dh(robot)
     return np.stack([m.theta_offset, m.a, m.d, m.alpha], axis=1)
+
+
+def _named(enum: type[IntEnum], value: int) -> str:
+    """``5 (IDLE)``: a mode's number and, when the protocol knows it, its name."""
+    try:
+        return f"{value} ({enum(value).name})"
+    except ValueError:
+        return str(value)
 
 
 def readiness_check(host: str, state: dict) -> Check:
     """Robot mode RUNNING and safety NORMAL (from the RTDE state the session read)."""
     mode, safety = int(state["robot_mode"]), int(state["safety_mode"])
     stopped = state.get("protective") or state.get("emergency")
-    ok = mode == ROBOT_MODE_RUNNING and safety == SAFETY_MODE_NORMAL and not stopped
+    ok = mode == RobotMode.RUNNING and safety == SafetyMode.NORMAL and not stopped
     detail = ""
-    if mode != ROBOT_MODE_RUNNING:
+    if mode != RobotMode.RUNNING:
         detail = (
-            f"controller at {host}: robot mode {mode}, expected 7 (RUNNING): power on and "
-            "release the brakes first"
+            f"controller at {host}: robot mode {_named(RobotMode, mode)}, expected 7 (RUNNING): "
+            "power on and release the brakes first"
         )
     elif not ok:
         detail = (
-            f"controller at {host}: safety mode {safety}, expected 1 (NORMAL): clear the "
-            "protective or emergency stop first"
+            f"controller at {host}: safety mode {_named(SafetyMode, safety)}, expected 1 "
+            "(NORMAL): clear the protective or emergency stop first"
         )
     return Check(
         "controller_ready",

@@ -49,6 +49,7 @@ from .run_plan import (
 )
 from .run_result import ControllerError, RunMode, RunPlan, RunResult
 from .run_supervisor import Child, ChildGone
+from .urscript import check_servo_options
 
 __all__ = ["ControllerError", "RunMode", "RunPlan", "RunResult", "run_trajectory"]
 
@@ -70,10 +71,7 @@ def _validate(
     mode = mode.value if isinstance(mode, Enum) else str(mode)
     if mode not in ("servoj", "path"):
         raise ValueError(f"mode: expected 'servoj' or 'path', got {mode!r}")
-    if not 0.03 <= lookahead <= 0.2:
-        raise ValueError(f"lookahead: {lookahead} s outside [0.03, 0.2] (ur_rtde's range)")
-    if not 100 <= gain <= 2000:
-        raise ValueError(f"gain: {gain} outside [100, 2000] (ur_rtde's range)")
+    check_servo_options(lookahead, gain)
     if not deviation_limit > 0:
         raise ValueError(f"deviation_limit: must be positive, got {deviation_limit}")
     n = traj.n

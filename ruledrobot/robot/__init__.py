@@ -8,7 +8,7 @@ Typical use::
     T = robot.fk(q)                      # (..., 6) -> (..., 4, 4) TCP poses
     sols = robot.ik(T)                   # (..., 4, 4) -> (..., 8, 6), NaN rows = no solution
     path = robot.path_ik(poses)          # (N, 4, 4) -> PathIKResult (continuous q, flags)
-    cal = rr.robot.load_calibration("my_ur5e.json")   # the robot's factory calibration
+    cal = rr.io.load_calibration("my_ur5e.json")      # the robot's factory calibration
     robot = rr.robot.load("ur5e", calibration=cal)    # exact FK, IK refined on it
 
 Units m, rad, s; poses are float64 4x4 homogeneous matrices.  See
@@ -23,14 +23,8 @@ from numpy.typing import ArrayLike
 from ._checks import FloatArray
 from .analytic_ik import IKSolutions, URGeometry, wrap_angle
 from .calibrated_ik import CalibratedIKSolutions
-from .calibration import (
-    Calibration,
-    CalibrationBounds,
-    CalibrationError,
-    load_calibration,
-    random_calibration,
-    save_calibration,
-)
+from .calibration import Calibration, CalibrationBounds, CalibrationError
+from .calibration_random import random_calibration
 from .catalogue import MODEL_NAMES, load
 from .model import DEFAULT_ACCELERATION, RobotModel
 from .path import PathIKResult, PathStatus, path_ik
@@ -56,11 +50,9 @@ __all__ = [
     "fk",
     "ik",
     "load",
-    "load_calibration",
     "model_for",
     "path_ik",
     "random_calibration",
-    "save_calibration",
     "wrap_angle",
 ]
 

@@ -27,9 +27,8 @@ and ``ik`` refines the nominal closed form on the calibrated chain
 from __future__ import annotations
 
 import dataclasses
-import os
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any, Literal, overload
+from typing import Any, Literal, overload
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -43,11 +42,10 @@ from ._checks import (
     as_poses,
     readonly,
 )
+from .calibration import Calibration
 from .kinematics import dh_fk, dh_jacobian, dh_skeleton
-
-if TYPE_CHECKING:
-    from .calibration import Calibration
-    from .path import PathIKResult
+from .path import PathIKResult, path_ik
+from .ur_tables import nominal_dh
 
 #: Default joint acceleration limit [rad/s^2].  UR publishes none; this is the
 #: URScript ``movej`` default acceleration (``a=1.4``), a conservative value
@@ -290,25 +288,22 @@ class RobotModel:
         """A copy whose base frame sits at ``base`` (4x4 or UR pose vector) in the world."""
         return dataclasses.replace(self, base=as_pose_or_vector(base, "base"))
 
-    def with_calibration(self, calibration: Calibration | str | os.PathLike | None) -> RobotModel:
+    def with_calibration(self, calibration: Calibration | None) -> RobotModel:
         """A copy that carries ``calibration`` (its effective DH table); None: the nominal arm.
 
-        ``calibration`` is a :class:`~ruledrobot.robot.Calibration` or the path of a
-        calibration file (:func:`~ruledrobot.robot.load_calibration`).  It must be a
-        calibration of this model (``ValueError`` otherwise).  Base, tool, limits and
-        masses are kept.  FK is then the DH chain with the effective parameters; ``ik``
+        ``calibration`` is a :class:`~ruledrobot.robot.Calibration` (files are read by
+        :func:`ruledrobot.io.load_calibration`).  It must be a calibration of this model
+        (``ValueError`` otherwise).  Base, tool, limits and masses are kept.  FK is then
+        the DH chain with the effective parameters; ``ik``
         seeds every branch with the nominal closed form and finishes on the calibrated
         chain; a nominal calibration gives the closed form's answer bit for bit.
         """
-        from .calibration import Calibration, load_calibration
-
         if calibration is None:
             return self.nominal
-        if isinstance(calibration, (str, os.PathLike)):
-            calibration = load_calibration(calibration)
         if not isinstance(calibration, Calibration):
             raise ValueError(
-                f"calibration: expected a Calibration, a file path or None, got "
+                f"calibration: expected a Calibration or None (read files with "
+                f"ruledrobot.io.load_calibration), got "
                 f"{type(calibration).__name__}"
             )
         if calibration.model != self.name:
@@ -621,8 +616,6 @@ class RobotModel:
 
         See :func:`ruledrobot.robot.path_ik` for the parameters and the rules.
         """
-        from .path import path_ik
-
         return path_ik(
             self,
             poses,
@@ -637,9 +630,6 @@ class RobotModel:
 def _check_calibration(model: RobotModel) -> tuple[tuple[FloatArray, ...], bool]:
     """The nominal table (d, a, alpha, offset) of a calibrated model and whether its IK
     needs the Newton finish; ValueError when the calibration does not fit the model."""
-    from .calibration import Calibration
-    from .catalogue import load
-
     cal: Any = model.calibration
     if not isinstance(cal, Calibration):
         raise ValueError(f"calibration: expected a Calibration or None, got {type(cal).__name__}")
@@ -657,7 +647,7 @@ def _check_calibration(model: RobotModel) -> tuple[tuple[FloatArray, ...], bool]
                 f"{float(theirs[i])!r}; "
                 "attach calibrations with with_calibration()"
             )
-    nom = load(cal.model)
+    nom = nominal_dh(cal.model)
     seed_dh = (nom.d, nom.a, nom.alpha, nom.theta_offset)
     return seed_dh, not cal.is_nominal
 

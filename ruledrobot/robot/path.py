@@ -35,7 +35,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from enum import IntEnum
-from typing import TYPE_CHECKING
+from typing import Protocol
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -43,8 +43,21 @@ from numpy.typing import ArrayLike
 from . import analytic_ik as _ik
 from ._checks import FloatArray, as_array, as_joint_vector, as_poses
 
-if TYPE_CHECKING:
-    from .model import RobotModel
+
+class PathArm(Protocol):
+    """What path IK needs of an arm (:class:`~ruledrobot.robot.RobotModel` has it)."""
+
+    n_joints: int
+    lower: FloatArray
+    upper: FloatArray
+
+    @property
+    def ur_geometry(self) -> _ik.URGeometry | None: ...
+
+    def ik(self, T: ArrayLike, **kwargs): ...
+
+    def flange_poses(self, T: ArrayLike, *, check: bool = True) -> FloatArray: ...
+
 
 TWO_PI = 2.0 * np.pi
 _LIMIT_EPS = 1e-9  # rad of slack on the joint limits when placing 2 pi representatives
@@ -246,7 +259,7 @@ def _runs(idx: np.ndarray) -> list[tuple[int, int]]:
 
 
 def path_ik(
-    model: RobotModel,
+    model: PathArm,
     poses: ArrayLike,
     *,
     q_start: ArrayLike | None = None,
@@ -430,7 +443,7 @@ def _seeds_for_singular(q6: FloatArray, sing: np.ndarray, start: FloatArray | No
 
 
 def _messages(
-    model: RobotModel,
+    model: PathArm,
     T: FloatArray,
     status: np.ndarray,
     step: FloatArray,

@@ -58,6 +58,7 @@ from ..geometry import se3
 from ..geometry.box import Box
 from ..geometry.lines import Lines
 from ..io.text import read_user_text
+from ..robot.calibration import Calibration
 from ..subdivision.schemes import SCHEME_NAMES
 
 if sys.version_info >= (3, 11):
@@ -93,7 +94,7 @@ class RobotSpec:
     speed_scale: float = 1.0
     acceleration: np.ndarray | None = None
     home: np.ndarray | None = field(default=None, repr=False)
-    calibration: Path | None = None
+    calibration: Calibration | None = None  #: read from the job's calibration file
 
 
 @dataclass(frozen=True)
@@ -229,8 +230,8 @@ class _Section:
             )
 
 
-def _calibration(sec: _Section, model: str, base_dir: Path | None) -> Path | None:
-    """``[robot] calibration``: a calibration file of this robot (checked on reading)."""
+def _calibration(sec: _Section, model: str, base_dir: Path | None) -> Calibration | None:
+    """``[robot] calibration``: a calibration file of this robot, read and checked."""
     value = sec.get("calibration")
     if value is None:
         return None
@@ -239,7 +240,7 @@ def _calibration(sec: _Section, model: str, base_dir: Path | None) -> Path | Non
     path = Path(value)
     if not path.is_absolute() and base_dir is not None:
         path = base_dir / path
-    from ..robot.calibration import load_calibration
+    from ..io.calibration import load_calibration
 
     try:
         cal = load_calibration(path)
@@ -248,7 +249,7 @@ def _calibration(sec: _Section, model: str, base_dir: Path | None) -> Path | Non
     if cal.model != model:
         raise sec.fail("calibration", f"{path} is a calibration of a {cal.model}, the job's "
                        f"robot is a {model}")  # fmt: skip
-    return path
+    return cal
 
 
 def _pose(sec: _Section, key: str) -> np.ndarray:

@@ -8,12 +8,11 @@ import numpy as np
 import pytest
 
 from ruledrobot.export import run_trajectory
-from ruledrobot.export.emulator.physics import MujocoBackend
 from ruledrobot.io.trajectory import read_trajectory, write_trajectory
 from ruledrobot.robot import load
 from ruledrobot.robot.trajectory import Trajectory
-
-from .conftest import start_emulator
+from ruledrobot.ursim.physics import MujocoBackend
+from tests.support.emulators import start_emulator
 
 MODEL = "ur5e"
 

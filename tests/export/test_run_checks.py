@@ -12,12 +12,11 @@ import numpy as np
 import pytest
 
 from ruledrobot.export import RunPlan, run_trajectory
-from ruledrobot.export.emulator import DEFAULT_Q, Emulator
 from ruledrobot.export.run_checks import ControllerInfo, controller_checks, query_dashboard
 from ruledrobot.robot import load
 from ruledrobot.robot.trajectory import TrajectoryMeta
-
-from .conftest import smooth_trajectory
+from ruledrobot.ursim import DEFAULT_Q, Emulator
+from tests.support.emulators import smooth_trajectory
 
 pytest.importorskip("rtde_control")
 

@@ -11,10 +11,10 @@ import pytest
 from typer.testing import CliRunner
 
 from ruledrobot.cli import app
-from ruledrobot.export.emulator import Emulator, KinematicBackend
 from ruledrobot.io.trajectory import write_trajectory
+from ruledrobot.ursim import Emulator, KinematicBackend
+from tests.support.emulators import smooth_trajectory, start_emulator
 
-from .conftest import smooth_trajectory, start_emulator
 from .test_run_plan import cut_trajectory
 
 pytest.importorskip("rtde_control")

@@ -1,6 +1,6 @@
 """The runner under faults between ur_rtde and the controller: a frozen controller
 (sockets open, nothing answers) and a dropped one (both sides closed), made by a
-loopback fault proxy (:mod:`ruledrobot.export.faultproxy`) between the runner's ur_rtde
+loopback fault proxy (:mod:`tests.support.faultproxy`) between the runner's ur_rtde
 client and the emulator.
 
 Before the ur_rtde session ran in a supervised child process, the first hung forever
@@ -19,11 +19,10 @@ from pathlib import Path
 import pytest
 
 from ruledrobot.export import run_trajectory
-from ruledrobot.export.emulator import Emulator
-from ruledrobot.export.faultproxy import FaultProxy
 from ruledrobot.io.trajectory import read_trajectory, write_trajectory
-
-from .conftest import _address, smooth_trajectory, start_emulator
+from ruledrobot.ursim import Emulator
+from tests.support.emulators import _address, smooth_trajectory, start_emulator
+from tests.support.faultproxy import FaultProxy
 
 pytest.importorskip("rtde_control")
 

@@ -8,7 +8,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from ruledrobot.export.emulator import DEFAULT_Q
 from ruledrobot.export.run_plan import (
     entry_sample,
     moveJ_time,
@@ -18,6 +17,7 @@ from ruledrobot.export.run_plan import (
 )
 from ruledrobot.robot import load
 from ruledrobot.robot.trajectory import Phase, Trajectory
+from ruledrobot.ursim import DEFAULT_Q
 
 #: the phases of :func:`cut_trajectory` (sample ranges) and its one in-stock run
 PHASES = (("approach", 0, 150), ("lead_in", 150, 250), ("cut", 250, 750),

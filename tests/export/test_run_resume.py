@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from ruledrobot.export import run_trajectory
-from ruledrobot.export.emulator import Emulator
+from ruledrobot.ursim import Emulator
 
 from .test_run_plan import IN_STOCK, cut_trajectory
 

@@ -16,12 +16,11 @@ import numpy as np
 import pytest
 
 from ruledrobot.export import ControllerError, RunResult, run_trajectory
-from ruledrobot.export.emulator import DEFAULT_Q, Emulator, KinematicBackend
 from ruledrobot.io.trajectory import read_trajectory, write_trajectory
 from ruledrobot.robot import load
 from ruledrobot.robot.trajectory import Trajectory
-
-from .conftest import smooth_trajectory, start_emulator
+from ruledrobot.ursim import DEFAULT_Q, Emulator, KinematicBackend
+from tests.support.emulators import smooth_trajectory, start_emulator
 
 pytest.importorskip("rtde_control")
 

@@ -9,14 +9,13 @@ import numpy as np
 import pytest
 
 from ruledrobot.export import export_trajectory, urscript_program
-from ruledrobot.export.emulator import Emulator
-from ruledrobot.export.emulator.program import Pose, parse_call
 from ruledrobot.geometry.se3 import pose_from_ur_vector
 from ruledrobot.io.trajectory import read_trajectory
 from ruledrobot.robot import load, model_for
 from ruledrobot.robot.trajectory import Payload, Trajectory
-
-from .conftest import smooth_trajectory
+from ruledrobot.ursim import Emulator
+from ruledrobot.ursim.program import Pose, parse_call
+from tests.support.emulators import smooth_trajectory
 
 
 def _statements(text: str) -> list:

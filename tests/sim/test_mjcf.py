@@ -210,7 +210,7 @@ def test_committed_models_are_current(tmp_path):
 def test_a_calibrated_arm_has_its_kinematics_and_its_nominal_shape():
     """Bodies follow the calibrated chain (TCP site = calibrated FK to 1e-9); the links keep
     their nominal shape: geoms within a few millimetres of the nominal arm's."""
-    from ruledrobot.robot.calibration import random_calibration
+    from ruledrobot.robot import random_calibration
 
     nominal = load("ur5e").with_tool([0.0, 0.0, 0.2, 0.0, 0.0, 0.0])
     cal = nominal.with_calibration(random_calibration("ur5e", seed=3))

@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from ruledrobot.robot import load, model_for
-from ruledrobot.robot.calibration import random_calibration, save_calibration
+from ruledrobot.io.calibration import save_calibration
+from ruledrobot.robot import load, model_for, random_calibration
 from ruledrobot.wirecut.demo import DEMO_JOB
 from ruledrobot.wirecut.job import load_job
 from ruledrobot.wirecut.planner import plan

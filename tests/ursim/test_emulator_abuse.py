@@ -18,19 +18,18 @@ from pathlib import Path
 
 import pytest
 
-from ruledrobot.export.emulator import Emulator, ThreadedEmulator
-from ruledrobot.export.emulator.faults import FaultSpec, parse_fault
-from ruledrobot.export.emulator.program import (
+from ruledrobot.ursim import Emulator, ThreadedEmulator
+from ruledrobot.ursim.faults import FaultSpec, parse_fault
+from ruledrobot.ursim.program import (
     MAX_LINE_BYTES,
     MAX_PROGRAM_BYTES,
     ProgramSplitter,
     ScriptSyntaxError,
     parse_call,
 )
-from ruledrobot.export.emulator.rawclient import UR_RTDE_RECEIVE_RECIPE, RawRTDEClient
-from ruledrobot.export.emulator.script_functions import bind
-
-from .conftest import _address, start_emulator
+from ruledrobot.ursim.script_functions import bind
+from tests.support.emulators import _address, start_emulator
+from tests.support.rawclient import UR_RTDE_RECEIVE_RECIPE, RawRTDEClient
 
 
 @pytest.fixture

@@ -23,7 +23,7 @@ from .tcp import Connection, TcpServer
 
 __all__ = ["ProgramReceiver", "ScriptPortServer", "receive_programs"]
 
-log = logging.getLogger("ruledrobot.export.emulator")
+log = logging.getLogger("ruledrobot.ursim")
 
 
 class ScriptPortServer(TcpServer):

@@ -44,8 +44,7 @@ import time
 from collections import deque
 from collections.abc import Mapping
 
-from .controller import Controller
-from .protocol import (
+from ..protocol.rtde import (
     CONTROL_PACKAGE_PAUSE,
     CONTROL_PACKAGE_SETUP_INPUTS,
     CONTROL_PACKAGE_SETUP_OUTPUTS,
@@ -65,12 +64,13 @@ from .protocol import (
     parse_names,
     parse_output_setup,
 )
-from .rtde_types import TYPE_SIZES
+from ..protocol.rtde_types import TYPE_SIZES
+from .controller import Controller
 from .tcp import Connection, QueuedConnection, TcpServer, writable_fds
 
 __all__ = ["RTDEConnection", "RTDEServer", "StreamStats", "due"]
 
-log = logging.getLogger("ruledrobot.export.emulator")
+log = logging.getLogger("ruledrobot.ursim")
 
 
 #: bytes queued for a client beyond which it is disconnected: about 0.45 s of ur_rtde's

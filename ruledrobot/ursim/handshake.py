@@ -34,20 +34,17 @@ from __future__ import annotations
 import logging
 from collections.abc import Callable
 from enum import IntEnum
-from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ...geometry.se3 import pose_from_ur_vector, ur_vector_from_pose
+from ..geometry.se3 import pose_from_ur_vector, ur_vector_from_pose
+from .host import ProgramHost
 from .motion import MotionError, PathMotion, StopMotion, joint_segment, linear_segment
 from .program import Program
 
-if TYPE_CHECKING:
-    from .controller import Controller
-
 __all__ = ["NOT_EMULATED", "RT_COMMANDS", "Command", "ControlScript", "NotEmulatedError"]
 
-log = logging.getLogger("ruledrobot.export.emulator")
+log = logging.getLogger("ruledrobot.ursim")
 
 
 class Command(IntEnum):
@@ -180,8 +177,9 @@ Waiter = Callable[[], bool]
 class ControlScript:
     """The running ``rtde_control`` program: one :meth:`step` per control period."""
 
-    def __init__(self, ctrl: Controller, program: Program) -> None:
-        self.c = ctrl
+    def __init__(self, host: ProgramHost, program: Program) -> None:
+        self.c = host
+        self.kin = host.kin
         self.program = program
         self.off = program.register_offset
         self.executing = False
@@ -298,10 +296,10 @@ class ControlScript:
         return self._motion_waiter(motion)
 
     def _q_now(self) -> np.ndarray:
-        return self.c.backend.state().target_q.copy()
+        return self.c.arm_state().target_q.copy()
 
     def _ik(self, pose: np.ndarray, qnear: np.ndarray, what: str) -> np.ndarray:
-        q = self.c.kin.ik_nearest(pose, qnear)
+        q = self.kin.ik_nearest(pose, qnear)
         if q is None:
             raise MotionError(
                 f"{what}: no inverse kinematics solution for p{np.round(pose, 6).tolist()}"
@@ -328,7 +326,7 @@ class ControlScript:
             if self._servol is not None and self._servol[0] == key:
                 q = self._servol[1]  # the same target again: its solution (IK once per target)
             else:
-                q = c.kin.ik_nearest(pose, self._q_now())
+                q = self.kin.ik_nearest(pose, self._q_now())
                 if q is None:
                     raise MotionError(
                         f"servol: no inverse kinematics solution for p{pose.round(6).tolist()}"
@@ -345,7 +343,7 @@ class ControlScript:
             if target != self._servoc_target or c.motion is None:
                 self._servoc_target = target
                 seg = linear_segment(self._q_now(), self.in_vec(0), self.in_d(6), self.in_d(7),
-                                     self.in_d(8), c.kin)  # fmt: skip
+                                     self.in_d(8), self.kin)  # fmt: skip
                 c.start_motion(PathMotion(seg.q_start, [seg]))
         elif cmd == Command.GET_STEPTIME:
             self.out_d(0, c.period)
@@ -355,15 +353,15 @@ class ControlScript:
             q = hist[max(0, len(hist) - 1 - steps)] if hist else self._q_now()
             self.out_vec(q)
         elif cmd == Command.GET_JOINT_TORQUES:
-            self.out_vec(c.backend.state().current)
+            self.out_vec(c.arm_state().current)
         elif cmd == Command.GET_ACTUAL_TOOL_FLANGE_POSE:
-            q = c.backend.state().q
-            flange = c.model.with_tool(np.eye(4)).fk(q)
+            q = c.arm_state().q
+            flange = self.kin.model.with_tool(np.eye(4)).fk(q)
             self.out_vec(ur_vector_from_pose(flange))
         elif cmd == Command.GET_TARGET_JOINT_ACCELERATIONS:
-            self.out_vec(c.backend.state().target_qdd)
+            self.out_vec(c.arm_state().target_qdd)
         elif cmd == Command.GET_JACOBIAN:
-            J = c.kin.model.jacobian(c.backend.state().q)
+            J = self.kin.model.jacobian(c.arm_state().q)
             for col in range(6):
                 base = col * 6 if col < 4 else 36 + (col - 4) * 6
                 self.out_vec(J[:, col], base)
@@ -373,7 +371,7 @@ class ControlScript:
         assert self._speedl is not None
         xd, acc = self._speedl
         c = self.c
-        J = c.kin.model.jacobian(self._q_now())
+        J = self.kin.model.jacobian(self._q_now())
         qd = np.linalg.lstsq(J, xd, rcond=1e-6)[0]
         c.set_speed(qd, acc)
 
@@ -384,19 +382,19 @@ class ControlScript:
         c = self.c
         if cmd == Command.MOVEJ:
             q = self.in_vec(0)
-            seg = joint_segment(self._q_now(), q, self.in_d(6), self.in_d(7), 0.0, c.kin)
+            seg = joint_segment(self._q_now(), q, self.in_d(6), self.in_d(7), 0.0, self.kin)
             return self._move(PathMotion(seg.q_start, [seg]), self.in_int(1) != 0)
         if cmd == Command.MOVEJ_IK:
             q0 = self._q_now()
             q = self._ik(self.in_vec(0), q0, "moveJ_IK")
-            seg = joint_segment(q0, q, self.in_d(6), self.in_d(7), 0.0, c.kin)
+            seg = joint_segment(q0, q, self.in_d(6), self.in_d(7), 0.0, self.kin)
             return self._move(PathMotion(q0, [seg]), self.in_int(1) != 0)
         if cmd in (Command.MOVEL, Command.MOVEL_FK):
             q0 = self._q_now()
             target = self.in_vec(0)
             if cmd == Command.MOVEL_FK:
-                target = np.asarray(c.kin.tcp_vector(target))
-            seg = linear_segment(q0, target, self.in_d(6), self.in_d(7), 0.0, c.kin)
+                target = np.asarray(self.kin.tcp_vector(target))
+            seg = linear_segment(q0, target, self.in_d(6), self.in_d(7), 0.0, self.kin)
             return self._move(PathMotion(q0, [seg]), self.in_int(1) != 0)
         if cmd == Command.MOVE_PATH:
             motion = c.build_path(self.program.path)
@@ -407,7 +405,7 @@ class ControlScript:
         if cmd in (Command.STOPJ, Command.STOPL):
             return self._stop(self.in_d(0), self.in_int(1) != 0)
         if cmd == Command.GET_INVERSE_KINEMATICS_DEFAULT:
-            self.out_vec(self._ik(self.in_vec(0), c.backend.state().q, "get_inverse_kin"))
+            self.out_vec(self._ik(self.in_vec(0), c.arm_state().q, "get_inverse_kin"))
             return None
         if cmd == Command.GET_INVERSE_KINEMATICS_ARGS:
             self.out_vec(self._ik(self.in_vec(0), self.in_vec(6), "get_inverse_kin"))
@@ -417,23 +415,23 @@ class ControlScript:
             Command.GET_INVERSE_KINEMATICS_HAS_SOLUTION_ARGS,
         ):
             qnear = self.in_vec(6) if cmd == Command.GET_INVERSE_KINEMATICS_HAS_SOLUTION_ARGS else (
-                c.backend.state().q)  # fmt: skip
-            self.out_int(1, int(c.kin.ik_nearest(self.in_vec(0), qnear) is not None))
+                c.arm_state().q)  # fmt: skip
+            self.out_int(1, int(self.kin.ik_nearest(self.in_vec(0), qnear) is not None))
             return None
         if cmd == Command.GET_FORWARD_KINEMATICS_DEFAULT:
-            self.out_vec(c.kin.tcp_vector(c.backend.state().q.tolist()))
+            self.out_vec(self.kin.tcp_vector(c.arm_state().q.tolist()))
             return None
         if cmd == Command.GET_FORWARD_KINEMATICS_ARGS:
             q = self.in_vec(0)
             tcp = self.in_vec(6) if self.has_arg(f"input_double_register_{11 + self.off}") else None
-            self.out_vec(c.kin.fk_vector(q, tcp))
+            self.out_vec(self.kin.fk_vector(q, tcp))
             return None
         if cmd == Command.SET_TCP:
-            c.kin.set_tcp(self.in_vec(0))
+            self.kin.set_tcp(self.in_vec(0))
             c.log(f"set_tcp(p{np.round(self.in_vec(0), 6).tolist()})")
             return None
         if cmd == Command.GET_TCP_OFFSET:
-            self.out_vec(c.kin.tcp_offset)
+            self.out_vec(self.kin.tcp_offset)
             return None
         if cmd == Command.POSE_TRANS:
             T = pose_from_ur_vector(self.in_vec(0)) @ pose_from_ur_vector(self.in_vec(6))
@@ -444,20 +442,20 @@ class ControlScript:
             if isinstance(m, PathMotion) and m.segments[-1].linear:
                 self.out_vec(m.target)
             elif m is not None:
-                self.out_vec(c.kin.tcp_vector(np.asarray(m.q_end).tolist()))
+                self.out_vec(self.kin.tcp_vector(np.asarray(m.q_end).tolist()))
             else:
-                self.out_vec(c.kin.tcp_vector(c.backend.state().target_q.tolist()))
+                self.out_vec(self.kin.tcp_vector(c.arm_state().target_q.tolist()))
             return None
         if cmd == Command.IS_STEADY:
-            st = c.backend.state()
+            st = c.arm_state()
             self.out_int(1, int(c.motion is None and float(np.max(np.abs(st.qd))) < 1e-4))
             return None
         if cmd == Command.IS_POSE_WITHIN_SAFETY_LIMITS:
-            ok = c.kin.ik_nearest(self.in_vec(0), c.backend.state().q) is not None
+            ok = self.kin.ik_nearest(self.in_vec(0), c.arm_state().q) is not None
             self.out_int(1, int(ok))
             return None
         if cmd == Command.IS_JOINTS_WITHIN_SAFETY_LIMITS:
-            self.out_int(1, int(bool(c.model.within_limits(self.in_vec(0)))))
+            self.out_int(1, int(bool(self.kin.model.within_limits(self.in_vec(0)))))
             return None
         if cmd == Command.PROTECTIVE_STOP:
             c.protective_stop("triggerProtectiveStop() from the client")

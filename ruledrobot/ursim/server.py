@@ -28,15 +28,16 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ...protocol.primary import KinematicsInfo
-from ...robot import Calibration, RobotModel, load, load_calibration
+from ..io.calibration import load_calibration
+from ..protocol.modes import RobotMode, RuntimeState, SafetyMode
+from ..protocol.primary import KinematicsInfo
+from ..robot import Calibration, RobotModel, load
 from .backend import ArmBackend, KinematicBackend
 from .controller import Controller
 from .dashboard import DashboardServer
 from .primary_port import PrimaryPublisher, PrimaryServer
 from .rtde_server import RTDEServer
 from .script_port import ScriptPortServer
-from .states import RobotMode, RuntimeState, SafetyMode
 from .tcp import try_realtime_priority
 
 __all__ = [
@@ -49,7 +50,7 @@ __all__ = [
     "serve",
 ]
 
-log = logging.getLogger("ruledrobot.export.emulator")
+log = logging.getLogger("ruledrobot.ursim")
 
 #: controller versions reported to ``v``: e-Series (500 Hz) and CB3 (125 Hz)
 E_SERIES_VERSION = (5, 11, 1, 108318)

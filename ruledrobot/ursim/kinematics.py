@@ -24,8 +24,8 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ...geometry.se3 import pose_from_ur_vector, ur_vector_from_pose
-from ...robot import RobotModel
+from ..geometry.se3 import pose_from_ur_vector, ur_vector_from_pose
+from ..robot import RobotModel
 
 __all__ = ["ArmKinematics", "rotvec_from_rows", "wrap_to_nearest"]
 

@@ -40,7 +40,8 @@ import threading
 import time
 from collections.abc import Callable, Sequence
 
-from ...protocol.primary import (
+from ..protocol.modes import RobotMode, RuntimeState, SafetyMode
+from ..protocol.primary import (
     KinematicsInfo,
     RobotModeData,
     Version,
@@ -51,7 +52,6 @@ from ...protocol.primary import (
 )
 from .controller import Controller
 from .script_port import ProgramReceiver
-from .states import RobotMode, RuntimeState, SafetyMode
 from .tcp import Connection, QueuedConnection, TcpServer, writable_fds
 
 __all__ = [
@@ -64,7 +64,7 @@ __all__ = [
     "robot_state",
 ]
 
-log = logging.getLogger("ruledrobot.export.emulator")
+log = logging.getLogger("ruledrobot.ursim")
 
 #: seconds between robot-state messages (10 Hz, as a controller sends them)
 PUBLISH_PERIOD = 0.1

@@ -14,7 +14,7 @@ import struct
 import time
 from typing import Any
 
-from .protocol import (
+from ruledrobot.protocol.rtde import (
     CONTROL_PACKAGE_PAUSE,
     CONTROL_PACKAGE_SETUP_INPUTS,
     CONTROL_PACKAGE_SETUP_OUTPUTS,
@@ -26,7 +26,7 @@ from .protocol import (
     PacketFramer,
     pack_packet,
 )
-from .rtde_types import TYPE_FORMATS
+from ruledrobot.protocol.rtde_types import TYPE_FORMATS
 
 __all__ = ["UR_RTDE_RECEIVE_RECIPE", "RawRTDEClient"]
 

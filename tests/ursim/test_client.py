@@ -9,12 +9,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from ruledrobot.export.emulator import DEFAULT_Q, Emulator
-from ruledrobot.export.emulator.rawclient import RawRTDEClient
 from ruledrobot.geometry.se3 import pose_from_ur_vector, ur_vector_from_pose
 from ruledrobot.robot import load
-
-from .conftest import UR, start_emulator
+from ruledrobot.ursim import DEFAULT_Q, Emulator
+from tests.support.emulators import UR, start_emulator
+from tests.support.rawclient import RawRTDEClient
 
 pytest.importorskip("rtde_control")
 

@@ -7,18 +7,8 @@ import struct
 import numpy as np
 import pytest
 
-from ruledrobot.export.emulator import DEFAULT_Q, KinematicBackend
-from ruledrobot.export.emulator.controller import Controller
-from ruledrobot.export.emulator.kinematics import ArmKinematics
-from ruledrobot.export.emulator.motion import (
-    PathMotion,
-    Profile,
-    StopMotion,
-    joint_segment,
-    linear_segment,
-)
-from ruledrobot.export.emulator.program import ProgramSplitter, parse_call, parse_program
-from ruledrobot.export.emulator.protocol import (
+from ruledrobot.geometry.se3 import pose_from_ur_vector, ur_vector_from_pose
+from ruledrobot.protocol.rtde import (
     DATA_PACKAGE,
     InputRecipe,
     OutputRecipe,
@@ -27,10 +17,20 @@ from ruledrobot.export.emulator.protocol import (
     pack_packet,
     parse_output_setup,
 )
-from ruledrobot.export.emulator.rawclient import UR_RTDE_RECEIVE_RECIPE
-from ruledrobot.export.emulator.rtde_types import TYPE_SIZES, input_type, output_type
-from ruledrobot.geometry.se3 import pose_from_ur_vector, ur_vector_from_pose
+from ruledrobot.protocol.rtde_types import TYPE_SIZES, input_type, output_type
 from ruledrobot.robot import load
+from ruledrobot.ursim import DEFAULT_Q, KinematicBackend
+from ruledrobot.ursim.controller import Controller
+from ruledrobot.ursim.kinematics import ArmKinematics
+from ruledrobot.ursim.motion import (
+    PathMotion,
+    Profile,
+    StopMotion,
+    joint_segment,
+    linear_segment,
+)
+from ruledrobot.ursim.program import ProgramSplitter, parse_call, parse_program
+from tests.support.rawclient import UR_RTDE_RECEIVE_RECIPE
 
 
 def test_official_types() -> None:

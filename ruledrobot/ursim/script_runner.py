@@ -28,15 +28,12 @@ servo or speed motion still in force is stopped with ``stopj(4)``.
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
 
 import numpy as np
 
+from .host import ProgramHost
 from .motion import MotionError, PathMotion, Segment, StopMotion, joint_segment, linear_segment
 from .program import Pose, Program, Statement
-
-if TYPE_CHECKING:
-    from .controller import Controller
 
 __all__ = ["ScriptRunner", "run_io_statement"]
 
@@ -54,7 +51,7 @@ def _float(st: Statement, key: str) -> float:
     return float(st.params[key])  # type: ignore[arg-type]
 
 
-def run_io_statement(c: Controller, st: Statement) -> bool:
+def run_io_statement(c: ProgramHost, st: Statement) -> bool:
     """Run a non-motion statement (I/O, registers, TCP, payload, messages); False if not one."""
     name, a = st.name, st.params
     if name in ("textmsg", "popup"):
@@ -92,10 +89,14 @@ def run_io_statement(c: Controller, st: Statement) -> bool:
 
 
 class ScriptRunner:
-    """Executes a parsed standalone program on a :class:`Controller`, one period per step."""
+    """Executes a parsed standalone program on a controller, one period per step.
 
-    def __init__(self, ctrl: Controller, program: Program) -> None:
-        self.c = ctrl
+    The controller is seen through :class:`~.host.ProgramHost`.
+    """
+
+    def __init__(self, host: ProgramHost, program: Program) -> None:
+        self.c = host
+        self.kin = host.kin
         self.program = program
         self.pc = 0
         self.wait_ticks = 0
@@ -137,7 +138,7 @@ class ScriptRunner:
         """Start the blended group of moves at ``pc``."""
         c = self.c
         stmts = self.program.statements
-        q = c.backend.state().target_q.copy()
+        q = c.arm_state().target_q.copy()
         q0 = q.copy()
         segs: list[Segment] = []
         while self.pc < len(stmts) and stmts[self.pc].name in _MOVES:
@@ -148,15 +149,15 @@ class ScriptRunner:
             a, v, r = _float(st, "a"), _float(st, "v"), _float(st, "r")
             if linear:
                 if not pose:
-                    target = np.asarray(c.kin.tcp_vector(target.tolist()))
-                seg = linear_segment(q, target, v, a, r, c.kin)
+                    target = np.asarray(self.kin.tcp_vector(target.tolist()))
+                seg = linear_segment(q, target, v, a, r, self.kin)
             else:
                 if pose:
-                    qt = c.kin.ik_nearest(target, q)
+                    qt = self.kin.ik_nearest(target, q)
                     if qt is None:
                         raise MotionError(f"line {st.line}: movej: pose out of reach")
                     target = qt
-                seg = joint_segment(q, target, v, a, r, c.kin)
+                seg = joint_segment(q, target, v, a, r, self.kin)
             segs.append(seg)
             q = seg.q_end
             if r <= 0.0:

@@ -43,19 +43,19 @@ from threading import RLock
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ...robot import RobotModel
-from .backend import ArmBackend, KinematicBackend
+from ..protocol.modes import JointMode, RobotMode, RuntimeState, SafetyMode, SafetyStatusBit
+from ..robot import RobotModel
+from .backend import ArmBackend, ArmState, KinematicBackend
 from .handshake import ControlScript
 from .kinematics import ArmKinematics
 from .motion import MotionError, PathMotion, Segment, StopMotion, joint_segment, linear_segment
 from .program import CompileError, PathWaypoint, Program, parse_program
 from .script_functions import compile_program
 from .script_runner import ScriptRunner, run_io_statement
-from .states import JointMode, RobotMode, RuntimeState, SafetyMode, SafetyStatusBit
 
 __all__ = ["DEFAULT_Q", "Controller", "Event"]
 
-log = logging.getLogger("ruledrobot.export.emulator")
+log = logging.getLogger("ruledrobot.ursim")
 
 #: Start configuration [rad]: elbow up, tool pointing down, away from singularities.
 DEFAULT_Q = (0.0, -1.5707963267948966, 1.5707963267948966, -1.5707963267948966,
@@ -302,6 +302,10 @@ class Controller:
         return r.line if isinstance(r, ScriptRunner) else 0
 
     # ------------------------------------------------------------ registers and inputs
+
+    def arm_state(self) -> ArmState:
+        """The arm's state after the last period (:class:`~.host.ProgramHost`)."""
+        return self.backend.state()
 
     def in_int(self, i: int) -> int:
         return self.values.get(_IN_INT[i], 0)  # type: ignore[return-value]

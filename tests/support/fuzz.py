@@ -1,4 +1,4 @@
-"""Hostile input for the emulator's three ports: for ``tests/export/test_fuzz.py`` and
+"""Hostile input for the emulator's three ports: for ``tests/ursim/test_fuzz.py`` and
 ``scripts/fuzz_emulator.py``.
 
 :func:`fuzz` sends, for a bounded time, round-robin cases on short-lived
@@ -21,8 +21,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .protocol import pack_packet
-from .rtde_types import INPUT_TYPES, OUTPUT_TYPES
+from ruledrobot.protocol.rtde import pack_packet
+from ruledrobot.protocol.rtde_types import INPUT_TYPES, OUTPUT_TYPES
 
 __all__ = ["FuzzReport", "check_loopback", "dashboard_case", "fuzz", "rtde_case", "script_case"]
 

@@ -10,12 +10,11 @@ import time
 
 import numpy as np
 
-from ruledrobot.export.emulator import DEFAULT_Q, Emulator
-from ruledrobot.export.emulator import fuzz as fuzz_mod
-from ruledrobot.export.emulator.protocol import pack_packet
-from ruledrobot.export.emulator.rawclient import UR_RTDE_RECEIVE_RECIPE, RawRTDEClient
-
-from .conftest import UR
+from ruledrobot.protocol.rtde import pack_packet
+from ruledrobot.ursim import DEFAULT_Q, Emulator
+from tests.support import fuzz as fuzz_mod
+from tests.support.emulators import UR
+from tests.support.rawclient import UR_RTDE_RECEIVE_RECIPE, RawRTDEClient
 
 
 def _blast(host: str, port: int, payload: bytes, read: bool = True) -> None:

@@ -19,12 +19,12 @@ process, so that a ur_rtde client in this process does not deadlock it).
 
 from __future__ import annotations
 
+from ..protocol.modes import JointMode, RobotMode, RuntimeState, SafetyMode, SafetyStatusBit
 from .backend import HARDWARE_ACCELERATION, ArmBackend, ArmState, KinematicBackend
 from .controller import DEFAULT_Q, Controller
 from .handshake import Command
 from .process import Emulator
 from .server import ClockStats, ThreadedEmulator, serve
-from .states import JointMode, RobotMode, RuntimeState, SafetyMode, SafetyStatusBit
 
 __all__ = [
     "DEFAULT_Q",

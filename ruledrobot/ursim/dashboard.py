@@ -11,13 +11,13 @@ from __future__ import annotations
 import logging
 from collections import deque
 
+from ..protocol.modes import RuntimeState
 from .controller import Controller
-from .states import RuntimeState
 from .tcp import Connection, TcpServer
 
 __all__ = ["GREETING", "DashboardServer"]
 
-log = logging.getLogger("ruledrobot.export.emulator")
+log = logging.getLogger("ruledrobot.ursim")
 
 GREETING = "Connected: Universal Robots Dashboard Server"
 _MAX_LINE = 4096

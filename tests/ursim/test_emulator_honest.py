@@ -19,13 +19,12 @@ import numpy as np
 import pytest
 
 from ruledrobot.export import urscript_program
-from ruledrobot.export.emulator import DEFAULT_Q, Emulator
-from ruledrobot.export.emulator.controller import Controller
-from ruledrobot.export.emulator.rawclient import RawRTDEClient
 from ruledrobot.robot import load
 from ruledrobot.robot.trajectory import Payload, Trajectory
-
-from .conftest import UR, smooth_trajectory
+from ruledrobot.ursim import DEFAULT_Q, Emulator
+from ruledrobot.ursim.controller import Controller
+from tests.support.emulators import UR, smooth_trajectory
+from tests.support.rawclient import RawRTDEClient
 
 MODEL = load("ur5e")
 

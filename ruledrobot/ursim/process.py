@@ -31,11 +31,11 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ...protocol.primary import KinematicsInfo
-from ...robot import Calibration, RobotModel
+from ..protocol.modes import RobotMode, RuntimeState, SafetyMode
+from ..protocol.primary import KinematicsInfo
+from ..robot import Calibration, RobotModel
 from .backend import ArmBackend
 from .server import ThreadedEmulator, emulated_model
-from .states import RobotMode, RuntimeState, SafetyMode
 
 __all__ = ["Emulator"]
 

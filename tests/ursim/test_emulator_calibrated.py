@@ -18,12 +18,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from ruledrobot.export.emulator import DEFAULT_Q, Emulator, ThreadedEmulator
 from ruledrobot.geometry.se3 import pose_from_ur_vector, ur_vector_from_pose
+from ruledrobot.io.calibration import save_calibration
 from ruledrobot.protocol.primary import PRIMARY_PORT, SECONDARY_PORT, read_kinematics_info
-from ruledrobot.robot import load, random_calibration, save_calibration
-
-from .conftest import UR, _address, start_emulator
+from ruledrobot.robot import load, random_calibration
+from ruledrobot.ursim import DEFAULT_Q, Emulator, ThreadedEmulator
+from tests.support.emulators import UR, _address, start_emulator
 
 pytest.importorskip("rtde_control")
 

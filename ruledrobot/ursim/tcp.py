@@ -34,7 +34,7 @@ from collections.abc import Callable
 
 __all__ = ["IDLE_WAIT", "POLL", "Connection", "QueuedConnection", "TcpServer", "writable_fds"]
 
-log = logging.getLogger("ruledrobot.export.emulator")
+log = logging.getLogger("ruledrobot.ursim")
 
 #: seconds between checks of the stop flag in blocking socket calls
 POLL = 0.1

@@ -16,9 +16,6 @@ from collections.abc import Iterator
 import numpy as np
 import pytest
 
-from ruledrobot.export.emulator import ThreadedEmulator
-from ruledrobot.export.emulator.rawclient import UR_RTDE_RECEIVE_RECIPE, RawRTDEClient
-from ruledrobot.export.emulator.server import CB3_VERSION, E_SERIES_VERSION
 from ruledrobot.protocol.primary import (
     KINEMATICS_INFO,
     ROBOT_MESSAGE,
@@ -35,8 +32,10 @@ from ruledrobot.protocol.primary import (
     split_messages,
 )
 from ruledrobot.robot import load
-
-from .conftest import _address
+from ruledrobot.ursim import ThreadedEmulator
+from ruledrobot.ursim.server import CB3_VERSION, E_SERIES_VERSION
+from tests.support.emulators import _address
+from tests.support.rawclient import UR_RTDE_RECEIVE_RECIPE, RawRTDEClient
 
 
 def _emulator(nodeid: str, model: str = "ur5e", **kwargs) -> ThreadedEmulator:
