@@ -20,7 +20,8 @@ from typing import Literal
 import numpy as np
 
 from ..geometry import se3
-from ..geometry._arrays import FloatArray, cross
+from ..geometry._arrays import cross
+from ..geometry.checks import FloatArray
 from ..geometry.lines import (
     Lines,
     coincident_neighbours,

@@ -9,7 +9,7 @@ from typing import Any
 import numpy as np
 
 from ..algorithms import refine
-from ..geometry._arrays import FloatArray
+from ..geometry.checks import FloatArray
 from ..geometry.lines import Lines, plucker_transform
 from ..geometry.mesh import strip_mesh
 from ..geometry.ruled import RuledSurface

@@ -8,7 +8,7 @@ from typing import Any
 
 import numpy as np
 
-from ..geometry._arrays import FloatArray
+from ..geometry.checks import FloatArray
 from ..geometry.lines import Lines
 from ..geometry.mesh import Mesh
 

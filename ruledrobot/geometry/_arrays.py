@@ -1,50 +1,13 @@
-"""Input checking shared by the geometry layer.
+"""Small vector kernels over the last axis (norm, dot, cross), broadcasting, no warnings.
 
-Every public function that takes user data funnels it through these helpers so
-that bad input raises one kind of error (:class:`ValueError`) with a message
-that names the argument, the offending index and what was expected.
+Input checks are in :mod:`.checks`.
 """
 
 from __future__ import annotations
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
 
-FloatArray = NDArray[np.float64]
-
-
-def as_float_array(value: ArrayLike, name: str, tail: tuple[int, ...] = ()) -> FloatArray:
-    """Return ``value`` as a float64 array whose trailing axes equal ``tail``.
-
-    Raises ValueError naming ``name`` when the shape is wrong or an entry is
-    not finite (the message gives the index of the first bad entry).
-    """
-    try:
-        arr = np.asarray(value, dtype=np.float64)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"{name}: expected numbers, got {type(value).__name__} ({exc})") from None
-    if tail and (arr.ndim < len(tail) or arr.shape[arr.ndim - len(tail) :] != tail):
-        want = "(..., " + ", ".join(str(n) for n in tail) + ")"
-        raise ValueError(f"{name}: expected an array of shape {want}, got shape {arr.shape}")
-    check_finite(arr, name, tail)
-    return arr
-
-
-def check_finite(arr: FloatArray, name: str, tail: tuple[int, ...] = ()) -> None:
-    """Raise ValueError naming the first batch index of ``arr`` holding NaN or inf."""
-    finite = np.isfinite(arr)
-    if finite.all():
-        return
-    item_ok = finite.reshape(*arr.shape[: arr.ndim - len(tail)], -1).all(axis=-1)
-    bad = np.argwhere(~item_ok)[0]
-    where = f"[{', '.join(str(int(i)) for i in bad)}]" if bad.size else ""
-    raise ValueError(f"{name}{where}: contains NaN or infinity; expected finite values")
-
-
-def first_index(mask: NDArray[np.bool_]) -> str:
-    """Format the first True index of a boolean array as ``[i, j]``."""
-    idx = np.argwhere(mask)[0]
-    return "[" + ", ".join(str(int(i)) for i in idx) + "]"
+from .checks import FloatArray
 
 
 def norm(v: FloatArray) -> FloatArray:

@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ._arrays import FloatArray, as_float_array
+from .checks import FloatArray, as_float_array
 
 __all__ = ["Box"]
 

@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ._arrays import FloatArray
+from .checks import FloatArray
 
 __all__ = ["interp_hermite", "interp_linear"]
 

@@ -21,7 +21,8 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ._arrays import FloatArray, as_float_array, cross, cross3, dot, dot3, first_index, norm
+from ._arrays import cross, cross3, dot, dot3, norm
+from .checks import FloatArray, as_float_array, first_index
 
 __all__ = [
     "CommonNormal",

@@ -24,8 +24,9 @@ from typing import NamedTuple
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ._arrays import FloatArray, as_float_array, check_finite, first_index, norm
+from ._arrays import norm
 from .box import Box
+from .checks import FloatArray, as_float_array, check_finite, first_index
 from .lines import Lines
 from .ruled import RuledSurface
 

@@ -46,7 +46,8 @@ from typing import Literal
 import numpy as np
 
 from . import se3
-from ._arrays import FloatArray, cross, dot, norm
+from ._arrays import cross, dot, norm
+from .checks import FloatArray
 from .lines import CommonNormal, Lines, common_normal
 
 __all__ = ["RuledSurface", "dh_transform"]

@@ -39,7 +39,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ._arrays import FloatArray, as_float_array, cross3, dot3, first_index
+from ._arrays import cross3, dot3
+from .checks import FloatArray, as_float_array, first_index
 
 __all__ = [
     "ScrewPair",

@@ -13,7 +13,8 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ._arrays import FloatArray, as_float_array, dot, first_index, norm
+from ._arrays import dot, norm
+from .checks import FloatArray, as_float_array, first_index
 
 __all__ = ["exp", "geodesic", "geodesic_many", "log", "validate_unit"]
 

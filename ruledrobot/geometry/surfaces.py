@@ -58,7 +58,8 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ._arrays import FloatArray, as_float_array, norm
+from ._arrays import norm
+from .checks import FloatArray, as_float_array
 from .lines import Lines, plucker_from_point_direction
 
 __all__ = [

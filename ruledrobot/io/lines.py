@@ -25,7 +25,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..geometry._arrays import FloatArray
+from ..geometry.checks import FloatArray
 from ..geometry.lines import Lines, plucker_from_point_direction, validate_plucker
 from .atomic import atomic_write_text
 from .text import read_user_text

@@ -22,7 +22,7 @@ from typing import NamedTuple
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..geometry._arrays import FloatArray
+from ..geometry.checks import FloatArray
 from ..geometry.mesh import IntArray, Mesh, mesh_normals, validate_mesh
 from .atomic import atomic_write_bytes, atomic_write_text
 

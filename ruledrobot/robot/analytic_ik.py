@@ -68,11 +68,10 @@ from dataclasses import dataclass
 from typing import NamedTuple
 
 import numpy as np
-from numpy.typing import ArrayLike
 
+from ..geometry.angles import wrap_angle
 from ._checks import FloatArray
 
-TWO_PI = 2.0 * np.pi
 WRIST_EPS = 1e-12  # |sin q5| below which the wrist is treated as singular
 RESCUE_W = 1e-6  # |sin q5| below which a missed elbow may be rescued by turning q6 ...
 RESCUE_ERR = 1e-11  # ... if the pose error that costs, |sin q5| |delta q6|, stays below this
@@ -116,18 +115,6 @@ class IKSolutions:
     elbow: FloatArray
     shoulder: FloatArray
     measure: FloatArray
-
-
-def wrap_angle(x: ArrayLike) -> FloatArray:
-    """Principal values in (-pi, pi] of finite angles [rad] (any shape).
-
-    ``x - 2 pi ceil((x - pi) / 2 pi)``, then a clamp for the one-ulp overshoot
-    rounding can leave at either end (+-pi both map to pi).
-    """
-    x = np.asarray(x, dtype=np.float64)
-    y = x - TWO_PI * np.ceil((x - np.pi) / TWO_PI)
-    y = np.minimum(y, np.pi)
-    return np.where(y > -np.pi, y, np.pi)
 
 
 def _atan2(y: FloatArray, x: FloatArray) -> FloatArray:

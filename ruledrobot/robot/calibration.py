@@ -41,6 +41,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ..geometry.angles import wrap_angle
 from ._checks import FloatArray, readonly
 from .ur_tables import MODEL_NAMES, NominalDH, nominal_dh
 
@@ -61,7 +62,6 @@ __all__ = [
 #: ``0 == notInitialized / 1 == notLinearised / 2 == Linearised``).
 STATUS_TEXT = {0: "not initialized", 1: "not linearised", 2: "linearised"}
 _COLUMNS = ("theta_offset", "a", "d", "alpha")
-_TWO_PI = 2.0 * math.pi
 
 
 class CalibrationError(ValueError):
@@ -96,12 +96,6 @@ _JOINT_NAMES = ("base", "shoulder", "elbow", "wrist 1", "wrist 2", "wrist 3")
 
 def _joint(i: int) -> str:
     return f"joint {i + 1} ({_JOINT_NAMES[i]})"
-
-
-def _wrap(x: float) -> float:
-    """``x`` modulo 2 pi in (-pi, pi]."""
-    y = math.remainder(x, _TWO_PI)
-    return math.pi if y == -math.pi else y
 
 
 def _column(value: ArrayLike, name: str) -> FloatArray:
@@ -319,8 +313,8 @@ def calibration_deviations(cal: Calibration) -> dict[str, Any]:
     m = _nominal_model(cal.model)
     nominal = np.stack([m.theta_offset, m.a, m.d, m.alpha], axis=1)
     delta = cal.dh() - nominal
-    delta[:, 0] = [_wrap(v) for v in delta[:, 0]]
-    delta[:, 3] = [_wrap(v) for v in delta[:, 3]]
+    delta[:, 0] = wrap_angle(delta[:, 0])
+    delta[:, 3] = wrap_angle(delta[:, 3])
     Fn = zero_frames(m.theta_offset, m.a, m.d, m.alpha)
     Fc = zero_frames(cal.theta_offset, cal.a, cal.d, cal.alpha)
     tilt, offset = np.zeros(6), np.zeros(6)
@@ -333,7 +327,7 @@ def calibration_deviations(cal: Calibration) -> dict[str, Any]:
     return {
         "delta": delta,
         "d_sum": float(delta[1:4, 2].sum()),
-        "theta_sum": _wrap(float(delta[1:4, 0].sum())),
+        "theta_sum": float(wrap_angle(delta[1:4, 0].sum())),
         "axis_tilt": tilt,
         "axis_offset": offset,
         "flange_position": float(np.linalg.norm(Fn[6, :3, 3] - Fc[6, :3, 3])),

@@ -13,8 +13,9 @@ from typing import Protocol
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ..geometry.angles import wrap_angle
 from ._checks import FloatArray
-from .calibration import Calibration, CalibrationError, _nominal_model, _wrap, zero_frames
+from .calibration import Calibration, CalibrationError, _nominal_model, zero_frames
 from .ur_tables import NominalDH
 
 __all__ = ["dh_from_axes", "random_calibration"]
@@ -166,7 +167,7 @@ def _random_attempt(
     flange[:3, 0], flange[:3, 1], flange[:3, 2], flange[:3, 3] = x6, np.cross(z6, x6), z6, of
     table = dh_from_axes(points, dirs, flange, reference_x=F[1:, :3, 0])
     table[:, 0] += rng.normal(0.0, 3e-5 * scale, 6)
-    table[:, 0] = [_wrap(v) for v in table[:, 0]]
+    table[:, 0] = wrap_angle(table[:, 0])
     checksum = tuple(int(c) for c in rng.integers(0, 2**32, 6))
     return Calibration.from_dh(nom.name, table, checksum=checksum, source=source, status=2)
 

@@ -40,6 +40,7 @@ from typing import Protocol
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ..geometry.angles import TWO_PI, wrap_angle
 from . import analytic_ik as _ik
 from ._checks import FloatArray, as_array, as_joint_vector, as_poses
 
@@ -59,7 +60,6 @@ class PathArm(Protocol):
     def flange_poses(self, T: ArrayLike, *, check: bool = True) -> FloatArray: ...
 
 
-TWO_PI = 2.0 * np.pi
 _LIMIT_EPS = 1e-9  # rad of slack on the joint limits when placing 2 pi representatives
 _STEP_CHUNK = 2048  # path steps per chunk when building the (8 x 8) step costs
 
@@ -161,17 +161,13 @@ def _representable(x: FloatArray, lo: FloatArray, hi: FloatArray) -> np.ndarray:
     return np.where(finite_lo, rep <= hi + _LIMIT_EPS, True)
 
 
-def _wrap(x: FloatArray) -> FloatArray:
-    return x - TWO_PI * np.ceil((x - np.pi) / TWO_PI)
-
-
 def _step_costs(Q: FloatArray, feas: np.ndarray, w: FloatArray) -> FloatArray:
     """(M-1, 8, 8) cost of going from candidate i at t to candidate j at t+1."""
     M = Q.shape[0]
     C = np.empty((max(M - 1, 0), 8, 8))
     for lo in range(0, M - 1, _STEP_CHUNK):
         hi = min(lo + _STEP_CHUNK, M - 1)
-        d = _wrap(Q[lo + 1 : hi + 1, None, :, :] - Q[lo:hi, :, None, :])
+        d = wrap_angle(Q[lo + 1 : hi + 1, None, :, :] - Q[lo:hi, :, None, :])
         c = np.einsum("tijk,k->tij", d * d, w)
         ok = feas[lo:hi, :, None] & feas[lo + 1 : hi + 1, None, :]
         C[lo:hi] = np.where(ok, c, np.inf)
@@ -331,7 +327,7 @@ def path_ik(
             if start is None:
                 s0 = np.zeros(8)
             else:
-                d0 = _wrap(Qc[0] - start)
+                d0 = wrap_angle(Qc[0] - start)
                 s0 = (d0 * d0) @ w
             s0 = np.where(Fc[0], s0, np.inf)
             return _viterbi(_step_costs(Qc, Fc, w), s0)
@@ -355,7 +351,7 @@ def path_ik(
         # continuous representatives, then whole turns into the limits
         k = np.zeros_like(qsel)
         if M > 1:
-            steps = np.cumsum(_wrap(np.diff(qsel, axis=0)), axis=0)
+            steps = np.cumsum(wrap_angle(np.diff(qsel, axis=0)), axis=0)
             u = qsel[0] + np.concatenate([np.zeros((1, J)), steps])
             k = np.round((u - qsel) / TWO_PI)
         u = qsel + TWO_PI * k
@@ -439,7 +435,7 @@ def _seeds_for_singular(q6: FloatArray, sing: np.ndarray, start: FloatArray | No
     frac = np.where(inner, pos - before, 0) / np.where(inner, after - before, 1)
     default = 0.0 if start is None else float(start[5])
     seed = np.where(has_b, qb, np.where(has_a, qa, default))
-    return seed + frac * _wrap(qa - qb)
+    return seed + frac * wrap_angle(qa - qb)
 
 
 def _messages(

@@ -12,8 +12,8 @@ from typing import Any
 
 import numpy as np
 
-from ..geometry._arrays import FloatArray
 from ..geometry.box import Box
+from ..geometry.checks import FloatArray
 from ..robot.model import RobotModel
 from .scene import BowTool
 

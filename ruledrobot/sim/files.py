@@ -12,7 +12,7 @@ import os
 from pathlib import Path
 from typing import Any
 
-from ..geometry._arrays import FloatArray
+from ..geometry.checks import FloatArray
 from ..robot.model import RobotModel
 from .playback import PlaybackResult, ProgressCallback, play
 from .scene import Scene

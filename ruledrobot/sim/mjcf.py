@@ -38,7 +38,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..geometry._arrays import FloatArray
+from ..geometry.checks import FloatArray, as_per_joint
 from ..io.atomic import atomic_write_text
 from ..robot.model import RobotModel
 from ._xml import placed, sub, to_string
@@ -174,16 +174,10 @@ class ServoGains:
 
 
 def _per_joint(value: ArrayLike | None, default: FloatArray, name: str) -> FloatArray:
+    """``value`` per joint (a scalar or one per joint, each >= 0), ``default`` if None."""
     if value is None:
         return default
-    try:
-        v = np.broadcast_to(np.asarray(value, dtype=np.float64), default.shape).copy()
-    except ValueError:
-        raise ValueError(f"{name}: expected a scalar or {default.shape[0]} values") from None
-    if not np.all(np.isfinite(v)) or np.any(v < 0.0):
-        k = int(np.flatnonzero(~(np.isfinite(v) & (v >= 0.0)))[0])
-        raise ValueError(f"{name}[{k}]: expected a finite value >= 0, got {v[k]!r}")
-    return v
+    return as_per_joint(value, name, default.shape[0], minimum=0.0)
 
 
 # ---------------------------------------------------------------------------------------

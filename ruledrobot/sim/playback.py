@@ -37,7 +37,7 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..geometry._arrays import FloatArray, as_float_array
+from ..geometry.checks import FloatArray, as_float_array
 from ..geometry.interp import interp_hermite
 from ..robot.model import RobotModel
 from ._mujoco import mujoco

@@ -28,7 +28,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..geometry._arrays import FloatArray
+from ..geometry.checks import FloatArray
 from ..geometry.interp import interp_linear
 from ..io.atomic import atomic_write_bytes
 from ..robot.model import RobotModel

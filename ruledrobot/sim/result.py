@@ -13,7 +13,7 @@ from typing import Any
 import numpy as np
 
 from ..geometry import se3
-from ..geometry._arrays import FloatArray
+from ..geometry.checks import FloatArray
 from ..io.atomic import atomic_open, atomic_write_text
 from ..robot.model import RobotModel
 from ..robot.verdict import Check, Verdict

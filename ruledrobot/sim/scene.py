@@ -27,8 +27,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..geometry._arrays import FloatArray
 from ..geometry.box import Box
+from ..geometry.checks import FloatArray
 from ..robot._checks import as_point
 from ..robot.model import RobotModel
 from ..robot.tool import BowTool

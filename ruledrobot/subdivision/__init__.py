@@ -11,7 +11,7 @@ from typing import Literal, overload
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..geometry._arrays import FloatArray, as_float_array
+from ..geometry.checks import FloatArray, as_float_array
 from ..geometry.lines import Lines, plucker_project
 from .engine import refine_sequence
 from .schemes import SCHEME_NAMES, Scheme, get_scheme

@@ -23,7 +23,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from ..geometry._arrays import FloatArray
+from ..geometry.checks import FloatArray
 from .schemes import Scheme
 from .spaces import Space
 

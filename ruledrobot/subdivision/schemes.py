@@ -30,7 +30,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..geometry._arrays import FloatArray
+from ..geometry.checks import FloatArray
 from .spaces import Space
 
 __all__ = ["SCHEME_NAMES", "Scheme", "get_scheme"]

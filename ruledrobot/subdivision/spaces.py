@@ -27,7 +27,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ..geometry import se3, sphere
-from ..geometry._arrays import FloatArray
+from ..geometry.checks import FloatArray
 
 __all__ = ["EuclideanSpace", "SE3Space", "Space", "SphereSpace"]
 

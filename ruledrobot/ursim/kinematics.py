@@ -24,10 +24,11 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ..geometry.angles import wrap_angle, wrap_near
 from ..geometry.se3 import pose_from_ur_vector, ur_vector_from_pose
 from ..robot import RobotModel
 
-__all__ = ["ArmKinematics", "rotvec_from_rows", "wrap_to_nearest"]
+__all__ = ["ArmKinematics", "rotvec_from_rows"]
 
 Vec = tuple[float, ...]
 
@@ -103,11 +104,6 @@ def rotvec_from_rows(R: Sequence[Sequence[float]]) -> Vec:
         return (2.0 * x, 2.0 * y, 2.0 * z)
     k = 2.0 * math.atan2(s, w) / s
     return (x * k, y * k, z * k)
-
-
-def wrap_to_nearest(q: np.ndarray, ref: np.ndarray) -> np.ndarray:
-    """The 2 pi representative of each joint of ``q`` nearest ``ref``."""
-    return ref + np.remainder(q - ref + np.pi, 2.0 * np.pi) - np.pi
 
 
 class ArmKinematics:
@@ -205,7 +201,7 @@ class ArmKinematics:
         sols = sols[~np.isnan(sols[:, 0])]
         if sols.shape[0] == 0:
             return None
-        sols = wrap_to_nearest(sols, qn)
+        sols = wrap_near(sols, qn)
         if within_limits:
             ok = np.all((sols >= self.model.lower) & (sols <= self.model.upper), axis=1)
             sols = sols[ok]
@@ -229,13 +225,13 @@ class ArmKinematics:
         # singularities); fall back to sample-by-sample nearest solutions otherwise
         first = sols[0][~np.isnan(sols[0][:, 0])]
         if first.shape[0]:
-            d = np.sum((wrap_to_nearest(sols[0], q) - q) ** 2, axis=1)
+            d = np.sum((wrap_near(sols[0], q) - q) ** 2, axis=1)
             b = int(np.nanargmin(d))
             branch = sols[:, b, :]
             if not np.isnan(branch).any():
-                steps = np.remainder(np.diff(branch, axis=0) + np.pi, 2.0 * np.pi) - np.pi
+                steps = wrap_angle(np.diff(branch, axis=0))
                 if steps.size == 0 or float(np.max(np.abs(steps))) < 0.05:
-                    start = wrap_to_nearest(branch[0], q)
+                    start = wrap_near(branch[0], q)
                     return start + np.concatenate([np.zeros((1, 6)), np.cumsum(steps, axis=0)])
         out = np.empty((poses.shape[0], 6))
         for k in range(poses.shape[0]):
@@ -243,7 +239,7 @@ class ArmKinematics:
             s = s[~np.isnan(s[:, 0])]
             if s.shape[0] == 0:
                 return None
-            s = wrap_to_nearest(s, q)
+            s = wrap_near(s, q)
             q = s[int(np.argmin(np.sum((s - q) ** 2, axis=1)))]
             out[k] = q
         return out

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..geometry._arrays import FloatArray
+from ..geometry.checks import FloatArray
 
 __all__ = ["feed_speeds", "wire_points"]
 

@@ -22,8 +22,8 @@ import numpy as np
 
 from ..algorithms import check_distinct_neighbours, refine
 from ..geometry import se3
-from ..geometry._arrays import FloatArray
 from ..geometry.box import Box
+from ..geometry.checks import FloatArray
 from ..geometry.ruled import RuledSurface
 from ..subdivision import check_size, get_scheme, refined_count
 from .job import Job

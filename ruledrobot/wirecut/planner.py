@@ -27,12 +27,12 @@ from pathlib import Path
 import numpy as np
 
 from ..geometry import se3
-from ..geometry._arrays import FloatArray
+from ..geometry.angles import wrap_near
+from ..geometry.checks import FloatArray
 from ..geometry.interp import interp_linear
 from ..io.atomic import atomic_write_bytes, atomic_write_text
 from ..io.lines import save_lines
 from ..io.trajectory import write_trajectory
-from ..robot import wrap_angle
 from ..robot.trajectory import Trajectory
 from ..robot.verdict import Check, Verdict
 from .checks import Measurements, collision_sentence, plan_verdict
@@ -60,11 +60,6 @@ class PlanResult:
     verdict: Verdict | None = None
 
 
-def _wrap_near(q: FloatArray, ref: FloatArray) -> FloatArray:
-    """The 2 pi representatives of ``q`` nearest ``ref``."""
-    return ref + wrap_angle(q - ref)
-
-
 def _backed_off(model, q: FloatArray, away: FloatArray, dist: float) -> FloatArray | None:
     """Joints nearest ``q`` whose flange is ``dist`` further along ``away`` (unit, base
     frame); None if unreachable or out of limits."""
@@ -74,7 +69,7 @@ def _backed_off(model, q: FloatArray, away: FloatArray, dist: float) -> FloatArr
     sols = sols[~np.isnan(sols).any(axis=1)]
     if not len(sols):
         return None
-    sols = _wrap_near(sols, q)
+    sols = wrap_near(sols, q)
     best = sols[np.argmin(np.abs(sols - q).max(axis=1))]
     return best if model.within_limits(best) else None
 
@@ -109,7 +104,7 @@ def _timed_motion(job: Job, model, cp: CutPath) -> tuple[TimedPath, int]:
     above_end = _backed_off(model, end, away[1], LIFT)
     slow = job.cut.approach_speed
     if job.robot.home is not None:
-        home = _wrap_near(job.robot.home, start)
+        home = wrap_near(job.robot.home, start)
         first = home if above_start is None else above_start
         parts.append(joint_move(home, first, vel, acc, dt, slow))
     if above_start is not None:
@@ -120,7 +115,7 @@ def _timed_motion(job: Job, model, cp: CutPath) -> tuple[TimedPath, int]:
         parts.append(joint_move(end, above_end, vel, acc, dt, slow))
     if job.robot.home is not None:
         last = end if above_end is None else above_end
-        parts.append(joint_move(last, _wrap_near(job.robot.home, last), vel, acc, dt, slow))
+        parts.append(joint_move(last, wrap_near(job.robot.home, last), vel, acc, dt, slow))
     return (concatenate(parts, dt) if len(parts) > 1 else cut), n_before
 
 

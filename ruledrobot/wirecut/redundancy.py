@@ -38,8 +38,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..geometry._arrays import FloatArray
 from ..geometry.box import Box
+from ..geometry.checks import FloatArray
 from ..geometry.segments import segment_distance
 from ..robot import path_ik, wrap_angle
 from ..robot.tool import BowTool

@@ -26,8 +26,8 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ..geometry import se3
-from ..geometry._arrays import FloatArray
 from ..geometry.box import Box
+from ..geometry.checks import FloatArray
 from ..robot.tool import BowTool
 from .job import ToolSpec
 

@@ -27,7 +27,7 @@ ALLOWED: dict[str, set[str]] = {
     "cli": {
         "algorithms", "batch", "export", "gallery", "geometry", "io", "protocol", "robot",
         "sim", "subdivision", "ursim", "view", "wirecut",
-    },  # fmt: skip
+    },
     # the package root re-exports the light lower layers only (``rr.Lines``, ``rr.refine``)
     "": {"algorithms", "geometry", "io", "subdivision"},
 }

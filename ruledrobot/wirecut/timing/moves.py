@@ -8,7 +8,7 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .checks import _array, _float, _limits
+from ...geometry.checks import as_limits, as_number, as_shaped
 from .limits import CONTINUITY_TOL, MAX_SAMPLES, FloatArray
 from .report import trajectory_limits_report
 from .result import TimedPath
@@ -43,13 +43,13 @@ def joint_move(
         :class:`TimedPath` with ``s_of_t`` the fraction of the move (0…1), exact
         endpoints, zero velocity and acceleration at both ends, no feed.
     """
-    a0 = _array(q0, "q0", (None,))
+    a0 = as_shaped(q0, "q0", (None,))
     J = a0.shape[0]
-    a1 = _array(q1, "q1", (J,))
-    vlim = _limits(vel_limits, "vel_limits", J)
-    alim = _limits(acc_limits, "acc_limits", J)
-    dt = _float(dt, "dt")
-    k_s = _float(speed_scale, "speed_scale")
+    a1 = as_shaped(q1, "q1", (J,))
+    vlim = as_limits(vel_limits, "vel_limits", J)
+    alim = as_limits(acc_limits, "acc_limits", J)
+    dt = as_number(dt, "dt")
+    k_s = as_number(speed_scale, "speed_scale")
     if k_s > 1.0:
         raise ValueError(f"speed_scale: expected a factor in (0, 1], got {k_s}")
     delta = a1 - a0
@@ -133,7 +133,7 @@ def concatenate(parts: Sequence[TimedPath], dt: float) -> TimedPath:
         ValueError: no parts, a part not sampled every ``dt`` (index named), joint
             counts differ, or a discontinuity (the index of the later part named).
     """
-    dt = _float(dt, "dt")
+    dt = as_number(dt, "dt")
     parts = list(parts)
     if not parts:
         raise ValueError("parts: expected at least one TimedPath, got none")

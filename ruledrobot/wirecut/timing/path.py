@@ -7,7 +7,7 @@ from dataclasses import replace
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .checks import _array, _float, _increasing, _limits
+from ...geometry.checks import as_limits, as_number, as_shaped, check_increasing
 from .limits import FEED_TOL, MAX_TRIES, REFINE_ROUNDS, FloatArray
 from .problem import _prepare, _Problem
 from .result import TimedPath
@@ -63,25 +63,25 @@ def time_path(
         ValueError: bad input (the message names the argument and index), or no
             trajectory within the limits (the message names the constraint and where).
     """
-    s_arr = _array(s, "s", (None,))
+    s_arr = as_shaped(s, "s", (None,))
     N = s_arr.shape[0]
     if N < 2:
         raise ValueError(f"s: expected at least 2 samples, got {N}")
-    _increasing(s_arr, "s")
-    q_arr = _array(q, "q", (N, None))
+    check_increasing(s_arr, "s")
+    q_arr = as_shaped(q, "q", (N, None))
     J = q_arr.shape[1]
     if J < 1:
         raise ValueError("q: expected at least one joint column, got shape (N, 0)")
-    sf = _array(speed_factor, "speed_factor", (N,))
+    sf = as_shaped(speed_factor, "speed_factor", (N,))
     neg = np.flatnonzero(sf < 0)
     if neg.size:
         i = int(neg[0])
         raise ValueError(f"speed_factor[{i}]: expected a value >= 0, got {sf[i]}")
-    feed = _float(feed_speed, "feed_speed")
-    vlim = _limits(vel_limits, "vel_limits", J)
-    alim = _limits(acc_limits, "acc_limits", J)
-    dt = _float(dt, "dt")
-    safety = _float(safety, "safety")
+    feed = as_number(feed_speed, "feed_speed")
+    vlim = as_limits(vel_limits, "vel_limits", J)
+    alim = as_limits(acc_limits, "acc_limits", J)
+    dt = as_number(dt, "dt")
+    safety = as_number(safety, "safety")
     if safety > 1.0:
         raise ValueError(f"safety: expected a factor in (0, 1], got {safety}")
     if solver not in ("toppra", "reachability"):

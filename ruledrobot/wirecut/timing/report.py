@@ -7,8 +7,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ...geometry.checks import as_limits, as_shaped, check_increasing
 from ...robot.rates import finite_difference_rates
-from .checks import _array, _increasing, _limits
 from .limits import RATIO_TOL, FloatArray
 
 # --------------------------------------------------------------------------- report
@@ -40,12 +40,12 @@ def trajectory_limits_report(
     Raises:
         ValueError: bad shapes, non-finite values, non-increasing ``t``, limits <= 0.
     """
-    t = _array(t, "t", (None,))
-    q = _array(q, "q", (t.shape[0], None))
+    t = as_shaped(t, "t", (None,))
+    q = as_shaped(q, "q", (t.shape[0], None))
     J = q.shape[1]
-    vlim = _limits(vel_limits, "vel_limits", J)
-    alim = _limits(acc_limits, "acc_limits", J)
-    _increasing(t, "t")
+    vlim = as_limits(vel_limits, "vel_limits", J)
+    alim = as_limits(acc_limits, "acc_limits", J)
+    check_increasing(t, "t")
     M = t.shape[0]
     out: dict[str, Any] = {
         "n_samples": M,
