@@ -1,5 +1,8 @@
 """Checks of a joint trajectory against a robot's limits, before anything moves.
 
+Positions here; speeds and accelerations by the robot layer's limits report
+(:func:`ruledrobot.robot.rates.trajectory_limits_report`), the one the planner uses.
+
 Speeds and accelerations are finite differences of the samples (the way the
 controller will see them when the samples are streamed one per period):
 ``v_k = (q_k - q_{k-1}) / (t_k - t_{k-1})`` belongs to sample k,
@@ -11,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..robot import RobotModel
-from ..robot.rates import finite_difference_rates
+from ..robot.rates import trajectory_limits_report
 from ..robot.trajectory import Trajectory
 
 __all__ = ["check_trajectory"]
@@ -61,23 +64,23 @@ def check_trajectory(
             f"trajectory sample {k} (t = {t[k]:.4f} s): joint q{j + 1} position {q[k, j]:.6g} rad "
             f"outside the limits [{lo[j]:.6g}, {hi[j]:.6g}] rad of {model.name}"
         )
-    v, a = finite_difference_rates(ts, q)
     vmax = np.asarray(model.max_velocity) * (1.0 + tolerance)
-    bad = np.abs(v) > vmax
-    if bad.any():
-        k, j = np.argwhere(bad)[0]
+    amax = np.asarray(model.max_acceleration) * (1.0 + tolerance)
+    rep = trajectory_limits_report(ts, q, vmax, amax)
+    scaled = f" at speed_scale {speed_scale:g}" if speed_scale != 1.0 else ""
+    if rep["max_speed_ratio"] > 1.0:
+        k, j = rep["worst_speed"]
+        speed = rep["max_speed_ratio"] * vmax[j]
         raise ValueError(
             f"trajectory sample {k + 1} (t = {t[k + 1]:.4f} s): joint q{j + 1} speed "
-            f"{abs(v[k, j]):.4g} rad/s exceeds the limit {model.max_velocity[j]:.4g} rad/s of "
-            f"{model.name}" + (f" at speed_scale {speed_scale:g}" if speed_scale != 1.0 else "")
+            f"{speed:.4g} rad/s exceeds the limit {model.max_velocity[j]:.4g} rad/s of "
+            f"{model.name}{scaled}"
         )
-    amax = np.asarray(model.max_acceleration) * (1.0 + tolerance)
-    bad = np.abs(a) > amax
-    if bad.any():
-        k, j = np.argwhere(bad)[0]
+    if rep["max_acc_ratio"] > 1.0:
+        k, j = rep["worst_acc"]
+        acc = rep["max_acc_ratio"] * amax[j]
         raise ValueError(
-            f"trajectory sample {k + 1} (t = {t[k + 1]:.4f} s): joint q{j + 1} acceleration "
-            f"{abs(a[k, j]):.4g} rad/s^2 exceeds the limit {model.max_acceleration[j]:.4g} "
-            f"rad/s^2 of {model.name}"
-            + (f" at speed_scale {speed_scale:g}" if speed_scale != 1.0 else "")
+            f"trajectory sample {k} (t = {t[k]:.4f} s): joint q{j + 1} acceleration "
+            f"{acc:.4g} rad/s^2 exceeds the limit {model.max_acceleration[j]:.4g} "
+            f"rad/s^2 of {model.name}{scaled}"
         )

@@ -38,15 +38,14 @@ NPZ or URScript, atomically.
 from __future__ import annotations
 
 import io
-import json
 import os
 from pathlib import Path
 
 import numpy as np
 
 from ..geometry.se3 import ur_vector_from_pose
-from ..io.atomic import atomic_write_bytes, atomic_write_text
-from ..io.trajectory import HEADER, TRAJECTORY_FORMAT, meta_to_dict, write_trajectory
+from ..io.atomic import atomic_write_text
+from ..io.trajectory import write_trajectory, write_trajectory_json, write_trajectory_npz
 from ..robot import model_for
 from ..robot.trajectory import Trajectory
 from .decimate import decimate_tcp_path
@@ -233,24 +232,9 @@ def export_trajectory(
     if fmt == "csv":
         return write_trajectory(p, traj)
     if fmt == "json":
-        if p.with_suffix(".csv").exists():
-            raise ValueError(f"{p}: would replace the metadata of {p.with_suffix('.csv').name} "
-                             "beside it; choose another name")  # fmt: skip
-        doc = {
-            "format": TRAJECTORY_FORMAT,
-            "units": {"t": "s", "q": "rad", "tcp": "m, rad (UR pose vector, robot base frame)"},
-            "meta": meta_to_dict(traj.meta),
-            "header": HEADER,
-            "t": traj.t.tolist(),
-            "q": traj.q.tolist(),
-            "tcp": traj.tcp.tolist(),
-        }
-        return atomic_write_text(p, json.dumps(doc, indent=None, separators=(",", ":")) + "\n")
+        return write_trajectory_json(p, traj)
     if fmt == "npz":
-        buf = io.BytesIO()
-        np.savez_compressed(buf, t=traj.t, q=traj.q, tcp=traj.tcp,
-                            meta=np.array(json.dumps(meta_to_dict(traj.meta))))  # fmt: skip
-        return atomic_write_bytes(p, buf.getvalue())
+        return write_trajectory_npz(p, traj)
     if fmt == "urscript":
         return atomic_write_text(p, urscript_program(traj, **urscript_options))  # type: ignore[arg-type]
     raise ValueError(f"fmt: expected 'csv', 'json', 'npz' or 'urscript', got {fmt!r}")

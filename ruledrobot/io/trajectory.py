@@ -38,7 +38,7 @@ from typing import Any
 import numpy as np
 
 from ..robot.trajectory import KinematicsRef, Payload, Phase, Trajectory, TrajectoryMeta
-from .atomic import atomic_write_text
+from .atomic import atomic_write_bytes, atomic_write_text
 from .text import read_user_text
 
 __all__ = [
@@ -51,6 +51,8 @@ __all__ = [
     "read_trajectory",
     "sidecar_path",
     "write_trajectory",
+    "write_trajectory_json",
+    "write_trajectory_npz",
 ]
 
 HEADER = ["t", "q1", "q2", "q3", "q4", "q5", "q6", "x", "y", "z", "rx", "ry", "rz"]
@@ -225,6 +227,36 @@ def write_trajectory(path: str | os.PathLike[str], traj: Trajectory) -> Path:
     atomic_write_text(p, text)
     atomic_write_text(sidecar_path(p), json.dumps(doc, indent=1) + "\n")
     return p
+
+
+def write_trajectory_json(path: str | os.PathLike[str], traj: Trajectory) -> Path:
+    """Write ``traj`` as one JSON document (atomically): ``{"format":
+    "ruledrobot.trajectory/1", "units": {...}, "meta": {sidecar fields}, "header": [...],
+    "t": [...], "q": [[...]], "tcp": [[...]]}``.  Refuses a name whose ``.csv`` sibling
+    exists (the JSON would take the place of that CSV's sidecar)."""
+    p = Path(path)
+    if p.with_suffix(".csv").exists():
+        raise ValueError(f"{p}: would replace the metadata of {p.with_suffix('.csv').name} "
+                         "beside it; choose another name")  # fmt: skip
+    doc = {
+        "format": TRAJECTORY_FORMAT,
+        "units": {"t": "s", "q": "rad", "tcp": "m, rad (UR pose vector, robot base frame)"},
+        "meta": meta_to_dict(traj.meta),
+        "header": HEADER,
+        "t": traj.t.tolist(),
+        "q": traj.q.tolist(),
+        "tcp": traj.tcp.tolist(),
+    }
+    return atomic_write_text(p, json.dumps(doc, indent=None, separators=(",", ":")) + "\n")
+
+
+def write_trajectory_npz(path: str | os.PathLike[str], traj: Trajectory) -> Path:
+    """Write ``traj`` as a compressed NPZ (atomically): arrays ``t``, ``q``, ``tcp`` and
+    ``meta`` (the sidecar fields as JSON text)."""
+    buf = io.BytesIO()
+    np.savez_compressed(buf, t=traj.t, q=traj.q, tcp=traj.tcp,
+                        meta=np.array(json.dumps(meta_to_dict(traj.meta))))  # fmt: skip
+    return atomic_write_bytes(path, buf.getvalue())
 
 
 def _parse_csv(p: Path, text: str) -> np.ndarray:

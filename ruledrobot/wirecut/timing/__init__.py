@@ -65,10 +65,10 @@ finite-difference verification), ``problem`` (grid and constraint rows),
 
 from __future__ import annotations
 
+from ...robot.rates import trajectory_limits_report
 from .limits import CONTINUITY_TOL, FEED_HOLD_TOL, FEED_TOL, MAX_SAMPLES, RATIO_TOL
 from .moves import concatenate, joint_move
 from .path import time_path
-from .report import trajectory_limits_report
 from .result import TimedPath
 
 __all__ = [

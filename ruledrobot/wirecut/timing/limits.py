@@ -5,14 +5,14 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-FloatArray = NDArray[np.float64]
+from ...geometry.checks import FloatArray
+from ...robot.rates import RATIO_TOL
+
+__all__ = ["RATIO_TOL", "FloatArray"]
+
 BoolArray = NDArray[np.bool_]
 IntArray = NDArray[np.int64]
 
-#: Ratios (sampled value / limit) up to ``1 + RATIO_TOL`` count as within the limit:
-#: finite differences of positions of size ~1 rad divided by dt² = 4e-6 s² carry a
-#: rounding error of ~1e-16/4e-6 ≈ 3e-11 rad/s²; 1e-9 covers it with margin.
-RATIO_TOL = 1e-9
 #: Allowed relative excess of the sampled feed over ``feed_speed`` (round-off of the
 #: controllable sets; the bound itself holds between grid points, see step 3).
 FEED_TOL = 1e-6

@@ -9,8 +9,8 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ...geometry.checks import as_limits, as_number, as_shaped
+from ...robot.rates import trajectory_limits_report
 from .limits import CONTINUITY_TOL, MAX_SAMPLES, FloatArray
-from .report import trajectory_limits_report
 from .result import TimedPath
 
 

@@ -1,85 +1,13 @@
-"""Limits report and feed of sampled joints, by finite differences (the verification)."""
+"""Feed of sampled joints, by finite differences (the verification); the limits report
+(:func:`trajectory_limits_report`) is the robot layer's, shared with the runner."""
 
 from __future__ import annotations
 
-from typing import Any
-
 import numpy as np
-from numpy.typing import ArrayLike
 
-from ...geometry.checks import as_limits, as_shaped, check_increasing
-from ...robot.rates import finite_difference_rates
-from .limits import RATIO_TOL, FloatArray
+from .limits import FloatArray
 
 # --------------------------------------------------------------------------- report
-
-
-def trajectory_limits_report(
-    t: ArrayLike, q: ArrayLike, vel_limits: ArrayLike, acc_limits: ArrayLike
-) -> dict[str, Any]:
-    """Joint speed and acceleration of a sampled trajectory by finite differences.
-
-    Independent of how the trajectory was made: velocity ``v_k = (q_{k+1} − q_k) /
-    (t_{k+1} − t_k)`` per interval, acceleration ``(v_k − v_{k−1}) / ((t_{k+1} −
-    t_{k−1})/2)`` per interior sample (the usual second difference when the
-    sampling is uniform).
-
-    Args:
-        t: (M,) strictly increasing sample times [s].
-        q: (M, J) joint positions [rad].
-        vel_limits: (J,) joint velocity limits [rad/s], > 0.
-        acc_limits: (J,) joint acceleration limits [rad/s²], > 0.
-
-    Returns:
-        dict with ``max_speed_ratio``, ``max_acc_ratio`` (floats), ``speed_ratio``,
-        ``acc_ratio`` (J,) per joint, ``max_speed`` [rad/s], ``max_acc`` [rad/s²]
-        (J,), ``worst_speed`` and ``worst_acc`` (sample index, joint) of the largest
-        ratio (None when there is nothing to difference), ``ok`` (both ratios
-        ``<= 1 + RATIO_TOL``), ``n_samples``, ``duration`` [s], ``dt_min``, ``dt_max``.
-
-    Raises:
-        ValueError: bad shapes, non-finite values, non-increasing ``t``, limits <= 0.
-    """
-    t = as_shaped(t, "t", (None,))
-    q = as_shaped(q, "q", (t.shape[0], None))
-    J = q.shape[1]
-    vlim = as_limits(vel_limits, "vel_limits", J)
-    alim = as_limits(acc_limits, "acc_limits", J)
-    check_increasing(t, "t")
-    M = t.shape[0]
-    out: dict[str, Any] = {
-        "n_samples": M,
-        "duration": float(t[-1] - t[0]) if M else 0.0,
-        "dt_min": float(np.diff(t).min()) if M > 1 else 0.0,
-        "dt_max": float(np.diff(t).max()) if M > 1 else 0.0,
-        "speed_ratio": np.zeros(J),
-        "acc_ratio": np.zeros(J),
-        "max_speed": np.zeros(J),
-        "max_acc": np.zeros(J),
-        "max_speed_ratio": 0.0,
-        "max_acc_ratio": 0.0,
-        "worst_speed": None,
-        "worst_acc": None,
-    }
-    if M >= 2:
-        v, a = finite_difference_rates(t, q)
-        r = np.abs(v) / vlim
-        k, j = np.unravel_index(int(np.argmax(r)), r.shape)
-        out.update(
-            speed_ratio=r.max(axis=0), max_speed=np.abs(v).max(axis=0),
-            max_speed_ratio=float(r[k, j]), worst_speed=(int(k), int(j)),
-        )  # fmt: skip
-        if M >= 3:
-            r = np.abs(a) / alim
-            k, j = np.unravel_index(int(np.argmax(r)), r.shape)
-            out.update(
-                acc_ratio=r.max(axis=0), max_acc=np.abs(a).max(axis=0),
-                max_acc_ratio=float(r[k, j]), worst_acc=(int(k) + 1, int(j)),
-            )  # fmt: skip
-    out["ok"] = bool(
-        out["max_speed_ratio"] <= 1.0 + RATIO_TOL and out["max_acc_ratio"] <= 1.0 + RATIO_TOL
-    )
-    return out
 
 
 def _wire_distance(s: FloatArray, sf: FloatArray, at: FloatArray) -> FloatArray:

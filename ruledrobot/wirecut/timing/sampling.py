@@ -6,9 +6,10 @@ import math
 
 import numpy as np
 
+from ...robot.rates import trajectory_limits_report
 from .limits import FEED_HOLD_TOL, FEED_TOL, MAX_SAMPLES, RATIO_TOL, FloatArray
 from .problem import _Problem
-from .report import _feed_of_samples, trajectory_limits_report
+from .report import _feed_of_samples
 from .result import TimedPath
 from .solvers import _StalledError
 
