@@ -23,11 +23,12 @@ from ..protocol.modes import JointMode, RobotMode, RuntimeState, SafetyMode, Saf
 from .backend import HARDWARE_ACCELERATION, ArmBackend, ArmState, KinematicBackend
 from .controller import DEFAULT_Q, Controller
 from .handshake import Command
-from .process import Emulator
+from .process import EMBEDDED_HOST, Emulator, embedded_emulator
 from .server import ClockStats, ThreadedEmulator, serve
 
 __all__ = [
     "DEFAULT_Q",
+    "EMBEDDED_HOST",
     "HARDWARE_ACCELERATION",
     "ArmBackend",
     "ArmState",
@@ -42,5 +43,6 @@ __all__ = [
     "SafetyMode",
     "SafetyStatusBit",
     "ThreadedEmulator",
+    "embedded_emulator",
     "serve",
 ]

@@ -24,7 +24,7 @@ import subprocess
 import sys
 import threading
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from multiprocessing.connection import Connection
 from typing import Any
 
@@ -37,7 +37,10 @@ from ..robot import Calibration, RobotModel
 from .backend import ArmBackend
 from .server import ThreadedEmulator, emulated_model
 
-__all__ = ["Emulator"]
+__all__ = ["EMBEDDED_HOST", "Emulator", "embedded_emulator"]
+
+#: Where the embedded emulator listens when a command is given no robot address.
+EMBEDDED_HOST = "127.0.0.42"
 
 #: methods and properties of ThreadedEmulator the parent may call
 _CALLS = frozenset(
@@ -386,3 +389,19 @@ class Emulator:
     def __repr__(self) -> str:
         where = "in-process" if self.in_process else f"pid {self.pid}"
         return f"Emulator({self.model_name!r} on {self.host}, {where})"
+
+
+@contextlib.contextmanager
+def embedded_emulator(
+    model: str | RobotModel, q0: ArrayLike, host: str = EMBEDDED_HOST
+) -> Iterator[Emulator]:
+    """The default target of ``ruledrobot run`` and ``demo`` without a robot address: a
+    MuJoCo-backed emulator of ``model`` with the arm at ``q0`` (rad), on loopback, closed
+    on exit."""
+    from .physics import MujocoBackend
+
+    emu = Emulator(host, model, q0=q0, backend=MujocoBackend).start()
+    try:
+        yield emu
+    finally:
+        emu.close()

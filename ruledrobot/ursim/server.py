@@ -31,7 +31,7 @@ from numpy.typing import ArrayLike
 from ..io.calibration import load_calibration
 from ..protocol.modes import RobotMode, RuntimeState, SafetyMode
 from ..protocol.primary import KinematicsInfo
-from ..robot import Calibration, RobotModel, load
+from ..robot import Calibration, RobotModel, load, random_calibration
 from .backend import ArmBackend, KinematicBackend
 from .controller import Controller
 from .dashboard import DashboardServer
@@ -120,14 +120,20 @@ def emulated_model(
     model: str | RobotModel, calibration: Calibration | str | os.PathLike | None = None
 ) -> RobotModel:
     """The arm an emulator runs: ``model`` (a catalogue name or a :class:`RobotModel`) with
-    ``calibration`` (a :class:`~ruledrobot.robot.Calibration` or a ``ruledrobot.calibration/1``
-    file) attached.  ValueError (naming both models) for a calibration of another model,
-    :class:`~ruledrobot.robot.CalibrationError` for a bad file."""
+    ``calibration`` (a :class:`~ruledrobot.robot.Calibration`, a ``ruledrobot.calibration/1``
+    file, or ``"random:SEED"`` for a seeded realistic one) attached.  ValueError (naming both
+    models) for a calibration of another model, :class:`~ruledrobot.robot.CalibrationError`
+    for a bad file."""
     arm = load(model) if isinstance(model, str) else model
     if not isinstance(arm, RobotModel):
         raise ValueError(f"model: expected a model name or a RobotModel, got {type(arm).__name__}")
     if calibration is None:
         return arm
+    if isinstance(calibration, str) and calibration.startswith("random:"):
+        seed_text = calibration[len("random:") :]
+        if not seed_text.isdigit():
+            raise ValueError(f"random:SEED needs a seed >= 0, got {seed_text!r}")
+        calibration = random_calibration(arm.name, int(seed_text))
     if isinstance(calibration, (str, os.PathLike)):
         cal, where = load_calibration(calibration), f"{os.fspath(calibration)}: "
     else:

@@ -1,0 +1,131 @@
+"""Commands of the cut planner: plan a job, play a trajectory in MuJoCo, the demo."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import typer
+
+from ._common import app, console, err, fail, print_verdict
+
+
+@app.command(epilog="Example:  ruledrobot simulate out/demo/trajectory.csv --out out/sim --video")
+def simulate(
+    trajectory: Path = typer.Argument(..., help="Trajectory CSV (t,q1..q6,x,y,z,rx,ry,rz)."),
+    out: Path = typer.Option(Path("out/sim"), "--out", "-o", help="Output folder."),
+    video: bool = typer.Option(False, "--video/--no-video", help="Render video.mp4 too."),
+) -> None:
+    """Play a joint trajectory in MuJoCo: collisions, limits, torques, tracking, video.
+
+    Exits 1 when a check fails (collision, joint range, speed, torque)."""
+    from ..sim import RenderUnavailable
+    from ..sim import simulate as do_simulate
+    from ..wirecut.cell import scene_of_trajectory
+
+    try:
+        scene, where = scene_of_trajectory(trajectory)
+        console.print(f"scene: {where}", highlight=False, markup=False)
+        with console.status("simulating") as status:
+            files = do_simulate(
+                trajectory,
+                out,
+                model_or_scene=scene,
+                video=video,
+                progress=lambda f, stage: status.update(f"{stage}: {100 * f:.0f} %"),
+            )
+    except ValueError as exc:
+        raise fail(str(exc)) from None
+    except RenderUnavailable as exc:
+        err.print(f"[yellow]no video:[/] {exc}")
+        files = {"report": out / "report.json"}
+    import json
+
+    from ..robot.verdict import Verdict
+
+    report = json.loads((out / "report.json").read_text())
+    verdict = Verdict.from_dict(report["verdict"])
+    print_verdict(verdict, f"checks of the playback of {trajectory}")
+    for name, path in files.items():
+        console.print(f"wrote {path}  ({name})", highlight=False, markup=False)
+    if not verdict.ok:
+        raise typer.Exit(code=1)
+
+
+def _run_plan(job_path: Path, out: Path, video: bool = False):
+    """Plan a job file into ``out``; prints the table of checks and the verdict.
+
+    Exit 2 on bad input (nothing written), 1 when a check fails (report and plots
+    written, no trajectory); returns the :class:`~ruledrobot.wirecut.planner.PlanResult`.
+    """
+    from ..wirecut.job import load_job
+    from ..wirecut.planner import plan as do_plan
+
+    try:
+        job = load_job(job_path)
+        with console.status("planning") as status:
+            result = do_plan(
+                job, out, progress=lambda msg: status.update(f"planning: {msg}"), video=video
+            )
+    except ValueError as exc:
+        raise fail(str(exc)) from None
+    for note in result.report.get("notes", []):
+        err.print(f"note: {note}", highlight=False, markup=False)
+    print_verdict(result.verdict, f"checks of {job_path}")
+    for name, path in result.files.items():
+        console.print(f"wrote {path}  ({name})", highlight=False, markup=False)
+    if not result.feasible:
+        err.print(f"no trajectory written: the plan fails ({out / 'report.json'} says why)",
+                  highlight=False, markup=False)  # fmt: skip
+        raise typer.Exit(code=1)
+    return result
+
+
+@app.command(epilog="Example:  ruledrobot plan job.toml --out out/cut   (job format: README)")
+def plan(
+    job: Path = typer.Argument(..., help="Cut job file (.toml)."),
+    out: Path = typer.Option(Path("out/plan"), "--out", "-o", help="Output folder."),
+    video: bool = typer.Option(False, "--video/--no-video", help="Render video.mp4 too."),
+) -> None:
+    """Plan a hot-wire cut: refine, choose the wire motion, time it, verify it in MuJoCo,
+    write the trajectory.  Exits with status 1 (and the reasons) when infeasible."""
+    _run_plan(job, out, video=video)
+
+
+@app.command(epilog="Example:  ruledrobot demo --out out/demo")
+def demo(
+    out: Path = typer.Option(Path("out/demo"), "--out", "-o", help="Output folder."),
+    video: bool = typer.Option(True, "--video/--no-video", help="Render video.mp4 too."),
+    stream: bool = typer.Option(
+        True, "--stream/--no-stream", help="Stream the cut to the embedded RTDE emulator."
+    ),
+) -> None:
+    """Run the whole chain on the built-in example (a hyperbolic paraboloid cut in foam):
+    refine, plan, time, verify in MuJoCo, render a video, export URScript, and stream
+    the cut through ur_rtde to the embedded controller emulator."""
+    import tempfile
+
+    from ..export import export_trajectory
+    from ..wirecut.demo import DEMO_JOB
+    from .robot import say_program_size, stream
+
+    console.print("[bold]ruledrobot demo[/]: hyperbolic paraboloid through a foam block, UR5e")
+    with tempfile.TemporaryDirectory() as tmp:
+        job_path = Path(tmp) / "job.toml"
+        job_path.write_text(DEMO_JOB, encoding="utf-8")
+        result = _run_plan(job_path, out, video=video)
+    traj_path = out / "trajectory.csv"
+    try:
+        script = export_trajectory(result.trajectory, out / "cut.script")
+    except ValueError as exc:
+        raise fail(str(exc)) from None
+    console.print(f"wrote {script}  (URScript for the teach pendant; streaming is the route for "
+                  "long cuts: docs/rtde.md)", highlight=False, markup=False)  # fmt: skip
+    say_program_size(script)
+    if stream:
+        res = stream(traj_path, None, yes=True)
+        if res.status != "completed":
+            raise typer.Exit(code=1)
+    console.print(f"job file: {out / 'job.toml'} (edit it and run: ruledrobot plan)",
+                  highlight=False, markup=False)  # fmt: skip
+
+

@@ -1,0 +1,334 @@
+"""Commands that meet the robot: export, run (RTDE), the controller emulator, calibrations."""
+
+from __future__ import annotations
+
+import contextlib
+from enum import Enum
+from pathlib import Path
+
+import typer
+
+from ._common import app, console, err, fail, print_verdict
+
+
+def say_program_size(path: Path) -> None:
+    """Warn about a long URScript program (its header says so too)."""
+    for line in path.read_text().splitlines()[:8]:
+        if line.strip().startswith("# long program"):
+            err.print("warning: " + line.strip()[2:], highlight=False, markup=False)
+
+
+class ScriptMode(str, Enum):
+    servoj = "servoj"
+    movep = "movep"
+    movel = "movel"
+
+
+class ExportFormat(str, Enum):
+    csv = "csv"
+    json = "json"
+    npz = "npz"
+    urscript = "urscript"
+
+
+@app.command(
+    epilog="Example:  ruledrobot export out/demo/trajectory.csv --out cut.script --format urscript"
+)
+def export(
+    trajectory: Path = typer.Argument(..., help="Trajectory CSV."),
+    out: Path = typer.Option(..., "--out", "-o", help="Output file."),
+    fmt: ExportFormat | None = typer.Option(
+        None, "--format", "-f", help="csv, json, npz or urscript (default: from the suffix)."
+    ),
+    mode: ScriptMode = typer.Option(ScriptMode.servoj, help="URScript motion."),
+    allow_long: bool = typer.Option(
+        False, "--allow-long", help="Write a URScript program beyond the safe size (see docs)."
+    ),
+) -> None:
+    """Export a trajectory as CSV/JSON/NPZ or a standalone URScript program for the pendant.
+
+    Every program sets the TCP and the payload from the trajectory's metadata."""
+    from ..export import export_trajectory
+    from ..io.trajectory import read_trajectory
+
+    try:
+        traj = read_trajectory(trajectory)
+        is_script = (fmt and fmt.value == "urscript") or out.suffix in (".script", ".urscript")
+        options = {"mode": mode.value, "allow_long": allow_long} if is_script else {}
+        path = export_trajectory(traj, out, None if fmt is None else fmt.value, **options)
+    except ValueError as exc:
+        raise fail(str(exc)) from None
+    if is_script:
+        say_program_size(path)
+    console.print(f"wrote {path}")
+
+
+class RunModeName(str, Enum):
+    servoj = "servoj"
+    path = "path"
+
+
+@app.command(
+    epilog="Example:  ruledrobot run out/demo/trajectory.csv --host 192.168.1.10   "
+    "(--dry-run checks without motion; --resume N re-enters the cut at sample N; without "
+    "--host a local emulator is used)"
+)
+def run(
+    trajectory: Path = typer.Argument(..., help="Trajectory CSV."),
+    host: str | None = typer.Option(
+        None, help="Robot controller address; default: an embedded emulator on 127.0.0.42."
+    ),
+    mode: RunModeName = typer.Option(
+        RunModeName.servoj, help="servoj (stream one servoJ per period) or path (moveL path)."
+    ),
+    speed_scale: float = typer.Option(1.0, min=0.01, max=1.0, help="Slow the whole run down."),
+    resume: int | None = typer.Option(
+        None, "--resume", min=0, help="Re-enter the cut at sample N (printed when a run stops)."
+    ),
+    yes: bool = typer.Option(False, "--yes", "-y", help="Start without asking (scripts)."),
+    dry_run: bool = typer.Option(False, "--dry-run", help="Check everything, move nothing."),
+    force: bool = typer.Option(
+        False, "--force", help="Run although the controller's kinematics differ from the plan's."
+    ),
+) -> None:
+    """Stream a planned trajectory to a UR controller through RTDE (ur_rtde): checks the
+    controller (robot model, period, state) and shows the approach move before asking to
+    start; monitors the motion, stops safely, says where and how to resume; records the
+    actual trajectory (<name>.run-NNN.csv).  Exit 0 completed, 1 refused or stopped, 2 bad
+    input."""
+    import sys
+
+    if not (yes or dry_run or sys.stdin.isatty()):
+        raise fail("no terminal to confirm the motion on: pass --yes to start without asking")
+    if force:
+        err.print("--force: the controller's kinematics are NOT checked against the plan's; "
+                  "the wire may miss the cut", style="bold red", highlight=False,
+                  markup=False)  # fmt: skip
+    result = stream(trajectory, host, yes=yes, mode=mode.value, speed_scale=speed_scale,
+                     dry_run=dry_run, start_index=resume or 0,
+                     force_kinematics=force)  # fmt: skip
+    if not result.completed or (result.verdict is not None and not result.verdict.ok):
+        raise typer.Exit(code=1)
+
+
+def stream(trajectory: Path, host: str | None, *, yes: bool = False, **options):
+    """Run ``trajectory`` (the CLI's side of :func:`run_trajectory`): checks table,
+    confirmation, progress bar, where it stopped and the resume command."""
+    from rich.text import Text
+
+    from ..export import ControllerError, run_trajectory
+    from ..export.run_report import RunProgress, resume_command
+    from ..io.trajectory import read_trajectory
+    from ..ursim import EMBEDDED_HOST, embedded_emulator
+
+    try:
+        traj = read_trajectory(trajectory)
+    except ValueError as exc:
+        raise fail(str(exc)) from None
+    dry_run = bool(options.get("dry_run"))
+    target = host
+    shown: list[bool] = []
+
+    def show_plan(plan) -> None:
+        shown.append(True)
+        where = plan.host or "no controller"
+        print_verdict(plan.verdict, f"checks before motion ({trajectory} on {where})")
+        for line in plan.describe():
+            console.print(Text(f"  {line}"), highlight=False)
+
+    def confirm(plan) -> bool:
+        show_plan(plan)
+        if yes:
+            console.print("  --yes: starting without asking", highlight=False)
+            return True
+        return typer.confirm("Start the motion?", default=False)
+
+    bar = RunProgress(traj, console)
+    try:
+        with contextlib.ExitStack() as stack:
+            if host is None and not dry_run:
+                target = EMBEDDED_HOST
+                console.print(f"no --host: starting the embedded MuJoCo-backed controller "
+                              f"emulator on {target}")  # fmt: skip
+                stack.enter_context(embedded_emulator(traj.meta.robot, traj.q[0], target))
+            try:
+                result = run_trajectory(trajectory, target, traj.meta.robot,
+                                        progress=bar.update, confirm=confirm,
+                                        **options)  # fmt: skip
+            finally:
+                bar.stop()
+    except (ValueError, ControllerError) as exc:
+        raise fail(str(exc)) from None
+    if not shown and result.verdict is not None:
+        from ..export import RunPlan
+
+        show_plan(RunPlan(result.verdict, result.entry, target, options.get("mode", "servoj"),
+                          traj, options.get("approach_speed", 0.25),
+                          options.get("speed_scale", 1.0)))  # fmt: skip
+    style = "bold green" if result.completed else "bold red"
+    console.print(Text(f"{result.status}: {result.message}", style=style), highlight=False)
+    if result.status == "dry_run":
+        console.print("  dry run: nothing moved", highlight=False)
+    elif result.moved:
+        console.print(f"  max deviation actual vs plan: {result.max_deviation:.3g} rad",
+                      highlight=False)  # fmt: skip
+    if result.stop is not None and result.status != "completed":
+        console.print(Text(f"  stopped at {result.stop.describe()}"), highlight=False)
+        cmd = resume_command(trajectory, host, options.get("mode", "servoj"),
+                             options.get("speed_scale", 1.0), result.resume_index)  # fmt: skip
+        console.print(Text(f"  resume with: {cmd}", style="bold"), highlight=False)
+    if result.client:
+        err.print(Text(f"  ur_rtde client: {result.client}"), highlight=False)
+    if result.actual_path is not None:
+        console.print(f"wrote {result.actual_path}  (recording of the actual motion)",
+                      highlight=False, markup=False)  # fmt: skip
+    return result
+
+
+@app.command(epilog="Example:  ruledrobot ursim --host 127.0.0.2 --model ur5e")
+def ursim(
+    host: str = typer.Option("127.0.0.1", help="Address to listen on (loopback by default)."),
+    model: str = typer.Option("ur5e", help="Robot model."),
+    programs: Path | None = typer.Option(
+        None, help="Folder the dashboard's `load` serves programs from (default: an empty one)."
+    ),
+    duration: float | None = typer.Option(
+        None, min=0.0, help="Stop after this many seconds (default: run until Ctrl-C)."
+    ),
+    fault: list[str] = typer.Option(
+        [],
+        "--fault",
+        help="KIND@WHEN[:ARG], repeatable: KIND protective_stop, emergency_stop, drop, freeze, "
+        "slow, clear; WHEN seconds after start (5s, 500ms) or SIGUSR1/SIGUSR2; ARG seconds "
+        "(drop: refuse new connections, freeze: how long, slow: the delay). E.g. --fault "
+        "protective_stop@5s --fault freeze@10s:3s --fault clear@SIGUSR2",
+    ),
+    physics: str = typer.Option(
+        "kinematic", help="The arm behind the controller: kinematic, or mujoco (simulated)."
+    ),
+    calibration: str | None = typer.Option(
+        None,
+        help="The robot's factory calibration: a ruledrobot.calibration/1 file, or random:SEED "
+        "(a seeded realistic one).  The emulator then serves its KinematicsInfo on 30001/30002 "
+        "and uses the calibrated kinematics for everything (default: nominal).",
+    ),
+) -> None:
+    """Run the controller emulator (RTDE 30004, dashboard 29999, script 30003, primary 30001,
+    secondary 30002) until Ctrl-C, optionally calibrated and with faults on a timer or on a
+    signal (docs/rtde.md)."""
+    from ..ursim import serve
+    from ..ursim.faults import FaultSchedule, parse_fault
+    from ..ursim.server import emulated_model
+
+    if physics not in ("kinematic", "mujoco"):
+        raise typer.BadParameter(f"expected kinematic or mujoco, got {physics!r}",
+                                 param_hint="'--physics'")  # fmt: skip
+    try:
+        specs = [parse_fault(f) for f in fault]
+    except ValueError as exc:
+        raise fail(f"--fault: {exc}") from None
+    arm = None
+    if calibration is not None:
+        try:  # a file is read, and another model's calibration refused, here
+            arm = emulated_model(model, calibration)
+        except ValueError as exc:
+            raise fail(f"--calibration: {exc}") from None
+    kinematics = ("nominal kinematics" if arm is None or arm.calibration is None
+                  else f"calibrated kinematics ({arm.calibration.source})")  # fmt: skip
+    schedule = FaultSchedule(specs, on_fire=lambda s: console.print(
+        f"fault: {s.describe()}", highlight=False, markup=False))  # fmt: skip
+
+    def ready(emu) -> None:  # printed once the ports are bound, never before
+        p = emu.ports
+        console.print(
+            f"UR controller emulator ({model}, {physics}, {kinematics}) listening on {host}: "
+            f"RTDE {p['rtde']}, dashboard {p['dashboard']}, script {p['script']}, primary "
+            f"{p['primary']}, secondary {p['secondary']}; programs in {emu.programs_dir}; "
+            "Ctrl-C to stop", highlight=False, markup=False,
+        )  # fmt: skip
+        for s in specs:
+            console.print(f"scheduled fault: {s.describe()}", highlight=False, markup=False)
+        schedule.start(emu)
+
+    options: dict = {} if programs is None else {"programs_dir": str(programs)}
+    if physics == "mujoco":
+        from ..ursim.physics import MujocoBackend
+
+        options["backend"] = MujocoBackend
+    if arm is not None:
+        options["calibration"] = arm.calibration
+    try:
+        serve(host, model, duration=duration, ready=ready, **options)
+    except KeyboardInterrupt:
+        pass
+    except (ValueError, OSError) as exc:
+        raise fail(str(exc)) from None
+    finally:
+        schedule.stop()
+
+
+calibration_app = typer.Typer(
+    help="A robot's own kinematics: fetch it from a controller, show a calibration file.",
+    no_args_is_help=True,
+)
+app.add_typer(calibration_app, name="calibration")
+
+
+@calibration_app.command(
+    "fetch",
+    epilog="Example:  ruledrobot calibration fetch --host 192.168.1.10 --out robot.calib.json",
+)
+def calibration_fetch(
+    host: str = typer.Option(..., help="Controller address (primary interface port 30001)."),
+    out: Path = typer.Option(Path("robot.calib.json"), "--out", "-o", help="Calibration file."),
+    model: str | None = typer.Option(None, help="Robot model; default: ask the dashboard."),
+    timeout: float = typer.Option(5.0, min=0.5, help="Give up after this many seconds."),
+) -> None:
+    """Read the controller's calibrated kinematics (KinematicsInfo) and write them as a
+    calibration file for the job's ``\\[robot] calibration``."""
+    from ..export.fetch_calibration import fetch_calibration
+    from ..io.calibration import save_calibration
+
+    try:
+        cal = fetch_calibration(host, model, timeout=timeout)
+        path = save_calibration(out, cal)
+    except (ValueError, OSError) as exc:
+        raise fail(str(exc)) from None
+    _show_calibration(cal)
+    console.print(f"wrote {path}", highlight=False, markup=False)
+
+
+@calibration_app.command("show", epilog="Example:  ruledrobot calibration show robot.calib.json")
+def calibration_show(path: Path = typer.Argument(..., help="Calibration file.")) -> None:
+    """Print a calibration: model, source, status and its deviations from the nominal arm."""
+    from ..io.calibration import load_calibration
+
+    try:
+        cal = load_calibration(path)
+    except ValueError as exc:
+        raise fail(str(exc)) from None
+    _show_calibration(cal)
+
+
+def _show_calibration(cal) -> None:
+    import numpy as np
+
+    from ..robot.calibration import calibration_deviations
+
+    dev = calibration_deviations(cal)
+    lines = [repr(cal)]
+    if "axis_tilt" in dev:
+        lines += [
+            "  joint axes tilted (mrad): " + " ".join(f"{1e3 * v:.2f}" for v in dev["axis_tilt"]),
+            "  joint axes moved (mm):    " + " ".join(f"{1e3 * v:.2f}" for v in dev["axis_offset"]),
+            f"  flange at q = 0: {1e3 * dev['flange_position']:.2f} mm and "
+            f"{1e3 * dev['flange_rotation']:.2f} mrad from the nominal arm",
+            f"  d2 + d3 + d4 - nominal: {1e3 * dev['d_sum']:.3f} mm; theta2 + theta3 + theta4: "
+            f"{1e3 * dev['theta_sum']:.3f} mrad",
+        ]
+    lines.append("  effective DH [theta_offset, a, d, alpha] per joint:")
+    lines += [f"    {k + 1}: " + np.array2string(r, precision=9) for k, r in enumerate(cal.dh())]
+    for line in lines:
+        console.print(line, highlight=False, markup=False)
+
+
