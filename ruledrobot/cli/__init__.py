@@ -27,6 +27,3 @@ def main() -> None:
     configure_gl()  # choose EGL/OSMesa before anything imports MuJoCo
     app()
 
-
-if __name__ == "__main__":  # pragma: no cover
-    main()

@@ -1,0 +1,5 @@
+"""``python -m ruledrobot.cli``: the command line."""
+
+from . import main
+
+main()
