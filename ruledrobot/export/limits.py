@@ -1,7 +1,8 @@
 """Checks of a joint trajectory against a robot's limits, before anything moves.
 
-Positions here; speeds and accelerations by the robot layer's limits report
-(:func:`ruledrobot.robot.rates.trajectory_limits_report`), the one the planner uses.
+The first sample that breaks a limit is named (the planner's report,
+:func:`ruledrobot.robot.rates.trajectory_limits_report`, gives the worst one; both
+difference the samples with :func:`ruledrobot.robot.rates.finite_difference_rates`).
 
 Speeds and accelerations are finite differences of the samples (the way the
 controller will see them when the samples are streamed one per period):
@@ -14,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..robot import RobotModel
-from ..robot.rates import trajectory_limits_report
+from ..robot.rates import finite_difference_rates
 from ..robot.trajectory import Trajectory
 
 __all__ = ["check_trajectory"]
@@ -64,23 +65,23 @@ def check_trajectory(
             f"trajectory sample {k} (t = {t[k]:.4f} s): joint q{j + 1} position {q[k, j]:.6g} rad "
             f"outside the limits [{lo[j]:.6g}, {hi[j]:.6g}] rad of {model.name}"
         )
+    v, a = finite_difference_rates(ts, q)
     vmax = np.asarray(model.max_velocity) * (1.0 + tolerance)
-    amax = np.asarray(model.max_acceleration) * (1.0 + tolerance)
-    rep = trajectory_limits_report(ts, q, vmax, amax)
-    scaled = f" at speed_scale {speed_scale:g}" if speed_scale != 1.0 else ""
-    if rep["max_speed_ratio"] > 1.0:
-        k, j = rep["worst_speed"]
-        speed = rep["max_speed_ratio"] * vmax[j]
+    bad = np.abs(v) > vmax
+    if bad.any():
+        k, j = np.argwhere(bad)[0]
         raise ValueError(
             f"trajectory sample {k + 1} (t = {t[k + 1]:.4f} s): joint q{j + 1} speed "
-            f"{speed:.4g} rad/s exceeds the limit {model.max_velocity[j]:.4g} rad/s of "
-            f"{model.name}{scaled}"
+            f"{abs(v[k, j]):.4g} rad/s exceeds the limit {model.max_velocity[j]:.4g} rad/s of "
+            f"{model.name}" + (f" at speed_scale {speed_scale:g}" if speed_scale != 1.0 else "")
         )
-    if rep["max_acc_ratio"] > 1.0:
-        k, j = rep["worst_acc"]
-        acc = rep["max_acc_ratio"] * amax[j]
+    amax = np.asarray(model.max_acceleration) * (1.0 + tolerance)
+    bad = np.abs(a) > amax
+    if bad.any():
+        k, j = np.argwhere(bad)[0]
         raise ValueError(
-            f"trajectory sample {k} (t = {t[k]:.4f} s): joint q{j + 1} acceleration "
-            f"{acc:.4g} rad/s^2 exceeds the limit {model.max_acceleration[j]:.4g} "
-            f"rad/s^2 of {model.name}{scaled}"
+            f"trajectory sample {k + 1} (t = {t[k + 1]:.4f} s): joint q{j + 1} acceleration "
+            f"{abs(a[k, j]):.4g} rad/s^2 exceeds the limit {model.max_acceleration[j]:.4g} "
+            f"rad/s^2 of {model.name}"
+            + (f" at speed_scale {speed_scale:g}" if speed_scale != 1.0 else "")
         )

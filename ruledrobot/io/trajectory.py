@@ -16,6 +16,7 @@ line, then one row per controller period, and nothing else (``csv.reader`` and
      "base": [...],                                   # robot base in the job's world
      "phases": [{"name": "approach", "start": 0, "stop": 812}, ...],
      "in_stock": [[1200, 9800]],
+     "heat": {"output": "standard:0", "value": 1.0, "windows": [[1100, 9900]]},   # or null
      "job": {"path": "job.toml", "sha256": "..."}, "source": "ruledrobot plan",
      "csv": "trajectory.csv", "csv_sha256": "...", "samples": 12925}
 
@@ -37,7 +38,7 @@ from typing import Any
 
 import numpy as np
 
-from ..robot.trajectory import KinematicsRef, Payload, Phase, Trajectory, TrajectoryMeta
+from ..robot.trajectory import Heat, KinematicsRef, Payload, Phase, Trajectory, TrajectoryMeta
 from .atomic import atomic_write_bytes, atomic_write_text
 from .text import read_user_text
 
@@ -96,6 +97,10 @@ def meta_to_dict(meta: TrajectoryMeta) -> dict[str, Any]:
         "base": _ur(meta.base),
         "phases": [{"name": p.name, "start": p.start, "stop": p.stop} for p in meta.phases],
         "in_stock": [list(r) for r in meta.in_stock],
+        "heat": None if meta.heat is None else {
+            "output": meta.heat.output, "value": meta.heat.value,
+            "windows": [list(w) for w in meta.heat.windows],
+        },
         "job": meta.job,
         "source": meta.source,
     }
@@ -128,6 +133,27 @@ class _Doc:
             want = f"{n} finite numbers" if n else "a list of finite numbers"
             raise self.fail(key, f"expected {want}, got {value!r}")
         return arr
+
+
+def _heat(d: _Doc) -> Heat | None:
+    h = d.get("heat")
+    if h is None:
+        return None
+    if not isinstance(h, dict) or not isinstance(h.get("output"), str) or ":" not in h["output"]:
+        raise d.fail("heat", 'expected {"output": "KIND:N", "value": f, "windows": [[a, b]]} '
+                     f"or null, got {h!r}")  # fmt: skip
+    kind, _, index = h["output"].partition(":")
+    wins = h.get("windows", [])
+    if not isinstance(wins, list) or not all(
+        isinstance(w, list) and len(w) == 2 and all(isinstance(x, int) for x in w) for w in wins
+    ):
+        raise d.fail("heat.windows", f"expected [[start, stop], ...] sample indices, got {wins!r}")
+    if not index.isdigit():
+        raise d.fail("heat.output", f"expected KIND:N, got {h['output']!r}")
+    try:
+        return Heat(kind, int(index), float(h.get("value", 1.0)), tuple(map(tuple, wins)))
+    except (TypeError, ValueError) as exc:
+        raise d.fail("heat", str(exc)) from None
 
 
 def meta_from_dict(doc: Any, where: str = "trajectory metadata") -> TrajectoryMeta:
@@ -187,6 +213,7 @@ def meta_from_dict(doc: Any, where: str = "trajectory metadata") -> TrajectoryMe
             raise d.fail(f"in_stock[{i}]", f"expected [start, stop] sample indices, got {r!r}")
         stock.append((r[0], r[1]))
     base = d.numbers("base", d.get("base", default=[0.0] * 6), 6)
+    heat = _heat(d)
     job = d.get("job")
     if job is not None and not isinstance(job, dict):
         raise d.fail("job", f"expected an object or null, got {job!r}")
@@ -195,7 +222,7 @@ def meta_from_dict(doc: Any, where: str = "trajectory metadata") -> TrajectoryMe
             robot=model.name, control_period=float(period), tcp_offset=tcp,
             payload=Payload(mass, cog), kinematics=kinematics, base=base,
             phases=tuple(phases), in_stock=tuple(stock), job=job,
-            source=str(d.get("source", default="")),
+            source=str(d.get("source", default="")), heat=heat,
         )  # fmt: skip
     except ValueError as exc:
         raise ValueError(f"{where}: {exc}") from None

@@ -41,6 +41,7 @@ from .rates import finite_difference_rates
 
 __all__ = [
     "PHASE_NAMES",
+    "Heat",
     "KinematicsRef",
     "Payload",
     "Phase",
@@ -53,7 +54,9 @@ __all__ = [
 ]
 
 #: Names of trajectory phases, in the order a cut meets them.
-PHASE_NAMES = ("approach", "lead_in", "cut", "lead_out", "retract", "transit", "move")
+PHASE_NAMES = (
+    "approach", "preheat", "lead_in", "cut", "lead_out", "retract", "transit", "move",
+)
 
 
 def kinematics_checksum(dh: ArrayLike) -> str:
@@ -137,6 +140,57 @@ class Phase:
                              f"{self.start}, {self.stop}")  # fmt: skip
 
 
+#: heat output kinds and how many outputs of each a UR controller has
+HEAT_OUTPUT_KINDS = {"standard": 8, "configurable": 8, "tool": 2, "analog": 2}
+
+
+@dataclass(frozen=True)
+class Heat:
+    """When the wire is hot: the output that switches it and the sample ranges it is on.
+
+    ``kind`` ``"standard"``, ``"configurable"`` or ``"tool"`` (a digital output, on =
+    True) or ``"analog"`` (standard analog output ``index`` at ``value``, a fraction of
+    its range; off = 0); ``windows``: half-open sample ranges ``(start, stop)`` with the
+    heat on — from the start of a pre-heat dwell to the end of a lead-out.
+    """
+
+    kind: str
+    index: int
+    value: float = 1.0
+    windows: tuple[tuple[int, int], ...] = ()
+
+    def __post_init__(self) -> None:
+        if self.kind not in HEAT_OUTPUT_KINDS:
+            raise ValueError(f"heat.kind: expected one of {', '.join(HEAT_OUTPUT_KINDS)}, "
+                             f"got {self.kind!r}")  # fmt: skip
+        n = HEAT_OUTPUT_KINDS[self.kind]
+        index = self.index
+        if isinstance(index, bool) or not isinstance(index, int) or not 0 <= index < n:
+            raise ValueError(f"heat.index: {self.kind} outputs are numbered 0..{n - 1}, got "
+                             f"{self.index!r}")  # fmt: skip
+        if not 0.0 <= float(self.value) <= 1.0:
+            raise ValueError(f"heat.value: expected a fraction in [0, 1], got {self.value!r}")
+        object.__setattr__(self, "value", float(self.value))
+        wins = tuple((int(a), int(b)) for a, b in self.windows)
+        for a, b in wins:
+            if not 0 <= a < b:
+                raise ValueError(
+                    f"heat.windows: expected ranges 0 <= start < stop, got [{a}, {b}]"
+                )
+        object.__setattr__(self, "windows", wins)
+
+    @property
+    def output(self) -> str:
+        return f"{self.kind}:{self.index}"
+
+    def on(self, n: int) -> np.ndarray:
+        """(n,) bool: the heat is on at sample k."""
+        m = np.zeros(n, dtype=bool)
+        for a, b in self.windows:
+            m[a:b] = True
+        return m
+
+
 @dataclass(frozen=True, eq=False)
 class TrajectoryMeta:
     """Metadata of a :class:`Trajectory` (see the module doc)."""
@@ -151,6 +205,7 @@ class TrajectoryMeta:
     in_stock: tuple[tuple[int, int], ...] = ()
     job: dict[str, str] | None = None
     source: str = ""
+    heat: Heat | None = None
 
     def __post_init__(self) -> None:
         put = object.__setattr__

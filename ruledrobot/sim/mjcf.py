@@ -41,6 +41,7 @@ from numpy.typing import ArrayLike
 from ..geometry.checks import FloatArray, as_per_joint
 from ..io.atomic import atomic_write_text
 from ..robot.model import RobotModel
+from ..robot.shape import Segment, dh_tail, link_radii, link_segments, rot_z
 from ._xml import placed, sub, to_string
 
 __all__ = [
@@ -48,8 +49,7 @@ __all__ = [
     "chain_mjcf",
     "default_armature",
     "default_damping",
-    "link_radii",
-    "physics_timestep",
+
     "robot_mjcf",
     "write_chain",
 ]
@@ -86,20 +86,6 @@ def physics_timestep(control_period: float) -> float:
         raise ValueError(f"control_period: must be positive, got {period}")
     n = max(1, math.ceil(period / MAX_TIMESTEP - 1e-9))
     return period / n
-
-
-def link_radii(model: RobotModel) -> FloatArray:
-    """Joint-housing radius per joint [m] (J,), from the torque limits (UR-like proportions).
-
-    ``r = 0.0185 m * (tau_max / 1 N m)^(1/4)``, clipped to [0.015, 0.12] m
-    (UR5e: 0.065 m shoulder, 0.043 m wrists; UR10e: 0.079 / 0.050 m).  Arms
-    without torque limits get 4.5 % of the summed DH lengths on every joint.
-    """
-    tau = model.max_torque
-    if np.all(np.isfinite(tau)):
-        return np.clip(0.0185 * tau**0.25, 0.015, 0.12)
-    length = float(np.sum(np.abs(model.a)) + np.sum(np.abs(model.d)))
-    return np.full(model.n_joints, float(np.clip(0.045 * length, 0.01, 0.12)))
 
 
 def default_armature(model: RobotModel) -> FloatArray:
@@ -185,25 +171,6 @@ def _per_joint(value: ArrayLike | None, default: FloatArray, name: str) -> Float
 # ---------------------------------------------------------------------------------------
 
 
-def _rz(angle: float) -> FloatArray:
-    c, s = math.cos(angle), math.sin(angle)
-    T = np.eye(4)
-    T[0, 0], T[0, 1], T[1, 0], T[1, 1] = c, -s, s, c
-    return T
-
-
-def _dh_tail(d: float, a: float, alpha: float) -> FloatArray:
-    """``Tz(d) Tx(a) Rx(alpha)`` (4, 4): from the body frame of link i to DH frame i."""
-    c, s = math.cos(alpha), math.sin(alpha)
-    # exact values at multiples of pi/2 (the UR twists), like the robot layer's FK
-    c = 0.0 if abs(c) < 1e-15 else c
-    s = 0.0 if abs(s) < 1e-15 else s
-    T = np.eye(4)
-    T[1, 1], T[1, 2], T[2, 1], T[2, 2] = c, -s, s, c
-    T[0, 3], T[2, 3] = a, d
-    return T
-
-
 def _cylinder_inertia(mass: float, radius: float, length: float, axis: int) -> FloatArray:
     """Diagonal inertia (3,) of a solid cylinder about its centre, axis along ``axis``."""
     axial = 0.5 * mass * radius**2
@@ -213,23 +180,14 @@ def _cylinder_inertia(mass: float, radius: float, length: float, axis: int) -> F
     return out
 
 
-@dataclass(frozen=True)
-class _Segment:
-    kind: str  # "capsule" | "cylinder"
-    a: FloatArray
-    b: FloatArray
-    radius: float
-    rgba: str
-
-
 def _body_frames(model: RobotModel) -> list[FloatArray]:
     """Poses (4, 4) of the link bodies at q = 0 in the base frame (body k: DH frame k-1
     turned by the joint's zero offset)."""
     out, T = [], np.eye(4)
     for k in range(model.n_joints):
-        B = T @ _rz(float(model.theta_offset[k]))
+        B = T @ rot_z(float(model.theta_offset[k]))
         out.append(B)
-        T = B @ _dh_tail(float(model.d[k]), float(model.a[k]), float(model.alpha[k]))
+        T = B @ dh_tail(float(model.d[k]), float(model.a[k]), float(model.alpha[k]))
     return out
 
 
@@ -242,65 +200,9 @@ def _body_corrections(model: RobotModel, shape: RobotModel) -> list[FloatArray]:
                                                     strict=True)]  # fmt: skip
 
 
-def _moved(seg: _Segment, C: FloatArray) -> _Segment:
+def _moved(seg: Segment, C: FloatArray) -> Segment:
     R, t = C[:3, :3], C[:3, 3]
     return dataclasses.replace(seg, a=R @ seg.a + t, b=R @ seg.b + t)
-
-
-def _link_geometry(model: RobotModel, radii: FloatArray) -> tuple[list[list[_Segment]], float]:
-    """Primitive geometry per link body (in the body frame) and the base height [m].
-
-    Each body gets a joint housing (cylinder along its z axis) and tubes
-    along its DH path ``origin -> Tz(d) -> Tx(a)``.  UR-structure arms get
-    the real arm's side offset: the upper arm runs at ``z = d2 + d3 + d4`` along
-    the shoulder axis (as on the real UR, where the DH plane holds the
-    forearm), and the shoulder and elbow housings span that offset.
-    """
-    n = model.n_joints
-    ur = model.has_analytic_ik
-    shoulder = float(model.d[1] + model.d[2] + model.d[3]) if ur else 0.0
-    d1 = float(model.d[0])
-    base_h = max(0.02, 0.5 * abs(d1))
-    out: list[list[_Segment]] = []
-    for k in range(n):
-        r = float(radii[k])
-        tube = 0.8 * r
-        d, a = float(model.d[k]), float(model.a[k])
-        segs: list[_Segment] = []
-        z0, z1 = -0.9 * r, 0.9 * r
-        if ur and k in (1, 2):
-            z0, z1 = min(0.0, shoulder) - 0.9 * r, max(0.0, shoulder) + 0.9 * r
-        if k == 0:
-            # the column above the base; its housing is the base's top
-            top = math.copysign(base_h + 0.002, d1) if d1 != 0.0 else 0.0
-            if abs(d1) > abs(top) + 0.004:
-                segs.append(
-                    _Segment(
-                        "cylinder", np.array([0, 0, top]), np.array([0, 0, d1]), r, _RGBA["link"]
-                    )
-                )
-        else:
-            segs.append(
-                _Segment("cylinder", np.array([0, 0, z0]), np.array([0, 0, z1]), r, _RGBA["joint"])
-            )
-            if abs(d) > 1e-9:
-                kind = "cylinder" if k == n - 1 else "capsule"
-                segs.append(
-                    _Segment(
-                        kind,
-                        np.zeros(3),
-                        np.array([0, 0, d]),
-                        r if k == n - 1 else tube,
-                        _RGBA["link"],
-                    )
-                )
-        if abs(a) > 1e-9:
-            z = shoulder if (ur and k == 1) else d
-            segs.append(
-                _Segment("capsule", np.array([0, 0, z]), np.array([a, 0, z]), tube, _RGBA["link"])
-            )
-        out.append(segs)
-    return out, base_h
 
 
 def _link_inertial(model: RobotModel, k: int, radius: float) -> tuple[FloatArray, FloatArray]:
@@ -314,7 +216,7 @@ def _link_inertial(model: RobotModel, k: int, radius: float) -> tuple[FloatArray
     approximation as the cylinders of UR's ROS description.
     """
     d, a, alpha = float(model.d[k]), float(model.a[k]), float(model.alpha[k])
-    tail = _dh_tail(d, a, alpha)
+    tail = dh_tail(d, a, alpha)
     com = tail[:3, :3] @ model.link_com[k] + tail[:3, 3]
     tube = 0.8 * radius
     if abs(a) >= abs(d) and abs(a) > 0.0:
@@ -325,7 +227,7 @@ def _link_inertial(model: RobotModel, k: int, radius: float) -> tuple[FloatArray
     return com, _cylinder_inertia(float(model.link_mass[k]), tube, length, axis)
 
 
-def _add_segment(body: ET.Element, name: str, seg: _Segment, **attrs: object) -> None:
+def _add_segment(body: ET.Element, name: str, seg: Segment, **attrs: object) -> None:
     sub(
         body,
         "geom",
@@ -333,7 +235,7 @@ def _add_segment(body: ET.Element, name: str, seg: _Segment, **attrs: object) ->
         type=seg.kind,
         size=seg.radius,
         fromto=np.concatenate([seg.a, seg.b]),
-        rgba=seg.rgba,
+        rgba=_RGBA[seg.part],
         **attrs,
     )  # type: ignore[arg-type]
 
@@ -380,7 +282,7 @@ def build_robot(
     # links keep their nominal shape, carried by the calibrated frames (its DH numbers
     # run metres along the nearly parallel axes 2-4, the metal does not)
     shape = model.nominal
-    geometry, base_h = _link_geometry(shape, radii)
+    geometry, base_h = link_segments(shape, radii)
     carry = _body_corrections(model, shape)
 
     root = ET.Element("mujoco", model=comment_model)
@@ -415,7 +317,7 @@ def build_robot(
     for k in range(n):
         name = f"link{k + 1}"
         body = placed(
-            parent, "body", parent_tail @ _rz(float(model.theta_offset[k])), name=name, gravcomp=1
+            parent, "body", parent_tail @ rot_z(float(model.theta_offset[k])), name=name, gravcomp=1
         )
         com, inertia = _link_inertial(shape, k, float(radii[k]))
         com = carry[k][:3, :3] @ com + carry[k][:3, 3]
@@ -442,7 +344,7 @@ def build_robot(
             _add_segment(body, f"{name}_g{j}", _moved(seg, carry[k]))
         names.append(name)
         parent = body
-        parent_tail = _dh_tail(float(model.d[k]), float(model.a[k]), float(model.alpha[k]))
+        parent_tail = dh_tail(float(model.d[k]), float(model.a[k]), float(model.alpha[k]))
 
     flange = parent_tail
     placed(parent, "site", flange, name="flange", size=0.01, rgba="0.1 0.1 0.1 0.3")

@@ -31,9 +31,10 @@ from ..geometry.box import Box
 from ..geometry.checks import FloatArray
 from ..robot._checks import as_point
 from ..robot.model import RobotModel
+from ..robot.shape import link_radii
 from ..robot.tool import BowTool
 from ._xml import placed, sub, to_string
-from .mjcf import ServoGains, build_robot, link_radii
+from .mjcf import ServoGains, build_robot
 
 __all__ = ["BowTool", "Scene", "default_camera", "default_table", "example_scene", "scene_mjcf"]
 

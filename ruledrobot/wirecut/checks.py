@@ -12,6 +12,9 @@ Gating (the plan is feasible only when all hold; ``docs/verdict.md``):
   ``planned_wire_deviation`` — the same for the planned joints;
 * ``feed_max`` / ``feed_min`` — the feed of the wire inside the stock within
   ``[cut] feed_tolerance`` of the set feed (above and below);
+* ``kept_surface`` (kerf compensated cuts) — the kept part's surface within
+  ``[cut] wire_tolerance`` of the target, from the kerf offsets (:mod:`.kerf`)
+  (these four are per cut, named ``wire_deviation:NAME`` ... when a job has several);
 * ``joint_position`` / ``joint_speed`` / ``joint_acceleration`` — ratios to the
   robot's limits (finite differences of the samples) at most 1; ``joint_torque``
   — the simulated joint torques (MuJoCo, with the bow's mass) at most the limits;
@@ -28,39 +31,92 @@ import numpy as np
 
 from ..robot.verdict import Check, Verdict
 
-__all__ = ["Measurements", "collision_sentence", "plan_verdict"]
+__all__ = ["CutMeasurements", "Measurements", "collision_sentence", "plan_verdict"]
+
+
+@dataclass(frozen=True)
+class CutMeasurements:
+    """What was measured on one cut (all its passes; None: not measured).  Units: mm,
+    mm/s, ratios; the tolerances are the cut's own."""
+
+    name: str
+    feed_set_mm_s: float
+    feed_max_mm_s: float | None
+    feed_min_mm_s: float | None
+    feed_within_1pct: float | None
+    wire_deviation_mm: float | None
+    planned_wire_deviation_mm: float | None
+    kerf_mm: float
+    compensated: bool
+    kept_surface_error_mm: float | None
+    wire_tolerance_mm: float
+    feed_tolerance: float
 
 
 @dataclass(frozen=True)
 class Measurements:
-    """What the planner measured (None: not measured).  Units: mm, mm/s, ratios."""
+    """What the planner measured on the whole job (None: not measured).  Units: mm,
+    mm/s, ratios.  ``cuts``: per cut; a single cut's checks keep their plain names."""
 
     reach_ok: bool
     reach_detail: str
     rulings: int
     simulated: bool
     collisions: tuple[str, ...]
-    wire_deviation_mm: float | None
-    planned_wire_deviation_mm: float | None
-    feed_set_mm_s: float
-    feed_max_mm_s: float | None
-    feed_min_mm_s: float | None
-    feed_within_1pct: float | None
     position_ratio: float | None
     speed_ratio: float | None
     acc_ratio: float | None
     torque_ratio: float | None
     singularity_min: float | None
     tracking_error_mm: float | None
-    kerf_mm: float
     duration_s: float | None
+    cuts: tuple[CutMeasurements, ...] = ()
 
 
-def plan_verdict(
-    m: Measurements, *, wire_tolerance_mm: float, feed_tolerance: float, singularity_margin: float
-) -> Verdict:
+def _cut_checks(c: CutMeasurements, single: bool) -> list[Check]:
+    key = "" if single else f":{c.name}"
+    of = "" if single else f" ({c.name})"
+    F = c.feed_set_mm_s
+    tol = c.feed_tolerance
+    checks = [
+        Check.at_most("wire_deviation" + key, "simulated wire deviation from the rulings" + of,
+                      c.wire_deviation_mm, c.wire_tolerance_mm, "mm",
+                      "the simulated wire leaves the target rulings"),
+        Check.at_most("planned_wire_deviation" + key,
+                      "planned wire deviation from the rulings" + of,
+                      c.planned_wire_deviation_mm, c.wire_tolerance_mm, "mm",
+                      "the planned wire leaves the target rulings"),
+        Check.at_most("feed_max" + key, "highest feed inside the stock" + of, c.feed_max_mm_s,
+                      F * (1 + tol), "mm/s",
+                      f"the wire moves faster than {F:g} mm/s + {100 * tol:g} %"),
+        Check.at_least("feed_min" + key, "lowest feed inside the stock" + of, c.feed_min_mm_s,
+                       F * (1 - tol), "mm/s",
+                       f"the joints cannot hold {F:g} mm/s - {100 * tol:g} %: the "
+                       "wire slows down inside the stock (a wider kerf there)"),
+    ]  # fmt: skip
+    if c.compensated:
+        checks.append(Check.at_most(
+            "kept_surface" + key, "kept surface from the target, kerf compensated" + of,
+            c.kept_surface_error_mm, c.wire_tolerance_mm, "mm",
+            "a straight wire's kerf offset cannot follow the surface's twist"))  # fmt: skip
+    return checks
+
+
+def _cut_info(c: CutMeasurements, single: bool) -> list[Check]:
+    key = "" if single else f":{c.name}"
+    of = "" if single else f" ({c.name})"
+    kerf = "kerf (compensated)" if c.compensated else "kerf (not compensated)"
+    return [
+        Check.info("feed_within_1pct" + key, "share of the cut within 1 % of the feed" + of,
+                   c.feed_within_1pct),
+        Check.info("kerf" + key, kerf + of, c.kerf_mm, "mm"),
+    ]  # fmt: skip
+
+
+def plan_verdict(m: Measurements, *, singularity_margin: float) -> Verdict:
     """The checks of a plan (see the module doc) from its measurements."""
-    F = m.feed_set_mm_s
+    single = len(m.cuts) <= 1
+    cut_checks = [ch for c in m.cuts for ch in _cut_checks(c, single)]
     checks = [
         Check("reach", "every ruling reachable, clear of stock and table",
               "yes" if m.reach_ok else "no", "yes", relation="==", ok=m.reach_ok,
@@ -72,19 +128,7 @@ def plan_verdict(
               None if not m.reach_ok else len(m.collisions), 0, relation="<=",
               ok=m.reach_ok and not m.collisions, detail="\n".join(m.collisions[:8])
               + (f"\nand {len(m.collisions) - 8} more" if len(m.collisions) > 8 else "")),
-        Check.at_most("wire_deviation", "simulated wire deviation from the rulings",
-                      m.wire_deviation_mm, wire_tolerance_mm, "mm",
-                      "the simulated wire leaves the target rulings"),
-        Check.at_most("planned_wire_deviation", "planned wire deviation from the rulings",
-                      m.planned_wire_deviation_mm, wire_tolerance_mm, "mm",
-                      "the planned wire leaves the target rulings"),
-        Check.at_most("feed_max", "highest feed inside the stock", m.feed_max_mm_s,
-                      F * (1 + feed_tolerance), "mm/s",
-                      f"the wire moves faster than {F:g} mm/s + {100 * feed_tolerance:g} %"),
-        Check.at_least("feed_min", "lowest feed inside the stock", m.feed_min_mm_s,
-                       F * (1 - feed_tolerance), "mm/s",
-                       f"the joints cannot hold {F:g} mm/s - {100 * feed_tolerance:g} %: the "
-                       "wire slows down inside the stock (a wider kerf there)"),
+        *cut_checks,
         Check.at_most("joint_position", "joint position / limit", m.position_ratio, 1.0,
                       detail="a joint leaves its position range"),
         Check.at_most("joint_speed", "joint speed / limit", m.speed_ratio, 1.0,
@@ -96,9 +140,7 @@ def plan_verdict(
         Check.at_least("singularity", "singularity measure during the cut", m.singularity_min,
                        singularity_margin, detail="the arm comes too close to a singularity"),
         Check.info("tracking_error", "simulated TCP tracking error", m.tracking_error_mm, "mm"),
-        Check.info("feed_within_1pct", "share of the cut within 1 % of the feed",
-                   m.feed_within_1pct),
-        Check.info("kerf", "kerf (not compensated)", m.kerf_mm, "mm"),
+        *[ch for c in m.cuts for ch in _cut_info(c, single)],
         Check.info("duration", "duration of the whole trajectory", m.duration_s, "s"),
     ]  # fmt: skip
     return Verdict(tuple(checks))

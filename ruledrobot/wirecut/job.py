@@ -1,6 +1,8 @@
 """Cut job files (TOML): what to cut, from what, with which robot and tool.
 
-A job describes, in the robot base frame (metres, radians, seconds)::
+A job holds one stock, one robot, one tool and one or more cuts.  A single cut
+is written as ``[surface]`` and ``[cut]`` tables (in the robot base frame;
+metres, radians, seconds)::
 
     [surface]                  # the ruled surface to cut
     builtin = "hyperbolic_paraboloid"   # or: file = "rulings.json" (lines file)
@@ -11,6 +13,7 @@ A job describes, in the robot base frame (metres, radians, seconds)::
     algorithm = "dh"           # projection | combined | dh
     scheme = "four_point"
     steps = 4                  # or: spacing = 0.002 (m, largest gap between refined rulings)
+    # closed = true            # a closed sequence of rulings (a column, a band)
 
     [stock]                    # the block, a box
     centre = [0.5, 0.0, 0.3]
@@ -30,15 +33,29 @@ A job describes, in the robot base frame (metres, radians, seconds)::
     wire_end = [0.2, 0.0, 0.25]
     clearance = 0.02           # wire kept this far beyond the stock at each end
     mass = 1.0
+    # heat = { output = "standard:0", preheat = 2.0 }   # switch the wire's heat (robot IO)
 
     [cut]
     feed_speed = 0.01          # m/s, wire speed inside the stock
     lead_in = 0.02             # m before the first chord
     lead_out = 0.02
-    approach_speed = 0.3       # fraction of joint speed limits for approach/retract
-    kerf = 0.0008              # m, reported; the wire path is the surface itself
+    approach_speed = 0.3       # fraction of joint speed limits for approach/retract/transit
+    kerf = 0.0008              # m, the width of the slot the wire melts
+    # keep = [0.5, 0.0, 0.2]   # a point of the part (or "inside"/"outside" for a closed
+    #                          # surface): the wire runs kerf/2 off the surface, in the waste
     wire_tolerance = 0.0005    # m, largest wire deviation from the rulings (a check)
     feed_tolerance = 0.05      # fraction: feed inside the stock within +-5 % (a check)
+
+A part with several cuts lists them in order as ``[[cut]]`` tables, each with a
+``name`` and its own ``[cut.surface]`` table (the fields of ``[surface]``), and
+the ``[cut]`` fields above; there is then no top-level ``[surface]``::
+
+    [[cut]]
+    name = "top"
+    keep = [0.5, 0.0, 0.2]
+    [cut.surface]
+    builtin = "hyperbolic_paraboloid"
+    ...
 
 :func:`load_job` validates every field and raises ValueError naming the file,
 the section and the field.
@@ -48,213 +65,118 @@ from __future__ import annotations
 
 import os
 import sys
-from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
-from ..geometry import se3
-from ..geometry.box import Box
-from ..geometry.lines import Lines
 from ..io.text import read_user_text
-from ..robot.calibration import Calibration
-from ..subdivision.schemes import SCHEME_NAMES
+from .job_sections import Section, parse_heat, parse_robot, parse_stock, parse_surface
+from .spec import CutSpec, HeatSpec, Job, RobotSpec, SurfaceSpec, ToolSpec
 
 if sys.version_info >= (3, 11):
     import tomllib
 else:  # pragma: no cover
     import tomli as tomllib
 
-__all__ = ["CutSpec", "Job", "RobotSpec", "SurfaceSpec", "ToolSpec", "load_job", "parse_job"]
-
-ALGORITHMS = ("projection", "combined", "dh")
-
-
-@dataclass(frozen=True)
-class SurfaceSpec:
-    """Where the rulings come from and how they are refined."""
-
-    builtin: str | None = None
-    file: Path | None = None
-    params: dict[str, Any] = field(default_factory=dict)
-    u: tuple[float, float] | None = None
-    rulings: int = 9
-    pose: np.ndarray = field(default_factory=lambda: np.eye(4), repr=False)
-    algorithm: str = "dh"
-    scheme: str = "four_point"
-    steps: int | None = 4
-    spacing: float | None = None
+__all__ = [
+    "CutSpec",
+    "HeatSpec",
+    "Job",
+    "RobotSpec",
+    "SurfaceSpec",
+    "ToolSpec",
+    "load_job",
+    "parse_job",
+]
 
 
-@dataclass(frozen=True)
-class RobotSpec:
-    model: str = "ur5e"
-    base: np.ndarray = field(default_factory=lambda: np.eye(4), repr=False)
-    speed_scale: float = 1.0
-    acceleration: np.ndarray | None = None
-    home: np.ndarray | None = field(default=None, repr=False)
-    calibration: Calibration | None = None  #: read from the job's calibration file
-
-
-@dataclass(frozen=True)
-class ToolSpec:
-    """The bow: wire end points in the flange frame (m), clearance beyond the stock, mass."""
-
-    wire_start: np.ndarray
-    wire_end: np.ndarray
-    clearance: float = 0.02
-    mass: float = 1.0
-
-    @property
-    def wire_length(self) -> float:
-        return float(np.linalg.norm(self.wire_end - self.wire_start))
-
-
-@dataclass(frozen=True)
-class CutSpec:
-    feed_speed: float = 0.01
-    lead_in: float = 0.02
-    lead_out: float = 0.02
-    approach_speed: float = 0.3
-    kerf: float = 0.0008
-    wire_tolerance: float = 0.0005
-    feed_tolerance: float = 0.05
-
-
-@dataclass(frozen=True)
-class Job:
-    """A validated cut job (see the module doc for the file format)."""
-
-    surface: SurfaceSpec
-    stock: Box
-    robot: RobotSpec
-    tool: ToolSpec
-    cut: CutSpec
-    source: Path | None = None
-
-    def robot_model(self):
-        """The job's robot: the catalogue model with its calibration (if the job names
-        one) and its base; the arm every stage plans and checks with."""
-        from ..robot import load
-
-        return load(self.robot.model).with_calibration(self.robot.calibration).with_base(
-            self.robot.base
+def _tool(t: Section) -> ToolSpec:
+    w0, w1 = t.vector("wire_start", 3), t.vector("wire_end", 3)
+    length = float(np.linalg.norm(w1 - w0))
+    if length < 1e-3:
+        raise t.fail("wire_end", f"wire must be at least 1 mm long, got {length * 1e3:.3g} mm")
+    heat = None
+    if t.get("heat") is not None:
+        heat = parse_heat(Section(t.raw, "heat", t.where, title=f"{t.title}.heat"))
+    tool = ToolSpec(w0, w1, clearance=t.number("clearance", 0.02, lo=0.0),
+                    mass=t.number("mass", 1.0, lo=0.0), heat=heat)  # fmt: skip
+    if 2 * tool.clearance >= length:
+        raise t.fail(
+            "clearance",
+            f"2 x clearance ({2 * tool.clearance:g} m) must be shorter "
+            f"than the wire ({length:g} m)",
         )
-
-    def input_lines(self) -> Lines:
-        """The input rulings in the robot base frame."""
-        s = self.surface
-        if s.file is not None:
-            from ..io.lines import load_lines
-
-            lines = load_lines(s.file)
-        else:
-            from ..geometry.surfaces import sample_surface
-
-            lo, hi = s.u if s.u is not None else (None, None)
-            lines = sample_surface(s.builtin, n=s.rulings, start=lo, stop=hi, **s.params).lines
-        return lines.transform(s.pose)
+    t.done()
+    return tool
 
 
-class _Section:
-    """Typed access to one TOML table with errors naming file, section and field."""
-
-    def __init__(self, doc: dict, name: str, where: str, required: bool = True) -> None:
-        self.where = where
-        self.name = name
-        raw = doc.get(name)
-        if raw is None:
-            if required:
-                raise ValueError(f"{where}: missing section [{name}]")
-            raw = {}
-        if not isinstance(raw, dict):
-            raise ValueError(f"{where}: [{name}] must be a table")
-        self.raw = raw
-        self.used: set[str] = set()
-
-    def fail(self, key: str, msg: str) -> ValueError:
-        return ValueError(f"{self.where}: [{self.name}] {key}: {msg}")
-
-    def get(self, key: str, default: Any = None) -> Any:
-        self.used.add(key)
-        return self.raw.get(key, default)
-
-    def number(
-        self,
-        key: str,
-        default: float | None = None,
-        lo: float | None = None,
-        hi: float | None = None,
-        strict_lo: bool = False,
-    ) -> float:
-        v = self.get(key, default)
-        if v is None:
-            raise self.fail(key, "missing; expected a number")
-        if isinstance(v, bool) or not isinstance(v, (int, float)) or not np.isfinite(v):
-            raise self.fail(key, f"expected a finite number, got {v!r}")
-        if lo is not None and (v < lo or (strict_lo and v == lo)):
-            rel = ">" if strict_lo else ">="
-            raise self.fail(key, f"expected a number {rel} {lo:g}, got {v!r}")
-        if hi is not None and v > hi:
-            raise self.fail(key, f"expected a number <= {hi:g}, got {v!r}")
-        return float(v)
-
-    def vector(self, key: str, n: int, default: Any = None) -> np.ndarray:
-        v = self.get(key, default)
-        if v is None:
-            raise self.fail(key, f"missing; expected a list of {n} numbers")
-        if (
-            not isinstance(v, list)
-            or len(v) != n
-            or any(isinstance(x, bool) or not isinstance(x, (int, float)) for x in v)
-        ):
-            raise self.fail(key, f"expected a list of {n} numbers, got {v!r}")
-        arr = np.asarray(v, dtype=np.float64)
-        if not np.all(np.isfinite(arr)):
-            raise self.fail(key, "contains NaN or infinity")
-        return arr
-
-    def choice(self, key: str, options: tuple[str, ...], default: str) -> str:
-        v = self.get(key, default)
-        if v not in options:
-            raise self.fail(key, f"expected one of {', '.join(options)}, got {v!r}")
-        return str(v)
-
-    def done(self) -> None:
-        extra = sorted(set(self.raw) - self.used)
-        if extra:
-            raise ValueError(
-                f"{self.where}: [{self.name}] unknown field(s) {', '.join(extra)}; "
-                f"expected some of {', '.join(sorted(self.used))}"
-            )
-
-
-def _calibration(sec: _Section, model: str, base_dir: Path | None) -> Calibration | None:
-    """``[robot] calibration``: a calibration file of this robot, read and checked."""
-    value = sec.get("calibration")
+def _keep(c: Section, closed: bool | None) -> str | np.ndarray | None:
+    value = c.get("keep")
     if value is None:
         return None
-    if not isinstance(value, str):
-        raise sec.fail("calibration", f"expected a path string, got {value!r}")
-    path = Path(value)
-    if not path.is_absolute() and base_dir is not None:
-        path = base_dir / path
-    from ..io.calibration import load_calibration
-
-    try:
-        cal = load_calibration(path)
-    except (OSError, ValueError) as exc:
-        raise sec.fail("calibration", str(exc)) from None
-    if cal.model != model:
-        raise sec.fail("calibration", f"{path} is a calibration of a {cal.model}, the job's "
-                       f"robot is a {model}")  # fmt: skip
-    return cal
+    if isinstance(value, str):
+        if value not in ("inside", "outside"):
+            raise c.fail("keep",
+                         f'expected "inside", "outside" or a point [x, y, z], got {value!r}')
+        if closed is False:
+            raise c.fail("keep", f'"{value}" needs a closed surface; give a point [x, y, z] of '
+                         "the part instead")  # fmt: skip
+        return value
+    return c.vector("keep", 3)
 
 
-def _pose(sec: _Section, key: str) -> np.ndarray:
-    v = sec.vector(key, 6, [0.0] * 6)
-    return se3.pose_from_ur_vector(v)
+def _cut(c: Section, name: str, surface: SurfaceSpec) -> CutSpec:
+    closed = surface.closed
+    if closed is None and surface.file is not None:
+        closed = None  # the file decides; checked when the rulings are read
+    elif closed is None:
+        closed = False
+    cut = CutSpec(
+        name=name,
+        surface=surface,
+        feed_speed=c.number("feed_speed", 0.01, lo=0.0, hi=1.0, strict_lo=True),
+        lead_in=c.number("lead_in", 0.02, lo=0.0),
+        lead_out=c.number("lead_out", 0.02, lo=0.0),
+        approach_speed=c.number("approach_speed", 0.3, lo=0.0, hi=1.0, strict_lo=True),
+        kerf=c.number("kerf", 0.0008, lo=0.0),
+        keep=_keep(c, closed),
+        wire_tolerance=c.number("wire_tolerance", 0.0005, lo=0.0, strict_lo=True),
+        feed_tolerance=c.number("feed_tolerance", 0.05, lo=0.0, hi=1.0, strict_lo=True),
+    )
+    c.done()
+    return cut
+
+
+def _cuts(doc: dict, where: str, base_dir: Path | None) -> tuple[CutSpec, ...]:
+    raw = doc.get("cut")
+    if isinstance(raw, list):  # [[cut]]: a part with several cuts
+        if "surface" in doc:
+            raise ValueError(f"{where}: [surface] with [[cut]] tables: give each cut its own "
+                             "[cut.surface] table and no top-level [surface]")  # fmt: skip
+        if not raw:
+            raise ValueError(f"{where}: [[cut]] is empty; expected at least one cut")
+        cuts: list[CutSpec] = []
+        for i, entry in enumerate(raw):
+            if not isinstance(entry, dict):
+                raise ValueError(f"{where}: [[cut]] entry {i + 1} must be a table")
+            name = entry.get("name", f"cut{i + 1}")
+            if not isinstance(name, str) or not name.strip():
+                raise ValueError(f"{where}: [[cut]] entry {i + 1}: name: expected a non-empty "
+                                 f"string, got {name!r}")  # fmt: skip
+            if name in [c.name for c in cuts]:
+                raise ValueError(f"{where}: [[cut]] entry {i + 1}: name {name!r} is used by an "
+                                 "earlier cut; names must be unique")  # fmt: skip
+            title = f"cut '{name}'"
+            c = Section.of(entry, title, where)
+            c.get("name")
+            surface = parse_surface(Section(entry, "surface", where, title=f"{title}.surface"),
+                                    base_dir)  # fmt: skip
+            c.get("surface")
+            cuts.append(_cut(c, name, surface))
+        return tuple(cuts)
+    surface = parse_surface(Section(doc, "surface", where), base_dir)
+    c = Section(doc, "cut", where, required=False)
+    return (_cut(c, "cut", surface),)
 
 
 def parse_job(doc: dict, where: str = "job", base_dir: Path | None = None) -> Job:
@@ -265,136 +187,11 @@ def parse_job(doc: dict, where: str = "job", base_dir: Path | None = None) -> Jo
         raise ValueError(
             f"{where}: unknown section(s) {', '.join(extra)}; expected {sorted(known)}"
         )
-
-    s = _Section(doc, "surface", where)
-    builtin, file = s.get("builtin"), s.get("file")
-    if (builtin is None) == (file is None):
-        raise s.fail("builtin/file", 'give exactly one of builtin = "name" or file = "path"')
-    params = s.get("params", {})
-    if not isinstance(params, dict):
-        raise s.fail("params", f"expected a table of parameters, got {params!r}")
-    u = None
-    path = None
-    if builtin is not None:
-        from ..geometry.surfaces import SURFACES
-
-        if builtin not in SURFACES:
-            raise s.fail(
-                "builtin",
-                f"unknown surface {builtin!r}; expected one of {', '.join(sorted(SURFACES))}",
-            )
-        try:
-            SURFACES[builtin].params(**params)
-        except ValueError as exc:
-            raise s.fail("params", str(exc)) from None
-        if s.get("u") is not None:
-            uu = s.vector("u", 2)
-            if not uu[1] > uu[0]:
-                raise s.fail("u", f"expected [start, stop] with stop > start, got {uu.tolist()}")
-            u = (float(uu[0]), float(uu[1]))
-    else:
-        if not isinstance(file, str):
-            raise s.fail("file", f"expected a path string, got {file!r}")
-        path = Path(file)
-        if not path.is_absolute() and base_dir is not None:
-            path = base_dir / path
-        if not path.exists():
-            raise s.fail("file", f"no such lines file: {path}")
-        if "u" in s.raw:
-            raise s.fail("u", "only for a builtin surface")
-        if params:
-            raise s.fail("params", "only for a builtin surface")
-    rulings = s.get("rulings", 9)
-    if isinstance(rulings, bool) or not isinstance(rulings, int) or not 4 <= rulings <= 10_000:
-        raise s.fail("rulings", f"expected an integer 4 <= rulings <= 10000, got {rulings!r}")
-    steps = s.get("steps")
-    spacing = s.get("spacing")
-    if steps is not None and spacing is not None:
-        raise s.fail("steps/spacing", "give steps or spacing, not both")
-    if spacing is not None:
-        spacing = s.number("spacing", lo=0.0, strict_lo=True)
-    elif steps is None:
-        steps = 4
-    if steps is not None and (
-        isinstance(steps, bool) or not isinstance(steps, int) or not 0 <= steps <= 12
-    ):
-        raise s.fail("steps", f"expected an integer 0 <= steps <= 12, got {steps!r}")
-    surface = SurfaceSpec(
-        builtin=builtin,
-        file=path,
-        params=dict(params),
-        u=u,
-        rulings=int(rulings),
-        pose=_pose(s, "pose"),
-        algorithm=s.choice("algorithm", ALGORITHMS, "dh"),
-        scheme=s.choice("scheme", SCHEME_NAMES, "four_point"),
-        steps=steps,
-        spacing=spacing,
-    )
-    s.done()
-
-    st = _Section(doc, "stock", where)
-    centre, size = st.vector("centre", 3), st.vector("size", 3)
-    for k in range(3):
-        if size[k] <= 0:
-            raise st.fail("size", f"edge {k} must be positive, got {size[k]!r}")
-    rot = se3.pose_from_rotvec(st.vector("rotvec", 3, [0.0, 0.0, 0.0]))[:3, :3]
-    stock = Box(centre, size, rot)
-    st.done()
-
-    r = _Section(doc, "robot", where)
-    model = r.get("model", "ur5e")
-    from ..robot import MODEL_NAMES
-
-    if model not in MODEL_NAMES:
-        raise r.fail("model", f"unknown robot {model!r}; expected one of {', '.join(MODEL_NAMES)}")
-    acc = r.get("acceleration")
-    acceleration = None
-    if acc is not None:
-        if isinstance(acc, list):
-            acceleration = r.vector("acceleration", 6)
-        else:
-            acceleration = np.full(6, r.number("acceleration"))
-        if np.any(acceleration <= 0):
-            raise r.fail("acceleration", "expected positive values (rad/s^2)")
-    robot = RobotSpec(
-        model=model,
-        base=_pose(r, "base"),
-        speed_scale=r.number("speed_scale", 1.0, lo=0.0, hi=1.0, strict_lo=True),
-        acceleration=acceleration,
-        home=r.vector("home", 6) if r.get("home") is not None else None,
-        calibration=_calibration(r, model, base_dir),
-    )
-    r.done()
-
-    t = _Section(doc, "tool", where)
-    w0, w1 = t.vector("wire_start", 3), t.vector("wire_end", 3)
-    length = float(np.linalg.norm(w1 - w0))
-    if length < 1e-3:
-        raise t.fail("wire_end", f"wire must be at least 1 mm long, got {length * 1e3:.3g} mm")
-    tool = ToolSpec(
-        w0, w1, clearance=t.number("clearance", 0.02, lo=0.0), mass=t.number("mass", 1.0, lo=0.0)
-    )
-    if 2 * tool.clearance >= length:
-        raise t.fail(
-            "clearance",
-            f"2 x clearance ({2 * tool.clearance:g} m) must be shorter "
-            f"than the wire ({length:g} m)",
-        )
-    t.done()
-
-    c = _Section(doc, "cut", where)
-    cut = CutSpec(
-        feed_speed=c.number("feed_speed", 0.01, lo=0.0, hi=1.0, strict_lo=True),
-        lead_in=c.number("lead_in", 0.02, lo=0.0),
-        lead_out=c.number("lead_out", 0.02, lo=0.0),
-        approach_speed=c.number("approach_speed", 0.3, lo=0.0, hi=1.0, strict_lo=True),
-        kerf=c.number("kerf", 0.0008, lo=0.0),
-        wire_tolerance=c.number("wire_tolerance", 0.0005, lo=0.0, strict_lo=True),
-        feed_tolerance=c.number("feed_tolerance", 0.05, lo=0.0, hi=1.0, strict_lo=True),
-    )
-    c.done()
-    return Job(surface, stock, robot, tool, cut)
+    cuts = _cuts(doc, where, base_dir)
+    stock = parse_stock(Section(doc, "stock", where))
+    robot = parse_robot(Section(doc, "robot", where), base_dir)
+    tool = _tool(Section(doc, "tool", where))
+    return Job(cuts, stock, robot, tool)
 
 
 def load_job(path: str | os.PathLike[str]) -> Job:
@@ -405,4 +202,4 @@ def load_job(path: str | os.PathLike[str]) -> Job:
     except tomllib.TOMLDecodeError as exc:
         raise ValueError(f"{p}: not valid TOML ({exc})") from None
     job = parse_job(doc, str(p), base_dir=p.parent)
-    return Job(job.surface, job.stock, job.robot, job.tool, job.cut, source=p)
+    return Job(job.cuts, job.stock, job.robot, job.tool, source=p)

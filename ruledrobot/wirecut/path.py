@@ -1,22 +1,22 @@
-"""From a job to the geometric cut path: refined rulings, lead-in/out, wire motion.
+"""From a cut to its geometric path: refined rulings, kerf offset, lead-in/out, wire motion.
 
-1. The input rulings are refined (``job.surface``: algorithm, scheme, and either
+1. The input rulings are refined (the cut's surface: algorithm, scheme, and either
    a number of steps or a target ``spacing`` — the largest gap between
    consecutive rulings inside the stock, the distance from the chord ends of one
    to the next — for which the fewest steps that meet it are taken).
 2. The frame motion (the refined DH frames of ``dh``; sign-continuous DH frames
-   of the refined rulings otherwise) is kept between the first and the last
-   ruling that meets the stock grown by the lead distance on every side, and
-   extended at either end by screw-geodesic extrapolation of the frame motion
-   when the surface stops before the wire is clear of the stock by the lead
-   distance.
-3. The redundancy search (:mod:`.redundancy`) chooses roll, slide, wire
+   of the refined rulings otherwise) is moved ``kerf / 2`` into the waste when the
+   cut names the part's side (:mod:`.kerf`).
+3. Open surfaces: the frames are kept between the first and the last ruling that
+   meets the stock grown by the lead distance on every side, and extended at
+   either end by screw-geodesic extrapolation of the frame motion when the
+   surface stops before the wire is clear of the stock by the lead distance.
+   Closed surfaces are cut as loops entered through a slit (:mod:`.closed`).
+4. The redundancy search (:mod:`.redundancy`) chooses roll, slide, wire
    direction and IK branch.
 """
 
 from __future__ import annotations
-
-from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -26,31 +26,27 @@ from ..geometry.box import Box
 from ..geometry.checks import FloatArray
 from ..geometry.ruled import RuledSurface
 from ..subdivision import check_size, get_scheme, refined_count
-from .job import Job
-from .redundancy import RedundancyResult, solve_redundancy
+from .closed import loop_paths
+from .cutpath import CutPath, RefinedCut
+from .kerf import kerf_offsets
+from .redundancy import solve_redundancy
+from .spec import CutSpec, Job
 from .toolpath import chords
 
-__all__ = ["CutPath", "chord_ends_in_flange", "cut_path", "refine_for_job"]
+__all__ = [
+    "CutPath",
+    "RefinedCut",
+    "chord_ends_in_flange",
+    "cut_path",
+    "cut_paths",
+    "refine_cut",
+    "refine_for_job",
+]
 
 MAX_STEPS = 10
 #: Most refined rulings a cut may have (the redundancy search, the time law and the
 #: simulation scale with them: ~2 min of planning and ~2 GB at this size).
 MAX_PATH_RULINGS = 250_000
-
-
-@dataclass(frozen=True)
-class CutPath:
-    """The geometric cut: frames (M, 4, 4) on the rulings and the chosen robot motion."""
-
-    frames: FloatArray = field(repr=False)
-    motion: RedundancyResult
-    steps: int
-    extended: tuple[int, int]  # frames added before / after by extrapolation
-    input_rulings: int
-
-    @property
-    def feasible(self) -> bool:
-        return self.motion.feasible
 
 
 def _gaps(frames: FloatArray, stock: Box) -> float:
@@ -72,45 +68,54 @@ def _gaps(frames: FloatArray, stock: Box) -> float:
     return float(np.max(gaps, axis=0)[both].max())
 
 
-def _frames(job: Job, steps: int) -> FloatArray:
-    s = job.surface
-    lines = job.input_lines()
-    res = refine(lines, s.algorithm, s.scheme, steps)
-    if res.frames is not None:
-        return res.frames
-    return RuledSurface(res.lines).dh_frames("continuous")
+def _frames(lines, closed: bool, cut: CutSpec, steps: int) -> tuple[FloatArray, bool]:
+    s = cut.surface
+    res = refine(RuledSurface(lines, closed=closed), s.algorithm, s.scheme, steps)
+    frames = res.frames
+    if frames is None:
+        frames = RuledSurface(res.lines, closed=closed).dh_frames("continuous")
+    return frames, bool(res.flip)
 
 
-def refine_for_job(job: Job) -> tuple[FloatArray, int]:
-    """Refined frames (M, 4, 4) and the number of steps used (see the module doc):
-    ``spacing`` takes the fewest steps whose largest gap inside the stock meets it."""
-    where = f"{job.source or 'job'}: [surface]"
-    check_distinct_neighbours(job.input_lines().plucker, False,
-                              f"{where} {job.surface.file or job.surface.builtin}")  # fmt: skip
-    n = len(job.input_lines())
-    sch = get_scheme(job.surface.scheme)
-    if job.surface.steps is not None:
-        check_size(sch, n, job.surface.steps, False, f"{where} steps", MAX_PATH_RULINGS, None)
-        return _frames(job, job.surface.steps), job.surface.steps
+def refine_cut(cut: CutSpec, stock: Box, where: str = "job") -> RefinedCut:
+    """Refined frames of ``cut`` (see the module doc): ``spacing`` takes the fewest
+    steps whose largest gap inside the stock meets it."""
+    s = cut.surface
+    label = f"{where}: [surface]" if cut.name == "cut" else f"{where}: [cut '{cut.name}'.surface]"
+    doc = s.document()
+    lines, closed = doc.lines, bool(doc.closed)
+    check_distinct_neighbours(lines.plucker, closed, f"{label} {s.label}")
+    n = len(lines)
+    sch = get_scheme(s.scheme)
+    if s.steps is not None:
+        check_size(sch, n, s.steps, closed, f"{label} steps", MAX_PATH_RULINGS, None)
+        F, flip = _frames(lines, closed, cut, s.steps)
+        return RefinedCut(F, s.steps, closed, flip, n)
     gap = np.inf
     for steps in range(MAX_STEPS + 1):
-        if refined_count(sch, n, steps, False) > MAX_PATH_RULINGS:
+        if refined_count(sch, n, steps, closed) > MAX_PATH_RULINGS:
             raise ValueError(
-                f"{where} spacing: {job.surface.spacing} m needs more than "
+                f"{label} spacing: {s.spacing} m needs more than "
                 f"{MAX_PATH_RULINGS:,} rulings (the limit of a cut); {steps - 1} steps give a "
                 f"largest gap of {gap:.3g} m: ask for a larger spacing"
             )
-        F = _frames(job, steps)
-        gap = _gaps(F, job.stock)
-        if gap <= job.surface.spacing:
-            return F, steps
+        F, flip = _frames(lines, closed, cut, steps)
+        gap = _gaps(F, stock)
+        if gap <= s.spacing:
+            return RefinedCut(F, steps, closed, flip, n)
     if not np.isfinite(gap):
-        raise ValueError(f"{where} spacing: no two consecutive rulings cross the stock: the "
+        raise ValueError(f"{label} spacing: no two consecutive rulings cross the stock: the "
                          "surface misses the block (check [surface] pose, [stock] centre)")
     raise ValueError(
-        f"{where} spacing: {job.surface.spacing} m not reached after {MAX_STEPS} steps "
+        f"{label} spacing: {s.spacing} m not reached after {MAX_STEPS} steps "
         f"({len(F)} rulings, largest gap {gap:.3g} m)"
     )
+
+
+def refine_for_job(job: Job) -> tuple[FloatArray, int]:
+    """Refined frames (M, 4, 4) of the job's first cut and the number of steps used."""
+    rc = refine_cut(job.cut, job.stock, str(job.source or "job"))
+    return rc.frames, rc.steps
 
 
 def _extend(F: FloatArray, grown: Box, limit: int = 400) -> tuple[FloatArray, int, int]:
@@ -126,7 +131,8 @@ def _extend(F: FloatArray, grown: Box, limit: int = 400) -> tuple[FloatArray, in
             if k > limit:
                 raise ValueError(
                     "lead-in/out: the frame motion does not leave the stock within "
-                    f"{limit} extrapolated rulings; extend the surface past the stock"
+                    f"{limit} extrapolated rulings; extend the surface past the stock, or "
+                    "mark it closed (closed = true) if it goes all the way round"
                 )
             last = se3.geodesic(a, b, 1.0 + k)
             new.append(last)
@@ -138,25 +144,49 @@ def _extend(F: FloatArray, grown: Box, limit: int = 400) -> tuple[FloatArray, in
     return np.concatenate(parts), added[0], added[1]
 
 
-def cut_path(job: Job, model=None, **search: float) -> CutPath:
-    """The geometric cut of ``job`` (see the module doc); ``search`` goes to the
-    redundancy search.  ``model`` defaults to the job's robot (flange, no tool)."""
+def _translated(F: FloatArray, offset: FloatArray) -> FloatArray:
+    out = F.copy()
+    out[:, :3, 3] += offset
+    return out
 
+
+def cut_paths(
+    job: Job, cut: CutSpec | None = None, model=None, **search
+) -> list[CutPath]:
+    """The passes of ``cut`` (default: the job's first): one for an open surface or a
+    closed one cut in one pass, two when a loop must be split (:mod:`.closed`)."""
+    cut = job.cut if cut is None else cut
     if model is None:
         model = job.robot_model()
-    F, steps = refine_for_job(job)
-    lead = max(job.cut.lead_in, job.cut.lead_out)
-    grown = Box(job.stock.centre, job.stock.size + 2.0 * lead, job.stock.rotation)
-    _, _, near = chords(F, grown)
-    if not near.any():
-        raise ValueError("surface: no refined ruling comes near the stock; check [surface] pose")
-    first, last = np.flatnonzero(near)[[0, -1]]
-    F = F[max(first - 1, 0) : last + 2]
-    F, before, after = _extend(F, grown)
+    rc = refine_cut(cut, job.stock, str(job.source or "job"))
+    kerf = kerf_offsets(rc.frames, job.stock, cut.kerf, cut.keep, rc.closed)
+    wire = _translated(rc.frames, kerf.offset)
     if job.robot.home is not None:
         search.setdefault("q_start", job.robot.home)
+    if rc.closed:
+        return loop_paths(job, cut, model, rc, wire, kerf, **search)
+    lead = max(cut.lead_in, cut.lead_out)
+    grown = Box(job.stock.centre, job.stock.size + 2.0 * lead, job.stock.rotation)
+    _, _, near = chords(wire, grown)
+    if not near.any():
+        raise ValueError(f"cut '{cut.name}': no refined ruling comes near the stock; check the "
+                         "surface's pose")  # fmt: skip
+    first, last = np.flatnonzero(near)[[0, -1]]
+    keep = slice(max(first - 1, 0), last + 2)
+    F, before, after = _extend(wire[keep], grown)
+    off = kerf.offset[keep]
+    off = np.concatenate([np.repeat(off[:1], before, 0), off, np.repeat(off[-1:], after, 0)])
+    S = _translated(F, -off)  # the target rulings (the lead-in/out ones lie outside the stock)
+    err = np.r_[np.zeros(before), kerf.error[keep], np.zeros(after)]
     motion = solve_redundancy(F, job.stock, job.tool, model, **search)
-    return CutPath(F, motion, steps, (before, after), len(job.input_lines()))
+    return [CutPath(F, motion, rc.steps, (before, after), rc.input_rulings, cut.name,
+                    S, err, kerf.compensated)]  # fmt: skip
+
+
+def cut_path(job: Job, model=None, **search: float) -> CutPath:
+    """The geometric cut of the job's first cut (see the module doc); ``search`` goes
+    to the redundancy search.  ``model`` defaults to the job's robot (flange, no tool)."""
+    return cut_paths(job, None, model, **search)[0]
 
 
 def chord_ends_in_flange(path: CutPath) -> FloatArray:

@@ -40,11 +40,11 @@ import numpy as np
 
 from ..geometry.box import Box
 from ..geometry.checks import FloatArray
-from ..geometry.segments import segment_distance
 from ..robot import path_ik, wrap_angle
 from ..robot.tool import BowTool
-from .job import ToolSpec
-from .toolpath import chords, flange_poses, slide_bounds, wire_frame, wire_poses
+from .clearance import Cell, clearance
+from .spec import ToolSpec
+from .toolpath import chords, flange_poses, slide_bounds, wire_poses
 
 __all__ = ["RedundancyResult", "bow_segments", "solve_redundancy"]
 
@@ -86,92 +86,11 @@ class _Score:
     lost: dict[str, int]
 
 
-#: DH skeleton segments checked against the bow and the wire: the legs of joints 2-4
-#: (upper arm, forearm, wrist 1); the wrist 2/3 legs carry the bow's hub.
-_ARM_NEAR_BOW = slice(2, 8)
-
-
-@dataclass(frozen=True)
-class _Cell:
-    """The fixed setting of a search: robot, bow and wire, stock, table, thresholds."""
-
-    model: object
-    W: FloatArray  # wire frame in the flange frame
-    rods: FloatArray  # (3, 2, 3) bow rods in the flange frame
-    wire: FloatArray  # (2, 3) wire ends in the flange frame
-    stock: Box
-    table_z: float | None
-    margin: float
-    singular_min: float
-    q_start: FloatArray | None
-
-    @classmethod
-    def of(cls, model, tool: ToolSpec, stock: Box, table_z, margin, singular_min, q_start):
-        bow = BowTool.from_spec(tool)
-        wire = np.array([bow.wire_start, bow.wire_end])
-        return cls(
-            model,
-            wire_frame(tool),
-            bow.segments(),
-            wire,
-            stock,
-            table_z,
-            margin,
-            singular_min,
-            q_start,
-        )
-
-
-def _clearance(cell: _Cell, q: FloatArray, P: FloatArray) -> dict[str, np.ndarray]:
-    """Per configuration (...): which clearance rule it breaks (dict of bool arrays).
-
-    ``q`` (..., 6) joints and ``P`` (..., 4, 4) their flange poses.  Link capsules sit
-    on the DH skeleton with the MuJoCo model's housing radii (so planner and
-    simulation agree); the bow rods have the simulated bow's rod radius.  The wire
-    inside the stock is the cut, not a collision.
-    """
-    from ..sim.mjcf import link_radii
-
-    model, stock, margin = cell.model, cell.stock, cell.margin
-    shape = q.shape[:-1]
-    qf = np.nan_to_num(q.reshape(-1, q.shape[-1]))
-    Pf = P.reshape(-1, 4, 4)
-    rods = np.concatenate([cell.rods, cell.wire[None]], axis=0)  # (4, 2, 3)
-    w = np.einsum("nij,kej->nkei", Pf[:, :3, :3], rods) + Pf[:, None, None, :3, 3]
-    pts = model.link_points(qf)  # (n, 13, 3)
-    legs_a, legs_b = pts[:, :-1], pts[:, 1:]  # (n, 12, 3): two legs per joint
-    radius = np.repeat(link_radii(model), 2)  # (12,)
-    n = len(qf)
-    out = {
-        "bow hits the stock": stock.segment_hits(w[:, :3, 0], w[:, :3, 1], margin).any(axis=1),
-        "arm hits the stock": np.zeros(n, bool),
-        "bow or wire hits the arm": np.zeros(n, bool),
-        "bow below the table": np.zeros(n, bool),
-        "arm below the table": np.zeros(n, bool),
-    }
-    for k in range(legs_a.shape[1]):
-        out["arm hits the stock"] |= stock.segment_hits(
-            legs_a[:, k], legs_b[:, k], margin + radius[k]
-        )
-    for k in range(12)[_ARM_NEAR_BOW]:
-        dist = segment_distance(legs_a[:, k, None], legs_b[:, k, None], w[:, :, 0], w[:, :, 1])
-        out["bow or wire hits the arm"] |= (dist < radius[k] + BowTool.arm_radius + margin).any(
-            axis=1
-        )
-    if cell.table_z is not None:
-        out["bow below the table"] = (w[:, :3, :, 2] < cell.table_z + margin).any(axis=(1, 2))
-        # skeleton points from the shoulder on (the base stands on the table); a
-        # straight leg is lowest at an end point
-        r_pt = np.r_[0.0, radius][2:]
-        out["arm below the table"] = (pts[:, 2:, 2] - r_pt < cell.table_z + margin).any(axis=1)
-    return {key: v.reshape(shape) for key, v in out.items()}
-
-
-def _failures(cell: _Cell, frames, roll, slide, reverse, jump: float):
+def _failures(cell: Cell, frames, roll, slide, reverse, jump: float):
     """Flange poses, path IK and, per reason, the rulings (bool masks) that fail."""
     P = flange_poses(wire_poses(frames, roll, slide, reverse), cell.W)
     ik = path_ik(cell.model, P, q_start=cell.q_start, jump_threshold=jump)
-    checks = _clearance(cell, ik.q, P)
+    checks = clearance(cell, ik.q, P)
     masks = {
         "no continuous IK solution": ~ik.ok,
         "near a singularity": ik.ok & (ik.measure < cell.singular_min),
@@ -180,7 +99,7 @@ def _failures(cell: _Cell, frames, roll, slide, reverse, jump: float):
     return P, ik, masks
 
 
-def _evaluate(cell: _Cell, frames, roll, slide, reverse, jump: float):
+def _evaluate(cell: Cell, frames, roll, slide, reverse, jump: float):
     """Flange poses, path IK, whether all checks pass, and lost rulings per reason."""
     P, ik, masks = _failures(cell, frames, roll, slide, reverse, jump)
     lost = {key: int(v.sum()) for key, v in masks.items()}
@@ -227,7 +146,7 @@ def solve_redundancy(
         raise ValueError(f"strategy: expected auto, constant or varying, got {strategy!r}")
     F = np.asarray(frames, dtype=np.float64)
     m = F.shape[0]
-    cell = _Cell.of(model, tool, stock, table_z, margin, singular_min, q_start)
+    cell = Cell.of(model, tool, stock, table_z, margin, singular_min, q_start)
     c0, c1, hit = chords(F, stock)
     if not hit.any():
         raise ValueError("rulings: none of them crosses the stock; nothing to cut")
@@ -344,7 +263,7 @@ def solve_redundancy(
             continue
         measure = model.singularity_measure(q)
         jump = float(np.abs(np.diff(q, axis=0)).max()) if m > 1 else 0.0
-        clear = not any(v.any() for v in _clearance(cell, q, P).values())
+        clear = not any(v.any() for v in clearance(cell, q, P).values())
         if jump <= jump_threshold and measure.min() >= singular_min and clear:
             reasons.append("no constant roll works: the roll varies along the cut")
             return result(roll, slide, reverse, P, q, measure.min(), jump, len(scores))
@@ -363,7 +282,7 @@ def solve_redundancy(
 
 
 def _ladder_roll(
-    cell: _Cell,
+    cell: Cell,
     F,
     slide,
     reverse,
@@ -386,7 +305,7 @@ def _ladder_roll(
     valid = ~np.isnan(q).any(axis=-1)
     meas = np.where(valid, model.singularity_measure(np.nan_to_num(q)), 0.0)
     valid &= meas >= cell.singular_min
-    for bad in _clearance(cell, q, np.broadcast_to(P[:, :, None], (n, k, 8, 4, 4))).values():
+    for bad in clearance(cell, q, np.broadcast_to(P[:, :, None], (n, k, 8, 4, 4))).values():
         valid &= ~bad
     qn = np.nan_to_num(q).reshape(n, k * 8, 6)
     node_ok = valid.reshape(n, k * 8)

@@ -29,7 +29,7 @@ from ..geometry import se3
 from ..geometry.box import Box
 from ..geometry.checks import FloatArray
 from ..robot.tool import BowTool
-from .job import ToolSpec
+from .spec import ToolSpec
 
 __all__ = [
     "chords",

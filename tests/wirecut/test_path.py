@@ -39,8 +39,11 @@ def test_cut_path_leads_in_and_out_clear_of_the_stock(job):
 def test_spacing_adds_steps_until_the_gap_holds(job):
     from dataclasses import replace
 
-    coarse = replace(job, surface=replace(job.surface, steps=None, spacing=0.01))
-    fine = replace(job, surface=replace(job.surface, steps=None, spacing=0.002))
+    def spaced(spacing: float):
+        surface = replace(job.surface, steps=None, spacing=spacing)
+        return replace(job, cuts=(replace(job.cut, surface=surface),))
+
+    coarse, fine = spaced(0.01), spaced(0.002)
     Fc, sc = refine_for_job(coarse)
     Ff, sf = refine_for_job(fine)
     assert sf > sc

@@ -7,6 +7,7 @@ import pytest
 
 import ruledrobot as rr
 from ruledrobot.wirecut import redundancy as red
+from ruledrobot.wirecut.clearance import Cell
 from ruledrobot.wirecut.job import load_job
 
 from .test_job import EXAMPLE
@@ -46,7 +47,7 @@ def test_solution_puts_the_wire_on_every_ruling_and_covers_every_chord(setup):
 def test_search_solves_a_job_where_the_plain_dh_motion_fails(setup):
     job, F, model = setup
     m = len(F)
-    cell = red._Cell.of(model, job.tool, job.stock, 0.0, 0.005, 0.02, None)
+    cell = Cell.of(model, job.tool, job.stock, 0.0, 0.005, 0.02, None)
     _, _, ok, lost = red._evaluate(cell, F, np.zeros(m), np.zeros(m), False, 0.5)
     assert not ok and sum(lost.values()) > 0  # the plain DH motion (roll 0) fails here
     r = red.solve_redundancy(F, job.stock, job.tool, model)

@@ -1,6 +1,6 @@
 """The plan's verdict gates on every check; folders never mislead; input hygiene.
 
-Jobs and files made here, not the demo: a colliding UR3e helicoid cut, duplicate
+Jobs and files made here, not the demo: a colliding UR10e helicoid cut, duplicate
 rulings, a stale output folder, a folder of someone else's files, typos.
 """
 
@@ -22,31 +22,32 @@ from ruledrobot.wirecut.path import refine_for_job
 
 runner = CliRunner()
 
-#: A UR3e with a small bow cutting a helicoid in a block close to its base: the bow
-#: hits the table on the approach and the upper arm during the cut.
+#: A UR10e cutting a helicoid through a tall block: the wire's midpoint stays near the
+#: block's axis, so the approach (backed off from the block's centre) starts with the bow's
+#: hub and the wrist inside the block — MuJoCo names what hits what, in the approach.
 COLLIDING = """\
 [surface]
 builtin = "helicoid"
-u = [0.0, 1.2]
-rulings = 8
-pose = [0.25, 0.0, 0.15, 0.0, 0.0, 0.0]
-steps = 4
+u = [-0.4, 0.4]
+rulings = 7
+pose = [0.7, 0.2, 0.35, 0.0, 0.0, 0.3]
+spacing = 0.003
 
 [stock]
-centre = [0.25, 0.0, 0.15]
-size = [0.12, 0.12, 0.1]
+centre = [0.7, 0.2, 0.35]
+size = [0.25, 0.25, 0.2]
 
 [robot]
-model = "ur3e"
+model = "ur10e"
 
 [tool]
-wire_start = [-0.1, 0.0, 0.12]
-wire_end = [0.1, 0.0, 0.12]
-clearance = 0.01
-mass = 0.5
+wire_start = [-0.25, 0.0, 0.3]
+wire_end = [0.25, 0.0, 0.3]
+clearance = 0.02
+mass = 1.2
 
 [cut]
-feed_speed = 0.01
+feed_speed = 0.012
 """
 
 

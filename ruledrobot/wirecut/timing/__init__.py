@@ -67,7 +67,7 @@ from __future__ import annotations
 
 from ...robot.rates import trajectory_limits_report
 from .limits import CONTINUITY_TOL, FEED_HOLD_TOL, FEED_TOL, MAX_SAMPLES, RATIO_TOL
-from .moves import concatenate, joint_move
+from .moves import concatenate, dwell, joint_move
 from .path import time_path
 from .result import TimedPath
 
@@ -79,6 +79,7 @@ __all__ = [
     "RATIO_TOL",
     "TimedPath",
     "concatenate",
+    "dwell",
     "joint_move",
     "time_path",
     "trajectory_limits_report",

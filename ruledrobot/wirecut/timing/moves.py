@@ -118,6 +118,30 @@ def joint_move(
     )  # fmt: skip
 
 
+def dwell(
+    q: ArrayLike, duration: float, vel_limits: ArrayLike, acc_limits: ArrayLike, dt: float
+) -> TimedPath:
+    """Hold still at ``q`` (J,) [rad] for ``duration`` [s], rounded up to whole periods
+    (e.g. while the wire heats).  ``s_of_t`` runs 0…1 over the hold."""
+    a = as_shaped(q, "q", (None,))
+    J = a.shape[0]
+    vlim = as_limits(vel_limits, "vel_limits", J)
+    alim = as_limits(acc_limits, "acc_limits", J)
+    dt = as_number(dt, "dt")
+    duration = as_number(duration, "duration", allow_zero=True)
+    n = max(1, math.ceil(duration / dt - 1e-9)) + 1
+    if n > MAX_SAMPLES:
+        raise ValueError(f"dwell: {duration:.6g} s = {n} samples, more than MAX_SAMPLES")
+    z = np.zeros((n, J))
+    return TimedPath(
+        t=np.arange(n) * dt, q=np.repeat(a[None, :], n, axis=0), qd=z, qdd=z.copy(),
+        s_of_t=np.linspace(0.0, 1.0, n), feed=np.zeros(n), feed_limited=np.zeros(n, dtype=bool),
+        segment=np.zeros(n, dtype=np.int64), dt=dt, vel_limits=vlim, acc_limits=alim,
+        feed_speed=None, max_speed_ratio=0.0, max_acc_ratio=0.0, max_feed_ratio=0.0,
+        method="dwell",
+    )  # fmt: skip
+
+
 def concatenate(parts: Sequence[TimedPath], dt: float) -> TimedPath:
     """Join timed paths end to start.
 

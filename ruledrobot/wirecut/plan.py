@@ -1,0 +1,193 @@
+"""Planning a job, the pure step: rulings -> passes -> timed motion -> measured trajectory.
+
+:func:`make_plan` writes nothing and runs no simulation; :mod:`.verify` plays the
+result in MuJoCo, :mod:`.outcome` turns both into the report and the verdict,
+:mod:`.write` writes the files.  Every number measured here is measured on the
+*sampled* joints through forward kinematics (what the controller receives).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..geometry import se3
+from ..geometry.checks import FloatArray
+from ..robot.rates import trajectory_limits_report
+from ..robot.tool import BowTool
+from ..robot.trajectory import Heat, Trajectory, phases_from_labels, runs
+from .measure import feed_speeds, wire_points
+from .motion import Motion, assemble_motion
+from .order import check_cut_order
+from .path import CutPath, cut_paths
+from .spec import Job
+
+__all__ = ["SINGULARITY_MARGIN", "Plan", "PlannedMeasures", "make_plan", "wire_deviation"]
+
+SINGULARITY_MARGIN = 0.02  # the redundancy search's own threshold (solve_redundancy)
+
+
+@dataclass(frozen=True, eq=False)
+class PlannedMeasures:
+    """Measurements of the planned (sampled) motion, per sample (M,) where arrays."""
+
+    flange: FloatArray = field(repr=False)  # (M, 4, 4) flange poses
+    feed: FloatArray = field(repr=False)  # m/s of the wire inside the stock (0 outside)
+    deviation: FloatArray = field(repr=False)  # m, wire from its target ruling (0 outside)
+    ratios: dict = field(repr=False)  # trajectory_limits_report
+    position_ratio: float
+    singularity_min: float
+    collisions: tuple[dict, ...]
+    sentences: tuple[str, ...]
+
+
+@dataclass(frozen=True, eq=False)
+class Plan:
+    """A planned job.  ``motion``/``trajectory``/``measured`` are None when some pass has
+    no feasible wire motion (``reasons`` say why)."""
+
+    job: Job
+    model: object = field(repr=False)  # RobotModel: flange, no tool, the job's base
+    passes: tuple[CutPath, ...] = field(repr=False)
+    motion: Motion | None = field(repr=False)
+    trajectory: Trajectory | None = field(repr=False)
+    measured: PlannedMeasures | None = field(repr=False)
+    reasons: tuple[str, ...]
+    notes: tuple[str, ...]
+    timings: dict[str, float]
+
+    @property
+    def reachable(self) -> bool:
+        return self.motion is not None
+
+    def cut_of_pass(self, k: int):
+        """The :class:`~.job.CutSpec` pass ``k`` belongs to."""
+        return next(c for c in self.job.cuts if c.name == self.passes[k].name)
+
+
+def job_reference(job: Job) -> dict[str, str] | None:
+    """``{"path", "sha256"}`` of the job file (None for a job built in memory)."""
+    if job.source is None:
+        return None
+    data = Path(job.source).read_bytes()
+    return {"path": str(job.source), "sha256": hashlib.sha256(data).hexdigest()}
+
+
+def wire_deviation(plan: Plan, q: FloatArray) -> FloatArray:
+    """Per sample (M,) the distance [m] of the wire's chord ends, with joints ``q``
+    (M, 6), from the target ruling of its pass at the same path parameter — the z axis
+    of the wire's frame motion there (the screw geodesic between neighbouring frames);
+    0 outside the stock."""
+    mo = plan.motion
+    flange = plan.model.fk(q)
+    out = np.zeros(len(q))
+    for k, cp in enumerate(plan.passes):
+        rows = np.flatnonzero((mo.pass_of == k) & mo.in_stock)
+        if not rows.size:
+            continue
+        s = mo.s[rows]
+        i0 = np.clip(np.floor(s).astype(int), 0, len(cp.frames) - 2)
+        target = se3.geodesic(cp.frames[i0], cp.frames[i0 + 1], s - i0)
+        off = wire_points(flange[rows], mo.ends[rows]) - target[:, None, :3, 3]
+        dist = np.linalg.norm(np.cross(off, target[:, None, :3, 2]), axis=-1).max(axis=1)
+        out[rows] = dist
+    return out
+
+
+def _position_ratio(model, q: FloatArray) -> float:
+    """Largest |q - centre| / half-range over joints with finite limits (1 = at a limit)."""
+    lo, hi = np.asarray(model.lower), np.asarray(model.upper)
+    fin = np.isfinite(lo) & np.isfinite(hi)
+    if not fin.any():
+        return 0.0
+    lo, hi = lo[fin], hi[fin]
+    mid, half = 0.5 * (lo + hi), 0.5 * (hi - lo)
+    return float((np.abs(q[:, fin] - mid) / half).max())
+
+
+def _bow_outside_cuts(job: Job, model, motion: Motion, flange: FloatArray):
+    """The planner's bow model (rods and wire) in the stock where no pass cuts."""
+    segs = BowTool.from_spec(job.tool).segments()
+    world = wire_points(flange, np.broadcast_to(segs.reshape(1, 6, 3), (len(flange), 6, 3)))
+    world = world.reshape(-1, 3, 2, 3)
+    cutting = motion.pass_of >= 0
+    hits = job.stock.segment_hits(world[:, :, 0], world[:, :, 1]).any(axis=1) & ~cutting
+    collisions, sentences = [], []
+    t, labels = motion.timed.t, motion.labels
+    for what, mask in (("the bow", hits),):
+        if mask.any():
+            k = np.flatnonzero(mask)
+            collisions.append({"what": f"{what} vs stock outside the cut",
+                               "first_t": float(t[k[0]]), "samples": int(k.size)})  # fmt: skip
+            sentences.append(f"{what} (planner's model) is in the stock outside the cut at "
+                             f"{k.size} samples from t = {t[k[0]]:.2f} s "
+                             f"({labels[k[0]]})")  # fmt: skip
+    return tuple(collisions), tuple(sentences)
+
+
+def _heat(job: Job, motion: Motion) -> Heat | None:
+    h = job.tool.heat
+    if h is None:
+        return None
+    return Heat(h.kind, h.index, h.value, runs(motion.heat))
+
+
+def make_plan(
+    job: Job, model=None, progress: Callable[[str], None] | None = None, **search
+) -> Plan:
+    """Plan every cut of ``job`` (no files, no simulation): see the module doc.
+    ``search`` goes to the redundancy search of every pass."""
+    say = progress or (lambda msg: None)
+    t0 = time.perf_counter()
+    timings: dict[str, float] = {}
+    model = job.robot_model() if model is None else model
+    check_cut_order(job)
+    passes: list[CutPath] = []
+    for cut in job.cuts:
+        say(f"refining the rulings and choosing the wire motion ({cut.name})"
+            if len(job.cuts) > 1 else "refining the rulings and choosing the wire motion")
+        passes += cut_paths(job, cut, model, **search)
+    timings["path_s"] = time.perf_counter() - t0
+    reasons = tuple(f"{cp.name}: {r}" if len(job.cuts) > 1 else r
+                    for cp in passes for r in cp.motion.reasons)  # fmt: skip
+    notes = tuple(n for cp in passes for n in cp.notes)
+    if not all(cp.feasible for cp in passes):
+        return Plan(job, model, tuple(passes), None, None, None, reasons, notes, timings)
+    say("timing the cut")
+    t1 = time.perf_counter()
+    motion = assemble_motion(job, model, passes)
+    timings["timing_s"] = time.perf_counter() - t1
+    say("measuring the planned motion")
+    t2 = time.perf_counter()
+    timed = motion.timed
+    flange = model.fk(timed.q)
+    feed = feed_speeds(timed.t, flange, motion.ends, motion.in_stock)
+    plan = Plan(job, model, tuple(passes), motion, None, None, reasons,
+                notes + motion.notes, timings)  # fmt: skip
+    dev = wire_deviation(plan, timed.q)
+    collisions, sentences = _bow_outside_cuts(job, model, motion, flange)
+    cutting = motion.pass_of >= 0
+    measured = PlannedMeasures(
+        flange=flange, feed=feed, deviation=dev,
+        ratios=trajectory_limits_report(timed.t, timed.q, model.max_velocity,
+                                        model.max_acceleration),
+        position_ratio=_position_ratio(model, timed.q),
+        singularity_min=float(model.singularity_measure(timed.q[cutting]).min()),
+        collisions=collisions, sentences=sentences,
+    )  # fmt: skip
+    bow = BowTool.from_spec(job.tool)
+    robot = model.with_tool(bow.wire_frame()).with_base(np.eye(4))
+    robot = dataclasses.replace(robot, tool_mass=job.tool.mass, tool_com=bow.inertia()[0])
+    trajectory = Trajectory.from_joints(
+        timed.t, timed.q, robot, base=job.robot.base, phases=phases_from_labels(motion.labels),
+        in_stock=runs(motion.in_stock), job=job_reference(job), source="ruledrobot plan",
+        heat=_heat(job, motion),
+    )  # fmt: skip
+    timings["measure_s"] = time.perf_counter() - t2
+    return dataclasses.replace(plan, trajectory=trajectory, measured=measured)

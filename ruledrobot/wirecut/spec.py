@@ -1,0 +1,169 @@
+"""The value types of a cut job: surface, stock, robot, tool (with its heat), cuts.
+
+Built and validated by :mod:`.job` from a job file; every other module reads them.
+Units: metres, radians, seconds; poses in the robot base frame.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..geometry.box import Box
+from ..geometry.lines import Lines
+from ..robot.calibration import Calibration
+
+__all__ = ["CutSpec", "HeatSpec", "Job", "RobotSpec", "SurfaceSpec", "ToolSpec"]
+
+
+@dataclass(frozen=True)
+class SurfaceSpec:
+    """Where the rulings come from and how they are refined.
+
+    ``closed``: None takes the lines file's own flag (a built-in surface is open).
+    """
+
+    builtin: str | None = None
+    file: Path | None = None
+    params: dict[str, Any] = field(default_factory=dict)
+    u: tuple[float, float] | None = None
+    rulings: int = 9
+    pose: np.ndarray = field(default_factory=lambda: np.eye(4), repr=False)
+    algorithm: str = "dh"
+    scheme: str = "four_point"
+    steps: int | None = 4
+    spacing: float | None = None
+    closed: bool | None = None
+
+    def document(self):
+        """The input rulings in the robot base frame and whether they close
+        (:class:`~ruledrobot.io.lines.LinesDocument`)."""
+        from ..io.lines import LinesDocument, read_lines_document
+
+        if self.file is not None:
+            doc = read_lines_document(self.file)
+            lines, closed = doc.lines, doc.closed
+        else:
+            from ..geometry.surfaces import sample_surface
+
+            lo, hi = self.u if self.u is not None else (None, None)
+            lines = sample_surface(self.builtin, n=self.rulings, start=lo, stop=hi,
+                                   **self.params).lines  # fmt: skip
+            closed = False
+        if self.closed is not None:
+            closed = self.closed
+        return LinesDocument(lines.transform(self.pose), closed)
+
+    def lines(self) -> Lines:
+        """The input rulings in the robot base frame."""
+        return self.document().lines
+
+    @property
+    def label(self) -> str:
+        """What the rulings are, for messages: the file or the built-in surface's name."""
+        return str(self.file) if self.file is not None else str(self.builtin)
+
+
+@dataclass(frozen=True)
+class RobotSpec:
+    model: str = "ur5e"
+    base: np.ndarray = field(default_factory=lambda: np.eye(4), repr=False)
+    speed_scale: float = 1.0
+    acceleration: np.ndarray | None = None
+    home: np.ndarray | None = field(default=None, repr=False)
+    calibration: Calibration | None = None  #: read from the job's calibration file
+
+
+@dataclass(frozen=True)
+class HeatSpec:
+    """Where the wire's heat is switched (robot IO) and how long it heats before a cut.
+
+    ``kind``: ``"standard"``, ``"configurable"`` or ``"tool"`` digital output, or
+    ``"analog"`` (standard analog output ``index`` set to ``value``, a fraction of its
+    range: the wire's current); ``preheat``: seconds the wire heats, still, at the
+    start of each lead-in before it moves into the stock.
+    """
+
+    kind: str
+    index: int
+    preheat: float = 2.0
+    value: float = 1.0
+
+    @property
+    def output(self) -> str:
+        return f"{self.kind}:{self.index}"
+
+
+@dataclass(frozen=True)
+class ToolSpec:
+    """The bow: wire end points in the flange frame (m), clearance beyond the stock, mass,
+    and the wire's heat output (None: the heat is not switched by the robot)."""
+
+    wire_start: np.ndarray
+    wire_end: np.ndarray
+    clearance: float = 0.02
+    mass: float = 1.0
+    heat: HeatSpec | None = None
+
+    @property
+    def wire_length(self) -> float:
+        return float(np.linalg.norm(self.wire_end - self.wire_start))
+
+
+@dataclass(frozen=True)
+class CutSpec:
+    """One cut of a part: its surface and how it is cut.
+
+    ``keep``: which side of the surface is the part — a point of the part (3,) in the
+    base frame, ``"inside"`` / ``"outside"`` for a closed surface, or None (the wire
+    runs on the surface itself and the kerf is not compensated).
+    """
+
+    name: str
+    surface: SurfaceSpec
+    feed_speed: float = 0.01
+    lead_in: float = 0.02
+    lead_out: float = 0.02
+    approach_speed: float = 0.3
+    kerf: float = 0.0008
+    keep: str | np.ndarray | None = field(default=None, repr=False)
+    wire_tolerance: float = 0.0005
+    feed_tolerance: float = 0.05
+
+
+@dataclass(frozen=True)
+class Job:
+    """A validated cut job (see the module doc for the file format): one stock, robot and
+    tool, and the cuts in the order they are made."""
+
+    cuts: tuple[CutSpec, ...]
+    stock: Box
+    robot: RobotSpec
+    tool: ToolSpec
+    source: Path | None = None
+
+    @property
+    def cut(self) -> CutSpec:
+        """The first cut (the only one of a single-cut job)."""
+        return self.cuts[0]
+
+    @property
+    def surface(self) -> SurfaceSpec:
+        """The first cut's surface (the only one of a single-cut job)."""
+        return self.cuts[0].surface
+
+    def robot_model(self):
+        """The job's robot: the catalogue model with its calibration (if the job names
+        one) and its base; the arm every stage plans and checks with."""
+        from ..robot import load
+
+        return load(self.robot.model).with_calibration(self.robot.calibration).with_base(
+            self.robot.base
+        )
+
+    def input_lines(self) -> Lines:
+        """The first cut's input rulings in the robot base frame."""
+        return self.surface.lines()

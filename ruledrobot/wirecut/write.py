@@ -1,0 +1,93 @@
+"""Writing a planned job: the files of ``docs/verdict.md``, into a staging folder that
+replaces the output folder as a whole (:class:`~ruledrobot.io.outdir.StagedFolder`).
+
+A plan whose verdict fails leaves its report, its plots and the simulation's report
+— and no trajectory: nothing of an earlier plan in that folder stays runnable.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+
+from ..geometry.lines import Lines
+from ..geometry.mesh import box_clipped_mesh
+from ..io.atomic import atomic_write_bytes, atomic_write_text
+from ..io.lines import save_lines
+from ..io.mesh import write_stl
+from ..io.outdir import StagedFolder
+from ..io.trajectory import write_trajectory
+from ..robot.verdict import Verdict
+from .plan import Plan
+from .plots import plot_plan
+from .verify import Verification
+
+__all__ = ["write_plan"]
+
+
+def _lines_of(frames: np.ndarray) -> Lines:
+    z, o = frames[:, :3, 2], frames[:, :3, 3]
+    return Lines(np.concatenate([z, np.cross(o, z)], axis=1))
+
+
+def _surfaces(folder: Path, plan: Plan) -> dict[str, Path]:
+    """``refined.json`` (the wire's rulings and frames of every pass, one after the
+    other) and ``surface.stl`` (the target surfaces inside the stock)."""
+    files: dict[str, Path] = {}
+    F = np.concatenate([cp.frames for cp in plan.passes])
+    files["refined"] = save_lines(folder / "refined.json", _lines_of(F), frames=F)
+    verts, faces, n = [], [], 0
+    job = plan.job
+    for cp in plan.passes:
+        mesh = box_clipped_mesh(_lines_of(cp.target_frames), job.stock.centre, job.stock.size,
+                                job.stock.rotation)  # fmt: skip
+        if len(mesh.faces):
+            verts.append(mesh.vertices)
+            faces.append(mesh.faces + n)
+            n += len(mesh.vertices)
+    if verts:
+        files["surface"] = write_stl(folder / "surface.stl", np.concatenate(verts),
+                                     np.concatenate(faces))  # fmt: skip
+    return files
+
+
+def write_plan(
+    stage: StagedFolder,
+    plan: Plan,
+    ver: Verification | None,
+    report: dict,
+    verdict: Verdict,
+    video: bool = False,
+) -> dict[str, Path]:
+    """Write the plan's files into ``stage`` (not yet committed); returns them by name.
+    ``report`` gains the write time and, when the video cannot be made, a note."""
+    folder = stage.path
+    files: dict[str, Path] = {}
+    if plan.motion is not None:
+        ok = verdict.ok
+        if ok:
+            files["trajectory"] = write_trajectory(folder / "trajectory.csv", plan.trajectory)
+            files["trajectory_meta"] = folder / "trajectory.json"
+        files.update(_surfaces(folder, plan))
+        files["plots"] = plot_plan(folder / "plots.png", plan)
+        if ver is not None:
+            sim = ver.playback.write(folder / "simulation", trajectory=ok)
+            files.update({f"simulation_{k}": v for k, v in sim.items()})
+            if video and ok:
+                from ..sim import RenderUnavailable, Scene, render_video
+
+                try:
+                    scene = Scene.from_job(plan.job, robot=plan.model)
+                    mo = plan.motion
+                    files["video"] = render_video(scene, folder / "video.mp4", mo.timed.t,
+                                                  ver.playback.q)  # fmt: skip
+                except RenderUnavailable as exc:
+                    report.setdefault("notes", []).append(f"no video: {exc}")
+    files["report"] = atomic_write_text(folder / "report.json",
+                                        json.dumps(report, indent=1) + "\n")  # fmt: skip
+    job = plan.job
+    if job.source is not None:
+        files["job"] = atomic_write_bytes(folder / "job.toml", Path(job.source).read_bytes())
+    return files
