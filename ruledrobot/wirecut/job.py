@@ -3,7 +3,11 @@
 A job describes, in the robot base frame (metres, radians, seconds)::
 
     [surface]                  # the ruled surface to cut
-    builtin = "hyperbolic_paraboloid"   # or: file = "rulings.json" (lines file)
+    builtin = "hyperbolic_paraboloid"   # or: file = "rulings.json" (lines file), or a file of
+                               # the field: gcode = "wing.ngc", airfoil, dxf, rhino -- a path, or
+                               # a table of the reader's options with the path under file
+                               # (airfoil: root, tip): [surface.gcode] file = "wing.ngc"
+                               # tower_distance = 0.8 (docs/formats.md)
     params = { c = 0.4 }       # parameters of the built-in surface
     u = [-0.12, 0.12]          # its parameter range
     rulings = 9                # input rulings sampled over u
@@ -84,6 +88,10 @@ class SurfaceSpec:
     scheme: str = "four_point"
     steps: int | None = 4
     spacing: float | None = None
+    #: rulings read from a file of the field (gcode, airfoil, dxf, rhino) when the job
+    #: names one (``file`` is then that file), as an open path, in the file's frame
+    read_lines: Lines | None = field(default=None, repr=False)
+    kind: str | None = None
 
 
 @dataclass(frozen=True)
@@ -144,7 +152,9 @@ class Job:
     def input_lines(self) -> Lines:
         """The input rulings in the robot base frame."""
         s = self.surface
-        if s.file is not None:
+        if s.read_lines is not None:
+            lines = s.read_lines
+        elif s.file is not None:
             from ..io.lines import load_lines
 
             lines = load_lines(s.file)
@@ -267,8 +277,22 @@ def parse_job(doc: dict, where: str = "job", base_dir: Path | None = None) -> Jo
 
     s = _Section(doc, "surface", where)
     builtin, file = s.get("builtin"), s.get("file")
-    if (builtin is None) == (file is None):
-        raise s.fail("builtin/file", 'give exactly one of builtin = "name" or file = "path"')
+    from ..io.formats import parse_read_spec, read_rulings
+
+    foreign = [k for k in ("gcode", "airfoil", "dxf", "rhino") if s.get(k) is not None]
+    if (builtin is not None) + (file is not None) + len(foreign) != 1:
+        raise s.fail("builtin/file/gcode/airfoil/dxf/rhino",
+                     'give exactly one of builtin = "name", file = "path" (a lines file), or '
+                     'gcode/airfoil/dxf/rhino = "path" (or a table of options; docs/formats.md)')
+    read_lines = None
+    if foreign:
+        kind = foreign[0]
+        spec = parse_read_spec(kind, s.get(kind), f"{where}: [surface.{kind}]", base_dir)
+        try:
+            read_lines = read_rulings(spec).path_lines()
+        except ValueError as exc:
+            raise s.fail(kind, str(exc)) from None
+        file = str(spec.path)
     params = s.get("params", {})
     if not isinstance(params, dict):
         raise s.fail("params", f"expected a table of parameters, got {params!r}")
@@ -329,6 +353,8 @@ def parse_job(doc: dict, where: str = "job", base_dir: Path | None = None) -> Jo
         scheme=s.choice("scheme", SCHEME_NAMES, "four_point"),
         steps=steps,
         spacing=spacing,
+        read_lines=read_lines,
+        kind=foreign[0] if foreign else ("lines" if file is not None else None),
     )
     s.done()
 
