@@ -17,15 +17,16 @@ __all__ = ["CadWriteOptions", "MatchOptions", "pair_to_rulings", "segments"]
 
 @dataclass(frozen=True)
 class MatchOptions:
-    """How two profiles make rulings (:mod:`.profiles`)."""
+    """How two profiles make rulings (:mod:`.profiles`); ``match`` None: ``"parameter"``,
+    or ``"index"`` for ruledrobot's own files (their points are matched already)."""
 
-    match: str = "parameter"
+    match: str | None = None
     points: int | None = None
     spacing: str = "uniform"
 
     @classmethod
     def parse(cls, o: Options) -> MatchOptions:
-        return cls(o.choice("match", MATCH_RULES, "parameter"),
+        return cls(o.choice("match", MATCH_RULES, None),
                    o.integer("points", lo=3, hi=100_000),
                    o.choice("spacing", SPACINGS, "uniform"))  # fmt: skip
 
@@ -83,6 +84,12 @@ def _crossed(a: FloatArray, b: FloatArray) -> bool:
     return d(a[0], b[-1]) + d(a[-1], b[0]) < d(a[0], b[0]) + d(a[-1], b[-1])
 
 
+def _area(p: FloatArray) -> float:
+    """Twice the signed xy area of the polygon through p (closed up)."""
+    q = np.concatenate([p, p[:1]])
+    return float(np.sum(q[:-1, 0] * q[1:, 1] - q[1:, 0] * q[:-1, 1]))
+
+
 def _flat_z(p: FloatArray) -> float | None:
     z = p[:, 2]
     return float(z.mean()) if np.ptp(z) <= 1e-9 * max(1.0, float(np.abs(p).max())) else None
@@ -109,26 +116,26 @@ def pair_to_rulings(a: FloatArray, b: FloatArray, closed: bool, m: MatchOptions,
     for name, p in zip(names, (a, b), strict=True):
         check_simple(p, f"{where}: {name}", closed)
     if za is not None and zb is not None:
-
-        def area(p: FloatArray) -> float:
-            q = np.concatenate([p, p[:1]])
-            return float(np.sum(q[:-1, 0] * q[1:, 1] - q[1:, 0] * q[:-1, 1]))
-
-        if closed and area(a) * area(b) < 0:
+        ext = float(np.ptp(np.concatenate([a, b])[:, :2], axis=0).max()) ** 2
+        aa, ab = _area(a), _area(b)
+        if min(abs(aa), abs(ab)) > 1e-6 * ext:  # profiles that enclose an area: by its sign
+            flip = aa * ab < 0
+        else:  # nearly straight open profiles: by their ends
+            flip = not closed and _crossed(a, b)
+        if flip:
             b = b[::-1].copy()
-            notes.append(f"the {names[1]} runs the other way round; reversed it")
+            notes.append(f"the {names[1]} runs the other way; reversed it to match the "
+                         f"{names[0]}")  # fmt: skip
         if closed:
             k = int(np.argmin(np.linalg.norm(b[:, :2] - a[0, :2], axis=1)))
             if k:
                 b = np.roll(b, -k, axis=0)
                 notes.append(f"the {names[1]} starts at its point {k}, the one nearest the start "
                              f"of the {names[0]}")  # fmt: skip
-        elif _crossed(a, b):
-            b = b[::-1].copy()
-            notes.append(f"the {names[1]} runs the other way; reversed it")
     if closed:
         a, b = np.concatenate([a, a[:1]]), np.concatenate([b, b[:1]])
-    pa, pb = match_profiles(a, b, m.match, (m.points + 1) if closed and m.points else m.points,
+    n = (m.points + 1) if closed and m.points else m.points
+    pa, pb = match_profiles(a, b, m.match or "parameter", n,
                             where, spacing=m.spacing, names=names)  # fmt: skip
     if closed:
         pa, pb = pa[:-1], pb[:-1]

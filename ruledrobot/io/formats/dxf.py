@@ -65,11 +65,11 @@ class DxfOptions:
 
 def _open(path: Path):
     ezdxf = require("ezdxf", "reading DXF files")
+    if not path.is_file():
+        raise ValueError(f"{path}: no such DXF file")
     try:
         return ezdxf.readfile(str(path))
-    except OSError as exc:
-        raise ValueError(f"{path}: cannot read ({exc})") from None
-    except ezdxf.DXFError as exc:
+    except (OSError, UnicodeDecodeError, ezdxf.DXFError) as exc:
         raise ValueError(f"{path}: not a readable DXF file ({exc})") from None
 
 
@@ -121,8 +121,11 @@ def read_dxf(path: str | os.PathLike[str], opts: DxfOptions | None = None) -> Ru
         by_layer.setdefault(e.dxf.layer, []).append(e)
     summary = ", ".join(f"{k} ({len(v)})" for k, v in by_layer.items()) or "none"
     layers = opts.layers
+    pairing = opts.pairing
     if layers is None and all(k in by_layer for k in OWN_LAYERS):
-        layers = OWN_LAYERS
+        layers = OWN_LAYERS  # ruledrobot's own file: its points are matched already
+        if pairing.match is None:
+            pairing = MatchOptions("index", pairing.points, pairing.spacing)
     if layers is not None:
         chosen = []
         for name in layers:
@@ -150,7 +153,7 @@ def read_dxf(path: str | os.PathLike[str], opts: DxfOptions | None = None) -> Ru
     for pts, name in ((a, names[0]), (b, names[1])):
         if len(pts) < 2:
             raise ValueError(f"{where}: the {name} has {len(pts)} point(s); expected at least 2")
-    r = pair_to_rulings(a * scale, b * scale, ca, opts.pairing, opts.distance, where, names,
+    r = pair_to_rulings(a * scale, b * scale, ca, pairing, opts.distance, where, names,
                         where)  # fmt: skip
     return Rulings(r.lines, r.closed, r.ends, r.planes, None, where, tuple(notes) + r.notes)
 

@@ -70,9 +70,12 @@ def check_simple(points: ArrayLike, where: str, closed: bool = False,
     if m < 3:
         return
 
+    eps = 1e-12 * max(1e-300, float(np.ptp(p, axis=0).max())) ** 2  # touching within rounding
+
     def orient(o: FloatArray, q: FloatArray, r: FloatArray) -> FloatArray:
-        return np.sign((q[..., 0] - o[..., 0]) * (r[..., 1] - o[..., 1])
-                       - (q[..., 1] - o[..., 1]) * (r[..., 0] - o[..., 0]))  # fmt: skip
+        v = (q[..., 0] - o[..., 0]) * (r[..., 1] - o[..., 1]) \
+            - (q[..., 1] - o[..., 1]) * (r[..., 0] - o[..., 0])  # fmt: skip
+        return np.where(np.abs(v) <= eps, 0.0, np.sign(v))
 
     j = np.arange(m)
     for i0 in range(0, m, 256):  # blocks of segments against all: memory stays small
