@@ -68,9 +68,9 @@ def convert(source: str | os.PathLike[str], target: str | os.PathLike[str], *,
     kind_in = source_kind or kind_of(src)
     kind_out = target_kind or kind_of(dst, writing=True)
     key = "root" if kind_in == "airfoil" else "file"
-    spec = parse_read_spec(kind_in, {key: str(src), **read_options}, f"{src} ({kind_in}):",
+    spec = parse_read_spec(kind_in, {key: str(src), **read_options}, f"{src} ({kind_in})",
                            cli=cli)  # fmt: skip
-    wopts = parse_write_options(kind_out, write_options, f"{dst} ({kind_out}):", cli=cli,
+    wopts = parse_write_options(kind_out, write_options, f"{dst} ({kind_out} output)", cli=cli,
                                 prefix="out_" if cli else "")  # fmt: skip
     rulings = read_rulings(spec)
     path = write_rulings(dst, rulings, kind_out, wopts)
@@ -86,8 +86,8 @@ def _convert_mesh(src: Path, dst: Path, target_kind: str | None, read_options: M
     kind_out = target_kind or kind_of(dst, writing=True)
     if kind_out != "rhino":
         raise ValueError(f"{src}: a mesh converts to a Rhino model (.3dm) only, not {kind_out}")
-    Options(read_options, f"{src} (mesh):", cli=cli).done()
-    o = Options(write_options, f"{dst} (rhino):", cli=cli, prefix="out_" if cli else "")
+    Options(read_options, f"{src} (mesh)", cli=cli).done()
+    o = Options(write_options, f"{dst} (rhino output)", cli=cli, prefix="out_" if cli else "")
     units = o.unit("units", "mm")
     o.done()
     try:

@@ -50,10 +50,7 @@ class GcodeReadOptions:
         d = o.number("tower_distance", nonzero=True, required="the distance between the "
                      "towers (m) is a machine setting, not in the file; e.g. 0.8")  # fmt: skip
         axes = o.string("axes", "XYUV")
-        try:
-            axes = check_axes(axes, f"{o.where} {o.name('axes')}")
-        except ValueError as exc:
-            raise ValueError(str(exc)) from None
+        axes = check_axes(axes, o.label("axes"))
         units = o.unit("units")
         if units not in (None, "mm", "in"):
             raise o.fail("units", f"G-code is in mm (G21) or inches (G20), got {units!r}")

@@ -58,7 +58,7 @@ class GcodeWriteOptions:
     def parse(cls, o: Options) -> GcodeWriteOptions:
         frame = o.vector("frame", 6)
         axes = o.string("axes", "XYUV")
-        axes = check_axes(axes, f"{o.where} {o.name('axes')}")
+        axes = check_axes(axes, o.label("axes"))
         units = o.unit("units", "mm")
         if units not in ("mm", "in"):
             raise o.fail("units", f"G-code is in mm (G21) or inches (G20), got {units!r}")

@@ -42,8 +42,14 @@ class Options:
     def name(self, key: str) -> str:
         return "--" + (self.prefix + key).replace("_", "-") if self.cli else key
 
+    def label(self, key: str) -> str:
+        """Where a field is: ``"a.ngc (gcode): --tower-distance"``, ``"job.toml:
+        [surface.gcode] tower_distance"``."""
+        sep = ": " if self.cli else " "
+        return f"{self.where}{sep}{self.name(key)}"
+
     def fail(self, key: str, msg: str) -> ValueError:
-        return ValueError(f"{self.where} {self.name(key)}: {msg}")
+        return ValueError(f"{self.label(key)}: {msg}")
 
     def has(self, key: str) -> bool:
         return self.raw.get(key) is not None
@@ -141,7 +147,7 @@ class Options:
         v = self.get(key, default)
         if v is None:
             return None
-        return unit_name(v, f"{self.where} {self.name(key)}")
+        return unit_name(v, self.label(key))
 
     def path(self, key: str, required: bool = True) -> Path | None:
         """A file that exists (relative paths from ``base_dir``)."""
