@@ -719,6 +719,8 @@ def convert_cmd(
                                                     "the towers (m)."),
     out_frame: str | None = typer.Option(None, help="Out: cutter frame in the rulings' frame, "
                                          "'x,y,z,rx,ry,rz' (m, rad)."),
+    out_block_offset: float | None = typer.Option(None, help="G-code out: from tower A to the "
+                                                  "source's first face (m); default centred."),
     out_axes: str | None = typer.Option(None, help="G-code out: axis letters (XYUV, XYZA...)."),
     out_feed_mode: str | None = typer.Option(None, help="G-code out: how the controller reads F "
                                              "(inverse_time, path4d, first_tower, "
@@ -753,6 +755,7 @@ def convert_cmd(
                 "tolerance": tolerance, "layer": layer, "use": use, "direction": direction}
         write = {"units": out_units, "tower_distance": out_tower_distance,
                  "frame": _numbers(out_frame, 6, "--out-frame"), "axes": out_axes,
+                 "block_offset": out_block_offset,
                  "feed_mode": out_feed_mode, "feed": out_feed, "feed_at": out_feed_at,
                  "faces": _numbers(out_faces, 2, "--out-faces"), "heat": out_heat,
                  "dwell": out_dwell, "decimals": out_decimals, "length": out_length,

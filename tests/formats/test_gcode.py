@@ -130,7 +130,8 @@ def test_without_heat_codes_every_g1_run_cuts(tmp_path):
         ("G0 X0 Y0 U0 V0\nG1 X1 Q3\n", {}, r"line 2: unknown word 'Q3'"),
         ("G0 X0 Y0 U0 V0\nG1 X1 Z3\n", {}, r"line 2: axis word 'Z3' is not an axis of the "
                                            r"mapping XYUV"),
-        ("G0 X0 Y0 U0 V0\nG2 X1 Y1 I1 J0\n", {}, r"line 2: unknown word 'I1'"),
+        ("G0 X0 Y0 U0 V0\nG2 X1 Y1 I1 J0\n", {}, r"line 2: G2 is an arc"),
+        ("G0 X0 Y0 U0 V0\nG1 X1 I1\n", {}, r"line 2: unknown word 'I1'"),
         ("G0 X0 Y0 U0 V0\nG2 X1 Y1\n", {}, r"line 2: G2 is an arc; arcs are not defined"),
         ("G0 X0 Y0 U0 V0\nG03 X1 Y1\n", {}, r"line 2: G3 is an arc"),
         ("G91\nG1 X1 Y1 U1 V1 F5\n", {}, r"line 2: relative move \(G91\) of X Y U V without a "
@@ -167,7 +168,8 @@ def test_a_wire_parallel_to_the_towers_cannot_be_written(tmp_path):
     with pytest.raises(ValueError, match=r"ruling 0 is parallel to the planes"):
         write_gcode(tmp_path / "b.ngc", rulings, GcodeWriteOptions(tower_distance=0.5,
                                                                    frame=np.eye(4)))
-    with pytest.raises(ValueError, match=r"tower_distance: missing; these rulings come without"):
+    with pytest.raises(ValueError, match=r"tower_distance: missing; these rulings come with no "
+                                         r"towers"):
         write_gcode(tmp_path / "b.ngc", rulings)
     assert not (tmp_path / "b.ngc").exists()
 
@@ -213,7 +215,7 @@ def test_written_feed_holds_where_the_user_says(tmp_path, mode, where):
     ends = np.zeros((12, 2, 3))
     ends[:, 0, :2], ends[:, 1, :2], ends[:, 1, 2] = q[:, :2], q[:, 2:], 0.8
     lines = __import__("ruledrobot").Lines.from_two_points(ends[:, 0], ends[:, 1])
-    rulings = Rulings(lines, ends=ends, planes=Planes(np.eye(4), 0.8))
+    rulings = Rulings(lines, ends=ends, planes=Planes(np.eye(4), 0.8, "towers"))
     faces = (0.3, 0.5)
     opts = GcodeWriteOptions(feed=0.004, feed_at=where, faces=faces, feed_mode=mode,
                              decimals=6)
@@ -249,3 +251,26 @@ def test_program_shape_heat_dwell_units(tmp_path):
     assert body[-2:] == ["M9", "M30"] and "G93" not in text
     none = gcode_text(r, GcodeWriteOptions(heat="none"))
     assert not {"M3", "M5", "M8", "M9"} & set(none.splitlines())
+
+
+def test_a_panel_is_placed_between_the_towers(tmp_path):
+    """Rulings with faces (a wing panel 0.4 m wide) on a cutter with towers 0.8 m apart:
+    centred by default, or block_offset from tower A; the feed at the faces defaults to
+    the panel's faces.  The written towers carry the same lines."""
+    from ruledrobot.io.formats.wing import WingOptions, read_wing
+
+    from .naca import naca4, selig_text
+
+    (tmp_path / "r.dat").write_text(selig_text("NACA 2412", naca4("2412", 41)))
+    wing = read_wing(WingOptions(tmp_path / "r.dat", 0.4, 0.25, tip_chord=0.15))
+    with pytest.raises(ValueError, match=r"planes that are faces, not towers"):
+        gcode_text(wing, GcodeWriteOptions())
+    for offset, shift in ((None, 0.2), (0.1, 0.1)):
+        out = write_gcode(tmp_path / "w.ngc", wing, GcodeWriteOptions(
+            tower_distance=0.8, block_offset=offset, feed_at="faces", decimals=6))
+        back = read_gcode(out, GcodeReadOptions(0.8, feed_mode="path4d"))
+        # the root face of the panel is the plane z = shift of the cutter frame
+        moved = np.eye(4)
+        moved[2, 3] = shift
+        again = plane_ends(back.lines, Planes(moved, 0.4))
+        np.testing.assert_allclose(again, wing.ends + np.array([0.0, 0.0, shift]), atol=2e-9)

@@ -150,7 +150,7 @@ def test_convert_round_trips_and_says_what_it_wrote(wedge):
         (["wedge.ngc", "--to", "w.ngc", "--tower-distance", "0.8", "--out-faces", "1,2,3"],
          r"--out-faces: expected 2 comma-separated numbers"),
         (["wedge.ngc", "--to", "w.ngc", "--tower-distance", "0.8", "--out-feed-at", "faces"],
-         r"--out-faces: missing; feed_at = faces"),
+         r"faces \(--out-faces\): missing; feed_at = faces"),
         (["missing.ngc", "--to", "w.json", "--tower-distance", "0.8"], r"--file: no such file"),
     ],
 )

@@ -144,5 +144,5 @@ def pair_to_rulings(a: FloatArray, b: FloatArray, closed: bool, m: MatchOptions,
     if za is not None and zb is not None:
         T = np.eye(4)
         T[2, 3] = za
-        planes = Planes(T, zb - za)
+        planes = Planes(T, zb - za, "profiles")
     return Rulings(lines, closed, np.stack([pa, pb], axis=1), planes, None, source, tuple(notes))

@@ -123,4 +123,4 @@ def read_gcode(path: str | os.PathLike[str], options: GcodeReadOptions) -> Rulin
     faster = np.maximum(np.hypot(d[:, 0], d[:, 1]), np.hypot(d[:, 2], d[:, 3]))
     with np.errstate(divide="ignore", invalid="ignore"):
         feed = faster / mv.duration[a:b][moved]
-    return Rulings(lines, False, ends, Planes(np.eye(4), D), feed, where, tuple(notes))
+    return Rulings(lines, False, ends, Planes(np.eye(4), D, "towers"), feed, where, tuple(notes))

@@ -160,6 +160,14 @@ def parse_gcode(text: str, where: str, axes: str = "XYUV", units: str | None = N
                              "such as G1 X10.5 Y20 (a letter and a number)")  # fmt: skip
         gs = [v for c, v, _ in words if c == "G"]
         ms = [v for c, v, _ in words if c == "M"]
+        for g in gs:
+            if g in (2.0, 3.0):
+                raise ValueError(f"{where}: line {lineno}: G{g:g} is an arc; arcs are not "
+                                 "defined for moves of two towers (export straight G1 "
+                                 "segments)")  # fmt: skip
+            if g not in _IGNORED_G and g not in (0, 1, 4, 20, 21, 28, 90, 91, 92, 92.1, 93, 94):
+                raise ValueError(f"{where}: line {lineno}: G{g:g} is not supported; expected "
+                                 f"one of {_KNOWN_G}")  # fmt: skip
         vals: dict[str, float] = {}
         for c, v, text_word in words:
             if c in "GM":
@@ -178,14 +186,6 @@ def parse_gcode(text: str, where: str, axes: str = "XYUV", units: str | None = N
             else:
                 raise ValueError(f"{where}: line {lineno}: unknown word {text_word!r}; expected "
                                  f"G, M, F, P, S, N or the axes {axes}")  # fmt: skip
-        for g in gs:
-            if g in (2.0, 3.0):
-                raise ValueError(f"{where}: line {lineno}: G{g:g} is an arc; arcs are not "
-                                 "defined for moves of two towers (export straight G1 "
-                                 "segments)")  # fmt: skip
-            if g not in _IGNORED_G and g not in (0, 1, 4, 20, 21, 28, 90, 91, 92, 92.1, 93, 94):
-                raise ValueError(f"{where}: line {lineno}: G{g:g} is not supported; expected "
-                                 f"one of {_KNOWN_G}")  # fmt: skip
         for mc in ms:
             if mc not in _HEAT_ON | _HEAT_OFF | _NO_EFFECT | _END:
                 raise ValueError(f"{where}: line {lineno}: M{mc:g} is not supported; expected "

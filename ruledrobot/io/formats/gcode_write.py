@@ -9,8 +9,16 @@ an optional dwell ``G4 P<s>`` (seconds, as LinuxCNC and GRBL read P), the cut,
 heat off, ``M30``.  No ``G92``: the coordinates are the machine's work
 coordinates, whose zero the user sets.
 
+Towers: ``tower_distance`` (m) and the cutter frame ``frame`` (a pose in the
+rulings' frame) when given.  A G-code source keeps its towers (and distance).
+A source with faces (a wing panel's root and tip) or profile planes (a DXF or
+3DM pair) is placed with its first plane ``block_offset`` (m) from tower A,
+centred between the towers by default; rulings without planes (a lines file, a
+plan's ``refined.json``) get a fitted frame (:func:`~.rulings.fit_planes`).
+
 The feed ``feed`` (m/s) holds where the user says (``feed_at``): at the towers
-or at the block faces (``faces``, two z values in the cutter frame); on each
+or at the block faces (``faces``, two z values in the cutter frame; default the
+source's faces); on each
 move the faster of the two reference points moves at the feed (no point of the
 wire there moves faster).  The F word carries it the way the controller reads
 F (``feed_mode``): ``inverse_time`` (``G93``, F = 1/minutes of each move; the
@@ -42,8 +50,9 @@ __all__ = ["GcodeWriteOptions", "gcode_text", "resolve_planes", "write_gcode"]
 class GcodeWriteOptions:
     """How to write a foam-cutter program (lengths m, feed m/s, dwell s)."""
 
-    tower_distance: float | None = None  # default: the source's planes
+    tower_distance: float | None = None  # default: a G-code source's towers
     frame: FloatArray | None = field(default=None, repr=False)  # cutter frame pose (4, 4)
+    block_offset: float | None = None  # tower A to the source's first plane (m)
     axes: str = "XYUV"
     units: str = "mm"
     feed: float = 0.005
@@ -64,14 +73,14 @@ class GcodeWriteOptions:
             raise o.fail("units", f"G-code is in mm (G21) or inches (G20), got {units!r}")
         faces = o.vector("faces", 2)
         feed_at = o.choice("feed_at", ("towers", "faces"), "towers")
-        if feed_at == "faces" and faces is None:
-            raise o.fail("faces", "missing; feed_at = faces needs the z of the two block faces "
-                         "in the cutter frame (m), e.g. [0.2, 0.5]")  # fmt: skip
         if faces is not None and faces[0] == faces[1]:
             raise o.fail("faces", "expected two different planes")
+        if frame is not None and o.has("block_offset"):
+            raise o.fail("block_offset", "give frame or block_offset, not both")
         opts = cls(
             tower_distance=o.number("tower_distance", nonzero=True),
             frame=None if frame is None else se3.pose_from_ur_vector(frame),
+            block_offset=o.number("block_offset"),
             axes=axes,
             units=units,
             feed=float(o.number("feed", 0.005, positive=True, hi=1.0)),
@@ -87,18 +96,45 @@ class GcodeWriteOptions:
 
 
 def resolve_planes(rulings: Rulings, opts: GcodeWriteOptions, where: str) -> Planes:
-    """The tower planes: the options', else the source's, else fitted (frame only)."""
+    """The tower planes (see the module doc): a G-code source keeps its towers; the
+    faces or profiles of a source are placed ``block_offset`` from tower A (default:
+    centred between the towers); rulings without planes get fitted ones."""
     src = rulings.planes
-    distance = opts.tower_distance if opts.tower_distance is not None else (
-        src.distance if src is not None else None)  # fmt: skip
+    distance = opts.tower_distance
     if distance is None:
-        raise ValueError(f"{where}: tower_distance: missing; these rulings come without towers "
-                         "(a lines file): give the distance between the towers (m)")  # fmt: skip
+        if src is None or src.name != "towers":
+            what = f"planes that are {src.name}, not towers" if src else "no towers"
+            raise ValueError(f"{where}: tower_distance: missing; these rulings come with "
+                             f"{what}: give the distance between the towers of the foam "
+                             "cutter (m)")  # fmt: skip
+        distance = src.distance
     if opts.frame is not None:
-        return Planes(opts.frame, distance)
-    if src is not None:
-        return Planes(src.pose, distance)
-    return fit_planes(rulings.lines, distance)
+        return Planes(opts.frame, distance, "towers")
+    if src is None:
+        return Planes(fit_planes(rulings.lines, distance).pose, distance, "towers")
+    if src.name == "towers" and opts.block_offset is None:
+        return Planes(src.pose, distance, "towers")
+    offset = opts.block_offset if opts.block_offset is not None else \
+        0.5 * (distance - src.distance)  # fmt: skip
+    return Planes(src.pose @ _shift(-offset), distance, "towers")
+
+
+def faces_in_cutter_frame(rulings: Rulings, planes: Planes, opts: GcodeWriteOptions,
+                          where: str) -> tuple[float, float]:  # fmt: skip
+    """The z of the block faces in the cutter frame: the option's, else the source's
+    faces or profiles."""
+    if opts.faces is not None:
+        return opts.faces
+    src = rulings.planes
+    if src is None or src.name == "towers":
+        raise ValueError(f"{where}: faces (--out-faces): missing; feed_at = faces needs the z "
+                         "of the two block faces in the cutter frame (m), e.g. [0.3, 0.5]")
+    rel = np.linalg.inv(planes.pose) @ src.pose
+    if not np.allclose(rel[:3, 2], [0.0, 0.0, 1.0], atol=1e-9):
+        raise ValueError(f"{where}: faces: the source's planes are not parallel to the towers; "
+                         "give faces")  # fmt: skip
+    z0 = float(rel[2, 3])
+    return z0, z0 + src.distance
 
 
 def _num(v: np.ndarray, decimals: int) -> list[str]:
@@ -128,8 +164,8 @@ def gcode_text(rulings: Rulings, opts: GcodeWriteOptions, where: str = "G-code")
     keep = np.r_[True, np.any(q[1:] != q[:-1], axis=1)]
     q = q[keep]
     if opts.feed_at == "faces":
-        ref = plane_ends(lines[np.flatnonzero(keep)], Planes(T @ _shift(opts.faces[0]),
-                         opts.faces[1] - opts.faces[0]), where)  # fmt: skip
+        f0, f1 = faces_in_cutter_frame(rulings, planes, opts, where)
+        ref = plane_ends(lines[np.flatnonzero(keep)], Planes(T @ _shift(f0), f1 - f0), where)
         ref = (ref - T[:3, 3]) @ T[:3, :3]
         dref = np.linalg.norm(np.diff(ref[..., :2], axis=0), axis=2).max(axis=1)
     else:
@@ -150,8 +186,9 @@ def gcode_text(rulings: Rulings, opts: GcodeWriteOptions, where: str = "G-code")
     n_ax = len(axes)
     d = opts.decimals
     unit_word, unit_name = ("G21", "mm") if opts.units == "mm" else ("G20", "in")
+    source = (rulings.source or "rulings").replace("(", "[").replace(")", "]")
     out = [
-        f"(ruledrobot: {len(q)} wire positions from {rulings.source or 'rulings'})",
+        f"(ruledrobot: {len(q)} wire positions from {source})",
         f"(towers: {axes[:2]} at z = 0, {axes[2:] or axes[:2]} at z = "
         f"{planes.distance / scale:.{d}f} {unit_name} of the cutter frame: set the machine's "
         "tower distance to this)",

@@ -111,5 +111,4 @@ def read_wing(opts: WingOptions) -> Rulings:
     root3, tip3, name = wing_profiles(opts)
     lines = rulings_from_ends(root3, tip3, str(opts.root))
     ends = np.stack([root3, tip3], axis=1)
-    return Rulings(lines, False, ends, Planes(np.eye(4), opts.span), None, name,
-                   (f"{len(lines)} rulings, match = {opts.match}",))  # fmt: skip
+    return Rulings(lines, False, ends, Planes(np.eye(4), opts.span, "faces"), None, name)
