@@ -152,3 +152,31 @@ def test_check_simple_finds_crossings_in_space():
 def test_missing_file_names_it(tmp_path):
     with pytest.raises(ValueError, match=r"no such airfoil file"):
         read_airfoil(Path(tmp_path) / "none.dat")
+
+
+def _crosses_brute_force(p: np.ndarray) -> bool:
+    def orient(o, q, r):
+        return np.sign((q[0] - o[0]) * (r[1] - o[1]) - (q[1] - o[1]) * (r[0] - o[0]))
+
+    m = len(p) - 1
+    for i in range(m):
+        for j in range(i + 2, m):
+            a, b, c, d = p[i], p[i + 1], p[j], p[j + 1]
+            if orient(a, b, c) * orient(a, b, d) < 0 and orient(c, d, a) * orient(c, d, b) < 0:
+                return True
+    return False
+
+
+@given(st.integers(0, 2**31), st.integers(4, 40), st.floats(0.01, 10.0))
+def test_the_grid_finds_the_same_crossings_as_all_pairs(seed, n, step):
+    """Random walks, some crossing themselves, some not: the grid-pruned check agrees
+    with comparing every pair of segments."""
+    rng = np.random.default_rng(seed)
+    p = np.cumsum(rng.normal(size=(n, 2)) * rng.uniform(0.05, 1.0, size=(n, 1)) * step, axis=0)
+    expected = _crosses_brute_force(p)
+    try:
+        check_simple(p, "walk")
+        found = False
+    except ValueError:
+        found = True
+    assert found == expected

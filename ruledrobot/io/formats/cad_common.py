@@ -97,11 +97,13 @@ def _flat_z(p: FloatArray) -> float | None:
 
 def pair_to_rulings(a: FloatArray, b: FloatArray, closed: bool, m: MatchOptions,
                     distance: float | None, where: str, names: tuple[str, str],
-                    source: str) -> Rulings:  # fmt: skip
+                    source: str, profiles: bool = True) -> Rulings:  # fmt: skip
     """Rulings between profile ``a`` and ``b`` (points (N, 3) m, a closed profile without
     its repeated first point).  ``distance`` puts two flat profiles (both in one plane
     z = c) that far apart along z.  A profile ``b`` that runs the other way round than
-    ``a``, or whose seam (first point) is elsewhere, is turned to match (noted)."""
+    ``a``, or whose seam (first point) is elsewhere, is turned to match (noted).
+    ``profiles=False`` (ruledrobot's own end curves: wire paths, matched already, which
+    may cross themselves) skips the profile checks and turns."""
     notes = []
     za, zb = _flat_z(a), _flat_z(b)
     if distance is not None:
@@ -113,9 +115,10 @@ def pair_to_rulings(a: FloatArray, b: FloatArray, closed: bool, m: MatchOptions,
     elif za is not None and zb is not None and abs(za - zb) <= 1e-12 * max(1.0, abs(za)):
         raise ValueError(f"{where}: both profiles lie in the plane z = {za:g}; give distance "
                          "(m): how far apart they are (span, or tower distance)")  # fmt: skip
-    for name, p in zip(names, (a, b), strict=True):
-        check_simple(p, f"{where}: {name}", closed)
-    if za is not None and zb is not None:
+    if profiles:
+        for name, p in zip(names, (a, b), strict=True):
+            check_simple(p, f"{where}: {name}", closed)
+    if profiles and za is not None and zb is not None:
         ext = float(np.ptp(np.concatenate([a, b])[:, :2], axis=0).max()) ** 2
         aa, ab = _area(a), _area(b)
         if min(abs(aa), abs(ab)) > 1e-6 * ext:  # profiles that enclose an area: by its sign

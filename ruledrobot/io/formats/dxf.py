@@ -122,7 +122,8 @@ def read_dxf(path: str | os.PathLike[str], opts: DxfOptions | None = None) -> Ru
     summary = ", ".join(f"{k} ({len(v)})" for k, v in by_layer.items()) or "none"
     layers = opts.layers
     pairing = opts.pairing
-    if layers is None and all(k in by_layer for k in OWN_LAYERS):
+    own = layers is None and all(k in by_layer for k in OWN_LAYERS)
+    if own:
         layers = OWN_LAYERS  # ruledrobot's own file: its points are matched already
         if pairing.match is None:
             pairing = MatchOptions("index", pairing.points, pairing.spacing)
@@ -154,7 +155,7 @@ def read_dxf(path: str | os.PathLike[str], opts: DxfOptions | None = None) -> Ru
         if len(pts) < 2:
             raise ValueError(f"{where}: the {name} has {len(pts)} point(s); expected at least 2")
     r = pair_to_rulings(a * scale, b * scale, ca, pairing, opts.distance, where, names,
-                        where)  # fmt: skip
+                        where, profiles=not own)  # fmt: skip
     return Rulings(r.lines, r.closed, r.ends, r.planes, None, where, tuple(notes) + r.notes)
 
 
