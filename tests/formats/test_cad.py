@@ -183,6 +183,12 @@ def dxf_with(tmp_path, build, units=4):
         (lambda m: (m.add_polyline3d([(0, 0, 0), (1, 0, 0)]),
                     m.add_polyline3d([(0, 0, 1), (1, 0, 1)])), 2, {},
          r"\$INSUNITS = 2 is not supported"),
+        (lambda m: (m.add_polyline3d([(0, 0, 0), (1, 0, 0)]),
+                    m.add_polyline3d([(0, 0, 1), (1, 0, 1)])), 4, {"distance": 0.3},
+         r"but these lie apart already \(z = 0 and 0\.001 m\): remove distance"),
+        (lambda m: (m.add_polyline3d([(0, 0, 0), (1, 0, 0.5)]),
+                    m.add_polyline3d([(0, 0, 1), (1, 0, 1)])), 4, {"distance": 0.3},
+         r"the profiles are not flat in z"),
     ],
 )
 def test_bad_dxf_files(tmp_path, build, units, options, message):

@@ -55,7 +55,9 @@ def test_a_foam_program_reads_as_the_wire_positions_of_its_cut(tmp_path):
 
 @pytest.mark.parametrize(("mode", "first"), [("path4d", 5e-3 * 13 / np.hypot(10, 13)),
                                              ("first_tower", 5e-3 * 13 / 10),
-                                             ("faster_tower", 5e-3)])
+                                             ("faster_tower", 5e-3),
+                                             # F300 as 1/min: 0.2 s for 13 mm
+                                             ("inverse_time", 0.013 * 300 / 60)])
 def test_feed_modes_read_f_as_their_controllers_do(tmp_path, mode, first):
     r = read_gcode(write(tmp_path, STYLE), GcodeReadOptions(0.5, feed_mode=mode))
     np.testing.assert_allclose(r.feed[0], first)

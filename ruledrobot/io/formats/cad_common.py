@@ -107,9 +107,14 @@ def pair_to_rulings(a: FloatArray, b: FloatArray, closed: bool, m: MatchOptions,
     notes = []
     za, zb = _flat_z(a), _flat_z(b)
     if distance is not None:
-        if za is None or zb is None or abs(za - zb) > 1e-9 * max(1.0, abs(za)):
+        if za is None or zb is None:
+            raise ValueError(f"{where}: distance places two flat profiles drawn in one plane "
+                             "z = c, but the profiles are not flat in z (drawn in 3-D): remove "
+                             "distance")  # fmt: skip
+        if abs(za - zb) > 1e-9 * max(1.0, abs(za)):
             raise ValueError(f"{where}: distance places two flat profiles drawn in one plane, "
-                             "but these lie apart already; remove distance")  # fmt: skip
+                             f"but these lie apart already (z = {za:g} and {zb:g} m): remove "
+                             "distance")  # fmt: skip
         b = b + np.array([0.0, 0.0, distance])
         zb = za + distance
     elif za is not None and zb is not None and abs(za - zb) <= 1e-12 * max(1.0, abs(za)):

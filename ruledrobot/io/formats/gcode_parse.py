@@ -128,7 +128,9 @@ def parse_gcode(text: str, where: str, axes: str = "XYUV", units: str | None = N
 
     ``units`` (``"mm"``/``"in"``) is what the file is in when it does not say
     (default mm); given and contradicted by a ``G20``/``G21`` it is an error.
-    ``distance_mode`` is the mode before any ``G90``/``G91``.
+    ``distance_mode`` is the mode before any ``G90``/``G91``; ``feed_mode``
+    ``"inverse_time"`` reads every F as 1/minutes (a controller in G93 by default),
+    the others read F as a speed unless the file says ``G93``.
     """
     axes = check_axes(axes, where)
     two_axis = len(axes) == 2
@@ -208,7 +210,8 @@ def parse_gcode(text: str, where: str, axes: str = "XYUV", units: str | None = N
         if "F" in vals:
             if vals["F"] <= 0:
                 raise ValueError(f"{where}: line {lineno}: F{vals['F']:g}: expected F > 0")
-            feed = vals["F"] / 60.0 * (1.0 if fmode == 93 else scale)
+            inverse = fmode == 93 or feed_mode == "inverse_time"
+            feed = vals["F"] / 60.0 * (1.0 if inverse else scale)
         if any(mc in _HEAT_ON for mc in ms):
             heat, heat_codes = True, True
         if any(mc in _HEAT_OFF for mc in ms):
@@ -269,7 +272,8 @@ def parse_gcode(text: str, where: str, axes: str = "XYUV", units: str | None = N
             if fmode == 93 and "F" not in vals:
                 raise ValueError(f"{where}: line {lineno}: G1 in inverse time mode (G93) without "
                                  "F; expected F on every move")  # fmt: skip
-        rows.append((pos.copy(), target.copy(), lineno, motion == 0, heat, feed, fmode))
+        rows.append((pos.copy(), target.copy(), lineno, motion == 0, heat, feed,
+                     93 if feed_mode == "inverse_time" else fmode))  # fmt: skip
         pos = target
         if any(mc in _END for mc in ms):
             break
