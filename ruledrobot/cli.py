@@ -652,6 +652,17 @@ def _show_calibration(cal) -> None:
 # --- convert: the file formats of hot-wire cutting and CAD (issue 14; docs/formats.md) ---
 
 
+_IN_GCODE = "Input: G-code"
+_IN_WING = "Input: airfoil panel"
+_IN_PAIR = "Input: profile pairs (airfoil, DXF, 3DM)"
+_IN_DXF = "Input: DXF"
+_IN_3DM = "Input: 3DM"
+_IN = "Input"
+_OUT_GCODE = "Output: G-code"
+_OUT_CAD = "Output: DXF and 3DM"
+_OUT = "Output"
+
+
 def _numbers(text: str | None, n: int, option: str) -> list[float] | None:
     """``"a,b,c"`` -> n floats, or None; a ValueError names the option."""
     if text is None:
@@ -681,63 +692,101 @@ def convert_cmd(
                                           "does not say: lines, gcode, dxf, rhino."),
     in_format: str | None = typer.Option(None, "--from", help="Input kind when the suffix "
                                          "does not say: lines, gcode, airfoil, dxf, rhino."),
-    tower_distance: float | None = typer.Option(None, help="G-code in: distance between the "
+    tower_distance: float | None = typer.Option(None,
+        rich_help_panel=_IN_GCODE, help="G-code in: distance between the "
                                                 "towers (m), a machine setting."),
-    axes: str | None = typer.Option(None, help="G-code in: axis letters A-horizontal, "
+    axes: str | None = typer.Option(None,
+        rich_help_panel=_IN_GCODE, help="G-code in: axis letters A-horizontal, "
                                     "A-vertical, B-horizontal, B-vertical (XYUV, XYZA; XY)."),
-    units: str | None = typer.Option(None, help="In: units of a file that does not say "
+    units: str | None = typer.Option(None,
+        rich_help_panel=_IN, help="In: units of a file that does not say "
                                      "(mm, cm, m, in)."),
-    distance_mode: str | None = typer.Option(None, help="G-code in: absolute or relative "
+    distance_mode: str | None = typer.Option(None,
+        rich_help_panel=_IN_GCODE, help="G-code in: absolute or relative "
                                              "before any G90/G91."),
-    feed_mode: str | None = typer.Option(None, help="G-code in: how F is meant (path4d, "
+    feed_mode: str | None = typer.Option(None,
+        rich_help_panel=_IN_GCODE, help="G-code in: how F is meant (path4d, "
                                          "first_tower, faster_tower, inverse_time)."),
-    cut: int | None = typer.Option(None, help="G-code in: which cut (1-based) of several."),
-    tip: Path | None = typer.Option(None, help="Airfoil: the tip profile (.dat)."),
-    span: float | None = typer.Option(None, help="Airfoil: span of the panel (m)."),
-    root_chord: float | None = typer.Option(None, help="Airfoil: root chord (m)."),
-    tip_chord: float | None = typer.Option(None, help="Airfoil: tip chord (m)."),
-    sweep: float | None = typer.Option(None, help="Airfoil: leading-edge sweep (rad)."),
-    dihedral: float | None = typer.Option(None, help="Airfoil: dihedral (rad)."),
-    twist: float | None = typer.Option(None, help="Airfoil: tip twist, + nose up (rad)."),
-    washout: float | None = typer.Option(None, help="Airfoil: washout (rad) = -twist."),
-    twist_axis: float | None = typer.Option(None, help="Airfoil: twist axis, fraction of chord."),
-    match: str | None = typer.Option(None, help="Profiles: pair points by 'parameter' or "
+    cut: int | None = typer.Option(None,
+        rich_help_panel=_IN_GCODE, help="G-code in: which cut (1-based) of several."),
+    tip: Path | None = typer.Option(None,
+        rich_help_panel=_IN_WING, help="Airfoil: the tip profile (.dat)."),
+    span: float | None = typer.Option(None,
+        rich_help_panel=_IN_WING, help="Airfoil: span of the panel (m)."),
+    root_chord: float | None = typer.Option(None,
+        rich_help_panel=_IN_WING, help="Airfoil: root chord (m)."),
+    tip_chord: float | None = typer.Option(None,
+        rich_help_panel=_IN_WING, help="Airfoil: tip chord (m)."),
+    sweep: float | None = typer.Option(None,
+        rich_help_panel=_IN_WING, help="Airfoil: leading-edge sweep (rad)."),
+    dihedral: float | None = typer.Option(None,
+        rich_help_panel=_IN_WING, help="Airfoil: dihedral (rad)."),
+    twist: float | None = typer.Option(None,
+        rich_help_panel=_IN_WING, help="Airfoil: tip twist, + nose up (rad)."),
+    washout: float | None = typer.Option(None,
+        rich_help_panel=_IN_WING, help="Airfoil: washout (rad) = -twist."),
+    twist_axis: float | None = typer.Option(None,
+        rich_help_panel=_IN_WING, help="Airfoil: twist axis, fraction of chord."),
+    match: str | None = typer.Option(None,
+        rich_help_panel=_IN_PAIR, help="Profiles: pair points by 'parameter' or "
                                      "'index'."),
-    points: int | None = typer.Option(None, help="Profiles: number of rulings."),
-    spacing: str | None = typer.Option(None, help="Profiles: uniform or cosine resampling."),
-    layers: list[str] | None = typer.Option(None, "--layers", help="DXF in: the two layers "
+    points: int | None = typer.Option(None,
+        rich_help_panel=_IN_PAIR, help="Profiles: number of rulings."),
+    spacing: str | None = typer.Option(None,
+        rich_help_panel=_IN_PAIR, help="Profiles: uniform or cosine resampling."),
+    layers: list[str] | None = typer.Option(None, "--layers",
+        rich_help_panel=_IN_DXF, help="DXF in: the two layers "
                                             "of the profiles (give twice)."),
-    distance: float | None = typer.Option(None, help="DXF in: put two flat profiles this far "
+    distance: float | None = typer.Option(None,
+        rich_help_panel=_IN_DXF, help="DXF in: put two flat profiles this far "
                                           "apart (m)."),
-    tolerance: float | None = typer.Option(None, help="DXF in: flattening tolerance (m)."),
-    layer: str | None = typer.Option(None, help="3DM in: only objects on this layer."),
-    use: str | None = typer.Option(None, help="3DM in: auto, lines, curves or surface."),
-    direction: str | None = typer.Option(None, help="3DM in: surface direction of the "
+    tolerance: float | None = typer.Option(None,
+        rich_help_panel=_IN_DXF, help="DXF in: flattening tolerance (m)."),
+    layer: str | None = typer.Option(None,
+        rich_help_panel=_IN_3DM, help="3DM in: only objects on this layer."),
+    use: str | None = typer.Option(None,
+        rich_help_panel=_IN_3DM, help="3DM in: auto, lines, curves or surface."),
+    direction: str | None = typer.Option(None,
+        rich_help_panel=_IN_3DM, help="3DM in: surface direction of the "
                                          "rulings (u or v)."),
-    out_units: str | None = typer.Option(None, help="Out: units (mm default; G-code mm/in)."),
-    out_tower_distance: float | None = typer.Option(None, help="G-code out: distance between "
+    out_units: str | None = typer.Option(None,
+        rich_help_panel=_OUT, help="Out: units (mm default; G-code mm/in)."),
+    out_tower_distance: float | None = typer.Option(None,
+        rich_help_panel=_OUT_GCODE, help="G-code out: distance between "
                                                     "the towers (m)."),
-    out_frame: str | None = typer.Option(None, help="Out: cutter frame in the rulings' frame, "
+    out_frame: str | None = typer.Option(None,
+        rich_help_panel=_OUT, help="Out: cutter frame in the rulings' frame, "
                                          "'x,y,z,rx,ry,rz' (m, rad)."),
-    out_block_offset: float | None = typer.Option(None, help="G-code out: from tower A to the "
+    out_block_offset: float | None = typer.Option(None,
+        rich_help_panel=_OUT_GCODE, help="G-code out: from tower A to the "
                                                   "source's first face (m); default centred."),
-    out_axes: str | None = typer.Option(None, help="G-code out: axis letters (XYUV, XYZA...)."),
-    out_feed_mode: str | None = typer.Option(None, help="G-code out: how the controller reads F "
+    out_axes: str | None = typer.Option(None,
+        rich_help_panel=_OUT_GCODE, help="G-code out: axis letters (XYUV, XYZA...)."),
+    out_feed_mode: str | None = typer.Option(None,
+        rich_help_panel=_OUT_GCODE, help="G-code out: how the controller reads F "
                                              "(inverse_time, path4d, first_tower, "
                                              "faster_tower)."),
-    out_feed: float | None = typer.Option(None, help="G-code out: feed (m/s), default 0.005."),
-    out_feed_at: str | None = typer.Option(None, help="G-code out: where the feed holds: "
+    out_feed: float | None = typer.Option(None,
+        rich_help_panel=_OUT_GCODE, help="G-code out: feed (m/s), default 0.005."),
+    out_feed_at: str | None = typer.Option(None,
+        rich_help_panel=_OUT_GCODE, help="G-code out: where the feed holds: "
                                            "towers or faces."),
-    out_faces: str | None = typer.Option(None, help="G-code out: z of the block faces in the "
+    out_faces: str | None = typer.Option(None,
+        rich_help_panel=_OUT_GCODE, help="G-code out: z of the block faces in the "
                                          "cutter frame 'z0,z1' (m)."),
-    out_heat: str | None = typer.Option(None, help="G-code out: M3 (M3/M5), M8 (M8/M9) or "
+    out_heat: str | None = typer.Option(None,
+        rich_help_panel=_OUT_GCODE, help="G-code out: M3 (M3/M5), M8 (M8/M9) or "
                                         "none."),
-    out_dwell: float | None = typer.Option(None, help="G-code out: pre-heat dwell (s)."),
-    out_decimals: int | None = typer.Option(None, help="G-code out: decimals of coordinates."),
-    out_length: float | None = typer.Option(None, help="DXF/3DM out: length of the drawn "
+    out_dwell: float | None = typer.Option(None,
+        rich_help_panel=_OUT_GCODE, help="G-code out: pre-heat dwell (s)."),
+    out_decimals: int | None = typer.Option(None,
+        rich_help_panel=_OUT_GCODE, help="G-code out: decimals of coordinates."),
+    out_length: float | None = typer.Option(None,
+        rich_help_panel=_OUT_CAD, help="DXF/3DM out: length of the drawn "
                                             "rulings (m), for rulings without ends."),
     out_surface: bool | None = typer.Option(None, "--out-surface/--out-no-surface",
-                                            help="3DM out: also the ruled surface."),
+
+        rich_help_panel=_OUT_CAD, help="3DM out: also the ruled surface."),
 ) -> None:
     """Convert rulings between formats: foam-cutter G-code, airfoil .dat pairs, DXF, Rhino
     3DM and lines files (and a mesh to 3DM).  Options of the input are plain, options of
