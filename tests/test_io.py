@@ -56,7 +56,9 @@ def test_csv_round_trip(tmp_path, lines):
         ),
         ("a.json", '{"lines": [[1, 0, 0, 0, 1, 0], [1, 0, 0, 1, 0, 0]]}', r"lines\[1\]: l \. m"),
         ("a.json", '{"format": "other/2", "lines": []}', r"format 'other/2' is not supported"),
-        ("a.json", '{"units": "mm", "lines": []}', r"units 'mm'"),
+        ("a.json", '{"units": "furlong", "lines": []}', r"'units': unknown length unit 'furlong'"),
+        ("a.csv", "px,py,pz,dx,dy,dz\n# units: mm\n0,0,0,1,0,0\n", r"line 2: '# units:' must come"),
+        ("a.csv", "# units: ft\npx,py,pz,dx,dy,dz\n", r"a\.csv: line 1: units: unknown length"),
         (
             "a.json",
             '{"lines": [{"point": [0, "x", 0], "direction": [1, 0, 0]}]}',
@@ -118,3 +120,30 @@ def test_written_files_get_ordinary_permissions(tmp_path, lines):
         assert p.stat().st_mode & 0o777 == 0o640
     finally:
         os.umask(umask)
+
+
+@pytest.mark.parametrize(
+    ("unit", "scale"),
+    [("m", 1.0), ("mm", 1e-3), ("cm", 1e-2), ("in", 0.0254), ("inches", 0.0254),
+     ("millimetres", 1e-3)],
+)
+def test_lines_files_in_other_units_read_in_metres(tmp_path, unit, scale):
+    """JSON "units" and the CSV "# units:" comment scale points, moments, frames and
+    striction points to metres; directions are unchanged."""
+    pts = np.array([[10.0, 20.0, 30.0], [40.0, -5.0, 2.5]])
+    dirs = np.array([[0.0, 0.0, 1.0], [0.0, 0.6, 0.8]])
+    frames = np.repeat(np.eye(4)[None], 2, axis=0)
+    frames[:, :3, 3] = pts
+    doc = {"format": "ruledrobot.lines/1", "units": unit,
+           "lines": [{"point": p.tolist(), "direction": d.tolist()}
+                     for p, d in zip(pts, dirs, strict=True)],
+           "frames": frames.reshape(2, 16).tolist(), "striction": pts.tolist()}  # fmt: skip
+    (tmp_path / "a.json").write_text(json.dumps(doc))
+    got = rr.io.read_lines_document(tmp_path / "a.json")
+    want = rr.Lines.from_point_direction(pts * scale, dirs)
+    np.testing.assert_allclose(got.lines.plucker, want.plucker, atol=1e-15)
+    np.testing.assert_allclose(got.frames[:, :3, 3], pts * scale)
+    np.testing.assert_allclose(got.striction, pts * scale)
+    rows = "\n".join(",".join(map(str, np.r_[p, d])) for p, d in zip(pts, dirs, strict=True))
+    (tmp_path / "a.csv").write_text(f"# units: {unit}\npx,py,pz,dx,dy,dz\n{rows}\n")
+    np.testing.assert_allclose(rr.load_lines(tmp_path / "a.csv").plucker, want.plucker, atol=1e-15)

@@ -10,6 +10,11 @@ file may add ``"frames"`` (row-major 4x4 each) and ``"striction"`` (points).
 CSV: header ``px,py,pz,dx,dy,dz``, one line per row (``#`` comments allowed;
 a comment ``# closed: true`` marks a closed sequence).
 
+Units: ``"units"`` (JSON) or a comment ``# units: mm`` (CSV, before the header)
+may be ``"m"`` (the default), ``"cm"``, ``"mm"`` or ``"in"``; lengths (points,
+moments, frame translations, striction points) are converted to metres on
+reading.  Files are always written in metres.
+
 Every error names the file and the item (JSON index, CSV line number).
 """
 
@@ -29,6 +34,7 @@ from ..geometry.checks import FloatArray
 from ..geometry.lines import Lines, plucker_from_point_direction, validate_plucker
 from .atomic import atomic_write_text
 from .text import read_user_text
+from .units import unit_scale
 
 __all__ = ["FORMAT", "LinesDocument", "load_lines", "read_lines_document", "save_lines"]
 
@@ -97,15 +103,15 @@ def _read_json(path: Path, text: str) -> LinesDocument:
     fmt = doc.get("format", FORMAT)
     if fmt != FORMAT:
         raise ValueError(f"{where}: format {fmt!r} is not supported; expected {FORMAT!r}")
-    units = doc.get("units", "m")
-    if units != "m":
-        raise ValueError(f"{where}: units {units!r} are not supported; expected 'm'")
+    scale = unit_scale(doc.get("units", "m"), f"{where}: 'units'")
     closed = doc.get("closed", False)
     if not isinstance(closed, bool):
         raise ValueError(f"{where}: 'closed' must be true or false, got {closed!r}")
     if "lines" not in doc:
         raise ValueError(f"{where}: missing 'lines'")
     lines = _lines_from_entries(doc["lines"], where)
+    if scale != 1.0:
+        lines = Lines(lines.plucker * np.r_[1.0, 1.0, 1.0, scale, scale, scale])
     frames = striction = None
     if "frames" in doc:
         fr = doc["frames"]
@@ -118,19 +124,21 @@ def _read_json(path: Path, text: str) -> LinesDocument:
                 f = [v for r in f for v in r]
             rows.append(_vector(f, 16, f"{where}: frames[{i}]"))
         frames = np.asarray(rows).reshape(-1, 4, 4)
+        frames[:, :3, 3] *= scale
     if "striction" in doc:
         st = doc["striction"]
         if not isinstance(st, list) or len(st) != len(lines):
             raise ValueError(f"{where}: 'striction' must hold one point per line")
         striction = np.asarray(
             [_vector(p, 3, f"{where}: striction[{i}]") for i, p in enumerate(st)]
-        )
+        ) * scale
     return LinesDocument(lines, closed, frames, striction)
 
 
 def _read_csv(path: Path, text: str) -> LinesDocument:
     where = str(path)
     closed = False
+    scale = 1.0
     rows: list[tuple[int, list[str]]] = []
     header_seen = False
     for lineno, raw in enumerate(io.StringIO(text), start=1):
@@ -141,6 +149,11 @@ def _read_csv(path: Path, text: str) -> LinesDocument:
             key, _, val = s[1:].partition(":")
             if key.strip().lower() == "closed":
                 closed = val.strip().lower() in ("true", "1", "yes")
+            elif key.strip().lower() == "units":
+                if header_seen:
+                    raise ValueError(f"{where}: line {lineno}: '# units:' must come before the "
+                                     "header (it applies to every row)")  # fmt: skip
+                scale = unit_scale(val.strip(), f"{where}: line {lineno}: units")
             continue
         cells = next(csv.reader([s]))
         if not header_seen:
@@ -167,7 +180,8 @@ def _read_csv(path: Path, text: str) -> LinesDocument:
             raise ValueError(f"{where}: line {lineno}: contains NaN or infinity")
         if np.linalg.norm(values[k, 3:]) <= 1e-12:
             raise ValueError(f"{where}: line {lineno}: direction is the zero vector")
-    return LinesDocument(Lines(plucker_from_point_direction(values[:, :3], values[:, 3:])), closed)
+    points = values[:, :3] * scale
+    return LinesDocument(Lines(plucker_from_point_direction(points, values[:, 3:])), closed)
 
 
 def read_lines_document(path: str | os.PathLike[str]) -> LinesDocument:

@@ -5,7 +5,11 @@ is written as ``[surface]`` and ``[cut]`` tables (in the robot base frame;
 metres, radians, seconds)::
 
     [surface]                  # the ruled surface to cut
-    builtin = "hyperbolic_paraboloid"   # or: file = "rulings.json" (lines file)
+    builtin = "hyperbolic_paraboloid"   # or: file = "rulings.json" (lines file), or a file of
+                               # the field: gcode = "wing.ngc", airfoil, dxf, rhino -- a path, or
+                               # a table of the reader's options with the path under file
+                               # (airfoil: root, tip): [surface.gcode] file = "wing.ngc"
+                               # tower_distance = 0.8 (docs/formats.md)
     params = { c = 0.4 }       # parameters of the built-in surface
     u = [-0.12, 0.12]          # its parameter range
     rulings = 9                # input rulings sampled over u

@@ -22,6 +22,8 @@ from .spec import HeatSpec, RobotSpec, SurfaceSpec
 __all__ = ["Section", "parse_heat", "parse_robot", "parse_stock", "parse_surface"]
 
 ALGORITHMS = ("projection", "combined", "dh")
+#: the files of the field a surface can be read from (:mod:`ruledrobot.io.formats`)
+FOREIGN_KINDS = ("gcode", "airfoil", "dxf", "rhino")
 #: where the wire's heat is switched: UR standard, configurable and tool digital outputs,
 #: and the standard analog outputs (a current or voltage set as a fraction of the range)
 HEAT_OUTPUTS = {"standard": 8, "configurable": 8, "tool": 2, "analog": 2}
@@ -122,8 +124,23 @@ def pose(sec: Section, key: str) -> np.ndarray:
 def parse_surface(s: Section, base_dir: Path | None) -> SurfaceSpec:
     """``[surface]`` (or a cut's ``surface`` table) -> :class:`.spec.SurfaceSpec`."""
     builtin, file = s.get("builtin"), s.get("file")
-    if (builtin is None) == (file is None):
-        raise s.fail("builtin/file", 'give exactly one of builtin = "name" or file = "path"')
+    foreign = [k for k in FOREIGN_KINDS if s.get(k) is not None]
+    if (builtin is not None) + (file is not None) + len(foreign) != 1:
+        raise s.fail("builtin/file/gcode/airfoil/dxf/rhino",
+                     'give exactly one of builtin = "name", file = "path" (a lines file), or '
+                     'gcode/airfoil/dxf/rhino = "path" (or a table of options; '
+                     "docs/formats.md)")  # fmt: skip
+    read = None
+    if foreign:
+        from ..io.formats import parse_read_spec, read_rulings
+
+        kind = foreign[0]
+        spec = parse_read_spec(kind, s.get(kind), f"{s.where}: [{s.title}.{kind}]", base_dir)
+        try:
+            read = read_rulings(spec)
+        except ValueError as exc:
+            raise s.fail(kind, str(exc)) from None
+        file = str(spec.path)
     params = s.get("params", {})
     if not isinstance(params, dict):
         raise s.fail("params", f"expected a table of parameters, got {params!r}")
@@ -153,7 +170,7 @@ def parse_surface(s: Section, base_dir: Path | None) -> SurfaceSpec:
         if not path.is_absolute() and base_dir is not None:
             path = base_dir / path
         if not path.exists():
-            raise s.fail("file", f"no such lines file: {path}")
+            raise s.fail(foreign[0] if foreign else "file", f"no such lines file: {path}")
         if "u" in s.raw:
             raise s.fail("u", "only for a builtin surface")
         if params:
@@ -188,6 +205,9 @@ def parse_surface(s: Section, base_dir: Path | None) -> SurfaceSpec:
         steps=steps,
         spacing=spacing,
         closed=closed,
+        read_lines=None if read is None else read.lines,
+        read_closed=False if read is None else bool(read.closed),
+        kind=foreign[0] if foreign else ("lines" if file is not None else None),
     )
     s.done()
     return surface

@@ -37,13 +37,20 @@ class SurfaceSpec:
     steps: int | None = 4
     spacing: float | None = None
     closed: bool | None = None
+    #: rulings read from a file of the field (gcode, airfoil, dxf, rhino) when the job
+    #: names one (``file`` is then that file), in the file's frame, and whether they close
+    read_lines: Lines | None = field(default=None, repr=False)
+    read_closed: bool = False
+    kind: str | None = None
 
     def document(self):
         """The input rulings in the robot base frame and whether they close
         (:class:`~ruledrobot.io.lines.LinesDocument`)."""
         from ..io.lines import LinesDocument, read_lines_document
 
-        if self.file is not None:
+        if self.read_lines is not None:
+            lines, closed = self.read_lines, self.read_closed
+        elif self.file is not None:
             doc = read_lines_document(self.file)
             lines, closed = doc.lines, doc.closed
         else:
@@ -64,7 +71,9 @@ class SurfaceSpec:
     @property
     def label(self) -> str:
         """What the rulings are, for messages: the file or the built-in surface's name."""
-        return str(self.file) if self.file is not None else str(self.builtin)
+        if self.file is None:
+            return str(self.builtin)
+        return str(self.file) if self.kind in (None, "lines") else f"{self.kind} {self.file}"
 
 
 @dataclass(frozen=True)
