@@ -542,10 +542,58 @@ def plan(
     job: Path = typer.Argument(..., help="Cut job file (.toml)."),
     out: Path = typer.Option(Path("out/plan"), "--out", "-o", help="Output folder."),
     video: bool = typer.Option(False, "--video/--no-video", help="Render video.mp4 too."),
+    view: bool = typer.Option(False, "--view", help="Then show it in the browser viewer "
+                              "(ruledrobot view OUT, on 127.0.0.1:8080; Ctrl-C stops)."),
 ) -> None:
     """Plan a hot-wire cut: refine, choose the wire motion, time it, verify it in MuJoCo,
     write the trajectory.  Exits with status 1 (and the reasons) when infeasible."""
-    _run_plan(job, out, video=video)
+    try:
+        _run_plan(job, out, video=video)
+    except typer.Exit as stop:
+        if view and stop.exit_code == 1:  # a failed plan is worth a look too
+            _view(out)
+        raise
+    if view:
+        _view(out)
+
+
+def _view(folder: Path, export: Path | None = None, **options) -> None:
+    """Serve the viewer of a plan folder until Ctrl-C, or write its static export; exit 2
+    on a folder that is not a plan folder, a refused address or a missing viewer extra."""
+    from .view import ViewerUnavailable, export_html, serve
+
+    try:
+        if export is not None:
+            path = export_html(folder, export)
+            console.print(f"wrote {path}  ({path.stat().st_size / 1e6:.1f} MB, opens in a "
+                          "browser with no Python and no network)", highlight=False,
+                          markup=False)  # fmt: skip
+            return
+        serve(folder, ready=lambda srv: console.print(
+            f"viewer of {folder} at {srv.url}  (open it in a browser; Ctrl-C stops)",
+            highlight=False, markup=False), **options)  # fmt: skip
+    except (ValueError, ViewerUnavailable, OSError) as exc:
+        raise _fail(str(exc)) from None
+
+
+@app.command(epilog="Example:  ruledrobot view out/cut     or:  ruledrobot view out/cut "
+             "--export scene.html")
+def view(
+    folder: Path = typer.Argument(..., help="Plan folder (what `ruledrobot plan` writes)."),
+    export: Path | None = typer.Option(None, "--export", help="Write one self-contained HTML "
+                                       "file of the scene instead of serving it."),
+    host: str = typer.Option("127.0.0.1", help="Address to serve on (loopback only, unless "
+                             "--allow-remote)."),
+    port: int = typer.Option(8080, min=0, max=65535, help="Port (0: any free port)."),
+    allow_remote: bool = typer.Option(False, "--allow-remote", help="Serve on a non-loopback "
+                                      "address (the viewer has no authentication)."),
+    duration: float | None = typer.Option(None, min=0.0, help="Stop after this many seconds "
+                                          "(default: run until Ctrl-C)."),
+) -> None:
+    """Show a plan folder in the browser: the arm, bow and wire moving through the stock,
+    the cut surface, the rulings, a timeline to play and scrub, phase and live figures,
+    collisions and near misses, the table of checks.  Never plans anything."""
+    _view(folder, export, host=host, port=port, allow_remote=allow_remote, duration=duration)
 
 
 @app.command(epilog="Example:  ruledrobot demo --out out/demo")

@@ -93,7 +93,8 @@ def export_html(
     """
     scene = source if isinstance(source, PlanScene) else build_scene(source, fps=fps)
     v = viser()
-    server = v.ViserServer(host="127.0.0.1", port=0, verbose=False)
+    with contextlib.redirect_stdout(io.StringIO()):  # viser's banner
+        server = v.ViserServer(host="127.0.0.1", port=0, verbose=False)
     try:
         server.gui.configure_theme(show_share_button=False)
         painter = Painter(server, scene)
