@@ -51,6 +51,11 @@ def _quad_strip(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return v, np.array([[0, 1, 3], [0, 3, 2]], dtype=np.uint32)
 
 
+def _caption_at(wire: np.ndarray) -> np.ndarray:
+    """Where the caption hangs: 2 cm above the wire's upper end (clear of the stock)."""
+    return wire[np.argmax(wire[:, 2])] + np.array([0.0, 0.0, 0.02])
+
+
 def caption(scene: PlanScene, k: int) -> str:
     """The words at the wire at frame ``k``: time, phase, feed, joint speed, singularity."""
     tl = scene.timeline
@@ -95,6 +100,13 @@ class Painter:
         self.scene = scene
         api = server.scene
         api.set_up_direction("+z")
+        # no shadow maps: they cost seconds per frame in software WebGL and add little here
+        api.configure_default_lights(True, cast_shadow=False)
+        # no environment map either (its prefiltering takes ~10 s in software WebGL): a
+        # hemisphere light in its place, so that faces turned from the lights stay readable
+        api.configure_environment_map(None)
+        api.add_light_hemisphere("/lights/sky", sky_color=(255, 255, 255),
+                                 ground_color=(120, 110, 100), intensity=2.0)  # fmt: skip
         pos, target = scene.camera
         server.initial_camera.position = tuple(float(x) for x in pos)
         server.initial_camera.look_at = tuple(float(x) for x in target)
@@ -160,7 +172,7 @@ class Painter:
             else:
                 self.cut.append(None)
         self.caption = api.add_label("/motion/caption", caption(scene, 0),
-                                     position=tl.wire[0].mean(axis=0), anchor="bottom-left",
+                                     position=_caption_at(tl.wire[0]), anchor="bottom-left",
                                      font_screen_scale=1.0)  # fmt: skip
 
     def show(self, k: int) -> None:
@@ -184,7 +196,7 @@ class Painter:
                 if self.cut[j] is not None:
                     self.cut[j].visible = vis and self.enabled["cut"]
             self.shown = k
-            self.caption.position = tl.wire[k].mean(axis=0)
+            self.caption.position = _caption_at(tl.wire[k])
             self.caption.text = caption(self.scene, k)
         self.frame = k
 

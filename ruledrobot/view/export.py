@@ -65,7 +65,7 @@ def overlay_html(scene: PlanScene) -> str:
 <div style="font-weight:600">{e(scene.title)}</div>
 <div style="color:{ok_colour};font-weight:700">verdict: {e(scene.verdict)}</div>
 {f"<ul>{notes}</ul>" if notes else ""}
-<details open><summary>checks</summary>
+<details{"" if scene.ok else " open"}><summary>checks</summary>
 <table style="border-collapse:collapse">{"".join(rows)}</table>
 {f"<ul style='color:#c62828'>{failed}</ul>" if failed else ""}</details>
 <details><summary>collisions and near misses</summary><ul>{events}</ul></details>

@@ -48,7 +48,7 @@ NEAR_MISS = 0.02
 #: Step (s) of the clearance search along the motion (finer than the display frames).
 CLEARANCE_STEP = 0.01
 #: The browser's first view: the video's camera moved this fraction of the way to its target.
-CAMERA_ZOOM = 0.6
+CAMERA_ZOOM = 0.7
 #: Phases in which the wire cuts (the video's close-up camera, the viewer's colours).
 CUTTING_PHASES = ("lead_in", "cut", "lead_out")
 
@@ -259,7 +259,10 @@ def build_scene(
     events += _reported(folder, mj, model, traj, labels if traj is not None else None)
     rest_pos, rest_quat = geom_poses(mj, model, q_rest[None], ids)
     cam_pos, cam_target = default_camera(robot.with_base(np.eye(4)), job.stock)
-    cam_pos = cam_target + CAMERA_ZOOM * (cam_pos - cam_target)  # closer than the video's
+    # closer than the video's, aimed nearer the stock: the cut is what the user looks at
+    aim = cam_target + 0.5 * (job.stock.centre - cam_target)
+    cam_pos = aim + CAMERA_ZOOM * (cam_pos - cam_target)
+    cam_target = aim
     camera = (R @ cam_pos + p, R @ cam_target + p)
     title = f"{folder.path.name} — {robot.name}, {len(rulings)} rulings in the stock"
     return PlanScene(folder, title, folder.summary, folder.feasible, geoms, rest_pos[0],
