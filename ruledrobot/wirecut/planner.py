@@ -418,7 +418,8 @@ def _write(
 
             try:
                 scene = Scene.from_job(job, robot=model)
-                files["video"] = render_video(scene, folder / "video.mp4", traj.t, pb.q)
+                files["video"] = render_video(scene, folder / "video.mp4", traj.t, pb.q,
+                                              phases=trajectory.meta.phases)  # fmt: skip
             except RenderUnavailable as exc:
                 report.setdefault("notes", []).append(f"no video: {exc}")
     return files
