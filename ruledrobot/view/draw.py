@@ -112,12 +112,15 @@ class Painter:
         server.initial_camera.look_at = tuple(float(x) for x in target)
         server.initial_camera.up = (0.0, 0.0, 1.0)
         self.handles: dict[int, Any] = {}
+        # the moving parts named in a collision are drawn red
+        hit = {part for e in scene.events if e.kind == "collision" for part in e.what.split(" – ")}
         for i, g in enumerate(scene.geoms):
             if g.rgba[3] <= 0.0:
                 continue
             root = "/cell" if g.static else "/robot"
+            colour = (220, 30, 30) if g.name in hit and not g.static else _rgb(g.rgba)
             self.handles[i] = api.add_mesh_simple(
-                f"{root}/{g.name}", g.vertices, g.faces, color=_rgb(g.rgba),
+                f"{root}/{g.name}", g.vertices, g.faces, color=colour,
                 opacity=None if g.rgba[3] >= 1.0 else float(g.rgba[3]),
                 side="double" if g.rgba[3] < 1.0 else "front",
                 wxyz=scene.rest_quat[i], position=scene.rest_pos[i],

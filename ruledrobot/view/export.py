@@ -71,7 +71,8 @@ def overlay_html(scene: PlanScene) -> str:
 <details><summary>collisions and near misses</summary><ul>{events}</ul></details>
 <details><summary>how to read it</summary><div>Drag to turn, scroll to zoom, right-drag to
 pan. The bar at the bottom plays, pauses and scrubs the motion; the caption at the wire
-gives time, phase, feed, joint speed and singularity measure. Red: the wire. Orange: the cut
+gives time, phase, feed, joint speed and singularity measure. Red: the wire (and parts named
+in a collision). Orange: the cut
 surface the wire has swept in the stock. Trail of the whole wire by phase: {legend}.
 Blue lines: the refined rulings; blue film: the planned surface.</div></details>
 </div>"""
