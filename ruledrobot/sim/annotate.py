@@ -120,8 +120,8 @@ class CutAnnotator:
             self.close_camera = self._close_camera()
 
     def _close_camera(self) -> Any:
-        """A free camera 0.3 m from the wire, on the side of the cut surface facing the
-        main camera, a little above it."""
+        """A free camera outside the block (half its diagonal plus 15 cm from the wire),
+        on the side of the cut surface facing the main camera, a little above it."""
         mj = self.mj
         pts = self.chord[self.cutting & self.inside].reshape(-1, 3)
         if len(pts) < 3:
