@@ -85,10 +85,21 @@ def plan(
     job: Path = typer.Argument(..., help="Cut job file (.toml)."),
     out: Path = typer.Option(Path("out/plan"), "--out", "-o", help="Output folder."),
     video: bool = typer.Option(False, "--video/--no-video", help="Render video.mp4 too."),
+    view: bool = typer.Option(False, "--view", help="Then show it in the browser viewer "
+                              "(ruledrobot view OUT, on 127.0.0.1:8080; Ctrl-C stops)."),
 ) -> None:
     """Plan a hot-wire cut: refine, choose the wire motion, time it, verify it in MuJoCo,
     write the trajectory.  Exits with status 1 (and the reasons) when infeasible."""
-    _run_plan(job, out, video=video)
+    from .view import show
+
+    try:
+        _run_plan(job, out, video=video)
+    except typer.Exit as stop:
+        if view and stop.exit_code == 1:  # a failed plan is worth a look too
+            show(out)
+        raise
+    if view:
+        show(out)
 
 
 @app.command(epilog="Example:  ruledrobot demo --out out/demo")

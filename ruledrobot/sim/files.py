@@ -86,11 +86,12 @@ def simulate(
     :class:`~ruledrobot.sim.render.RenderUnavailable`, after writing the
     report, when no OpenGL backend works).  Returns ``{name: path}``.
     """
+    from ..io.trajectory import read_trajectory
+
+    traj = read_trajectory(trajectory)
     if model_or_scene is None:
-        from ..io.trajectory import read_trajectory
         from ..robot import model_for
 
-        traj = read_trajectory(trajectory)
         model_or_scene = Scene(model_for(traj.meta), width=width, height=height)
     result = play_file(trajectory, model_or_scene, progress=progress, **options)
     paths = result.write(out_dir)
@@ -104,6 +105,7 @@ def simulate(
             width=width,
             height=height,
             progress=progress,
+            phases=traj.meta.phases if result.t.size == traj.n else None,
         )
         paths["strip"] = render_strip(
             result, Path(out_dir) / "strip.png", width=width, height=height

@@ -140,8 +140,14 @@ class Renderer:
         self._flags_set = False
         _OPEN.add(self)
 
-    def frame(self, q: ArrayLike) -> np.ndarray:
-        """(H, W, 3) uint8 image at joint positions q (J,) [rad]."""
+    def frame(
+        self, q: ArrayLike, decorate: Any = None, camera: Any = None
+    ) -> np.ndarray:
+        """(H, W, 3) uint8 image at joint positions q (J,) [rad].
+
+        ``decorate(scene)`` is called with the ``mjvScene`` before rendering (to add
+        decorative geoms); ``camera`` overrides the renderer's camera (a name, an id
+        or an ``MjvCamera``)."""
         mj = self._mj
         J = self.scene.robot.n_joints
         self.data.qpos[:J] = np.asarray(q, dtype=np.float64)
@@ -149,7 +155,9 @@ class Renderer:
         mj.mj_comPos(self.model, self.data)
         mj.mj_camlight(self.model, self.data)  # camera and light poses
         r = self._r
-        r.update_scene(self.data, camera=self.camera)
+        r.update_scene(self.data, camera=self.camera if camera is None else camera)
+        if decorate is not None:
+            decorate(r.scene)
         if not self._flags_set:
             r.scene.flags[mj.mjtRndFlag.mjRND_SHADOW] = False
             r.scene.flags[mj.mjtRndFlag.mjRND_REFLECTION] = False
@@ -196,13 +204,22 @@ def _frames(
     width: int,
     height: int,
     camera: str | int,
+    annotate: bool = True,
+    phases: Any = None,
 ) -> Iterator[np.ndarray]:
     ta, qa = _motion(source, t, q)
     times = frame_times(ta, fps)
     qs = _sample(ta, qa, times)
     with Renderer(source, width, height, camera) as r:
-        for qk in qs:
-            yield r.frame(qk)
+        if not annotate or r.scene.tool is None or r.scene.stock is None:
+            for qk in qs:
+                yield r.frame(qk)
+            return
+        from .annotate import CutAnnotator
+
+        with CutAnnotator(r, ta, qa, times, phases) as ann:
+            for i, qk in enumerate(qs):
+                yield ann.frame(i, qk)
 
 
 def render_frames(
@@ -214,14 +231,23 @@ def render_frames(
     width: int = 640,
     height: int = 480,
     camera: str | int = "cell",
+    annotate: bool = True,
+    phases: Any = None,
 ) -> np.ndarray:
     """Frames (K, H, W, 3) uint8 of a motion at ``fps`` (K = duration x fps + 1).
 
     ``source`` is a :class:`~ruledrobot.sim.playback.PlaybackResult` (its
     scene and simulated motion) or a Scene / RobotModel with ``t`` (M,) [s]
     and ``q`` (M, J) [rad] (``t`` defaults to 25 samples per second).
+
+    ``annotate`` (scenes with a bow and a stock): the cut surface the wire has
+    swept appears in the stock, the wire's path stays as a trail, a caption
+    gives time, phase and feed, and while the wire cuts a close-up camera on
+    the wire is inset (:mod:`ruledrobot.sim.annotate`).  ``phases``: the
+    motion's phases (``Phase`` sample ranges of ``t``, e.g. a trajectory's
+    ``meta.phases``) for the caption.
     """
-    return np.stack(list(_frames(source, t, q, fps, width, height, camera)))
+    return np.stack(list(_frames(source, t, q, fps, width, height, camera, annotate, phases)))
 
 
 def render_video(
@@ -236,10 +262,13 @@ def render_video(
     camera: str | int = "cell",
     preset: str = "veryfast",
     progress: Any = None,
+    annotate: bool = True,
+    phases: Any = None,
 ) -> Path:
     """Render a motion to an MP4 file (H.264, yuv420p) at ``path``; returns the path.
 
-    Arguments as :func:`render_frames`.  Frames are streamed to ffmpeg, the
+    Arguments as :func:`render_frames` (annotated by default: cut surface, trail,
+    caption, close-up during the cut).  Frames are streamed to ffmpeg, the
     file is moved into place only when complete.  ``progress(fraction,
     "render")`` is called every 25 frames.
     """
@@ -254,7 +283,8 @@ def render_video(
         tmp_path = os.path.join(tmp, "video.mp4")
         writer = None
         try:
-            for i, frame in enumerate(_frames(source, ta, qa, fps, width, height, camera)):
+            frames = _frames(source, ta, qa, fps, width, height, camera, annotate, phases)
+            for i, frame in enumerate(frames):
                 if writer is None:
                     writer = imageio_ffmpeg.write_frames(
                         tmp_path,

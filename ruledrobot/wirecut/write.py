@@ -82,7 +82,8 @@ def write_plan(
                     scene = Scene.from_job(plan.job, robot=plan.model)
                     mo = plan.motion
                     files["video"] = render_video(scene, folder / "video.mp4", mo.timed.t,
-                                                  ver.playback.q)  # fmt: skip
+                                                  ver.playback.q,
+                                                  phases=plan.trajectory.meta.phases)  # fmt: skip
                 except RenderUnavailable as exc:
                     report.setdefault("notes", []).append(f"no video: {exc}")
     files["report"] = atomic_write_text(folder / "report.json",
