@@ -123,11 +123,9 @@ class CutAnnotator:
         self.times = times
         self.close: Any = None
         if self.cutting.any():
-            from .render import Renderer
-
             w_c = max(2 * (renderer.width // 6), 16)
             h_c = max(2 * (renderer.height // 6), 16)
-            self.close = Renderer(scene, w_c, h_c)
+            self.close = type(renderer)(scene, w_c, h_c)  # a second renderer, same kind
             self.close_camera = self._close_camera()
 
     def _close_camera(self) -> Any:
