@@ -29,7 +29,8 @@ from multiprocessing.connection import Connection
 
 import numpy as np
 
-from .run_motion import approach, run_path, stream
+from ..robot.trajectory import Heat
+from .run_motion import approach, preheat, run_path, stream
 from .run_session import Link, Session, SessionError, Stop
 
 __all__ = ["main"]
@@ -61,11 +62,22 @@ def _motion(s: Session, m: dict) -> None:
     if moved > m["moved_tolerance"]:
         raise Stop("command_failed", f"the arm moved {moved:.4f} rad since the checks: run again")
     q_grid = np.asarray(m["q_grid"])
+    heat = m.get("heat")
+    hot = None
+    if heat is not None:
+        s.link.stage("connecting IO", m["connect_timeout"])
+        s.connect_io(Heat(heat["kind"], heat["index"], heat["value"]))
+        hot = np.asarray(heat["hot"], dtype=bool)
     approach(s, q_grid[0], m["approach_speed"], m["approach_acceleration"], m["heartbeat"])
+    if hot is not None and hot[0]:  # entering a cut where it stopped: heat before moving
+        preheat(s, float(heat["preheat"]), m["heartbeat"])
     if m["mode"] == "servoj":
-        stream(s, q_grid, m["lookahead"], m["gain"], m["heartbeat"])
+        stream(s, q_grid, m["lookahead"], m["gain"], m["heartbeat"], hot)
     else:
+        if hot is not None and hot.any():
+            s.set_heat(True)
         run_path(s, q_grid, m["path_rows"], m["duration"], m["heartbeat"])
+        s.set_heat(False)
 
 
 def _run(s: Session, m: dict) -> None:

@@ -13,7 +13,7 @@ import numpy as np
 
 from .run_session import Session, Stop
 
-__all__ = ["approach", "run_path", "stream"]
+__all__ = ["approach", "preheat", "run_path", "stream"]
 
 
 def approach(
@@ -51,8 +51,29 @@ def approach(
             raise Stop("command_failed", "approach moveJ did not reach the first sample in time")
 
 
-def stream(s: Session, q_grid: np.ndarray, lookahead: float, gain: float, heartbeat: float) -> None:
-    """servoJ every controller period, monitored, then hold the last sample until settled."""
+def preheat(s: Session, seconds: float, heartbeat: float) -> None:
+    """Heat the wire and hold still ``seconds`` (a run that starts inside a heat window:
+    the resume of a cut), monitored."""
+    s.set_heat(True)
+    s.link.stage("preheat", heartbeat)
+    deadline = time.monotonic() + seconds
+    while time.monotonic() < deadline:
+        time.sleep(0.005)
+        s.kick()
+        s.poll()
+        s.service()
+
+
+def stream(
+    s: Session,
+    q_grid: np.ndarray,
+    lookahead: float,
+    gain: float,
+    heartbeat: float,
+    hot: np.ndarray | None = None,
+) -> None:
+    """servoJ every controller period, monitored, then hold the last sample until settled.
+    ``hot`` (K,): the wire's heat at each grid sample (switched where it changes)."""
     c = s.c
     dt = 1.0 / s.frequency
     K = q_grid.shape[0]
@@ -61,6 +82,8 @@ def stream(s: Session, q_grid: np.ndarray, lookahead: float, gain: float, heartb
     s.start_recording()
     s.start_clock()
     for k in range(K):
+        if hot is not None and bool(hot[k]) != s.hot:
+            s.set_heat(bool(hot[k]))
         t0 = c.initPeriod()
         if not c.servoJ(rows[k], 0.0, 0.0, dt, lookahead, gain):
             raise s.classify(f"servoJ of grid sample {k}")

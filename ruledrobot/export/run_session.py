@@ -26,6 +26,9 @@ from typing import Any
 
 import numpy as np
 
+from ..robot.trajectory import Heat
+from .heat import set_heat_rtde
+
 __all__ = ["CHUNK", "Link", "Session", "SessionError", "Stop"]
 
 #: seconds between recording chunks / heartbeats
@@ -90,6 +93,9 @@ class Session:
         self.max_latency = float(cfg["max_latency"])
         self.r: Any = None
         self.c: Any = None
+        self.io: Any = None  # rtde_io.RTDEIOInterface when the run switches the wire's heat
+        self.heat: Heat | None = None
+        self.hot = False
         self.max_dev = 0.0
         self.k_match = 0
         self.sent = 0
@@ -131,6 +137,26 @@ class Session:
             self.c = rtde_control.RTDEControlInterface(self.host, self.frequency)
         except RuntimeError as exc:
             raise SessionError(f"controller at {self.host}: control interface: {exc}") from None
+
+    def connect_io(self, heat: Heat) -> None:
+        """The IO interface that switches ``heat``; the wire starts cold."""
+        import rtde_io
+
+        try:
+            self.io = rtde_io.RTDEIOInterface(self.host)
+        except RuntimeError as exc:
+            raise SessionError(f"controller at {self.host}: IO interface: {exc}") from None
+        self.heat = heat
+        self.set_heat(False)
+
+    def set_heat(self, on: bool) -> None:
+        """Switch the wire's heat (no-op without heat); a refusal stops the run."""
+        if self.heat is None or self.io is None:
+            return
+        if not set_heat_rtde(self.io, self.heat, on):
+            raise Stop("command_failed", f"the controller refused to switch the heat "
+                       f"({self.heat.output}) {'on' if on else 'off'}")  # fmt: skip
+        self.hot = on
 
     def arm_watchdog(self) -> None:
         """The control script stops the program when no command arrives for 1/watchdog s."""
@@ -266,6 +292,12 @@ class Session:
         """servoStop / stopJ, then stopScript; each best effort, the whole within
         ``budget`` seconds (else the supervisor kills this process)."""
         self.link.stage("stopping", budget)
+        if self.hot or self.heat is not None:  # the heat first: a still wire burns the foam
+            try:
+                set_heat_rtde(self.io, self.heat, False)
+                self.hot = False
+            except Exception:
+                pass
         c = self.c
         if c is None:
             return

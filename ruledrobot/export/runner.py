@@ -37,6 +37,7 @@ from ..robot import RobotModel, load, model_for
 from ..robot.trajectory import Trajectory
 from ..robot.verdict import Check, Verdict
 from .decimate import decimate_tcp_path
+from .heat import send_heat_off
 from .limits import check_trajectory
 from .run_checks import controller_checks, kinematics_check, query_dashboard, readiness_check
 from .run_plan import (
@@ -77,6 +78,11 @@ def _validate(
     n = traj.n
     if not 0 <= start_index < n - 1:
         raise ValueError(f"start sample {start_index} outside [0, {n - 2}] for {n} samples")
+    heat = traj.meta.heat
+    if mode == "path" and heat is not None and len(heat.windows) > 1:
+        raise ValueError(f"mode path: the wire's heat ({heat.output}) is switched "
+                         f"{len(heat.windows)} times in this trajectory, a path switches it "
+                         "once (on before, off after): stream it (mode servoj)")  # fmt: skip
     return mode
 
 
@@ -355,6 +361,7 @@ def _move(
         "cog": [float(x) for x in traj.meta.payload.cog],
         "checked_q": state["q"],
         "moved_tolerance": 1e-3,
+        "heat": _heat_message(traj, k0, grid_to_input),
     }
     result.start_index = k0
     child.send("go", motion)
@@ -381,6 +388,11 @@ def _move(
                 f"{1.0 / o['watchdog']:g} s after the last command it received"
             )
         result.client = f"{out.exit}\n{out.log}".strip()
+    heat = traj.meta.heat
+    if heat is not None and result.status != "completed":
+        # the child switches the heat off on every stop it lives through; a crashed or
+        # hung client cannot, and a controller keeps its outputs when the program stops
+        result.message += "; " + send_heat_off(host, heat)
     rec = _recording(out.chunks, traj, host, mode, result)
     if result.status == "completed":
         result.stop_index, result.stop_time = n, float(traj.t[-1])
@@ -403,6 +415,16 @@ def _move(
         elif source is not None:
             result.actual_path = write_trajectory(recording_path_for(source), rec)
     return result
+
+
+def _heat_message(traj: Trajectory, k0: int, grid_to_input: np.ndarray) -> dict | None:
+    """The heat the child switches: the output and, per grid sample, on or off."""
+    heat = traj.meta.heat
+    if heat is None:
+        return None
+    on = heat.on(traj.n)[k0 + grid_to_input]
+    return {"kind": heat.kind, "index": heat.index, "value": heat.value,
+            "preheat": heat.preheat, "hot": on.tolist()}  # fmt: skip
 
 
 def _recording(

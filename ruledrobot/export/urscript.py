@@ -17,6 +17,10 @@ Sent to port 30003 (or 30001/30002) the ``def`` runs as a program; in a Script
 node of PolyScope the file only defines ``ruledrobot_cut()``, which a second
 node must call (``docs/rtde.md``).
 
+A trajectory with a heated wire (``meta.heat``) switches the heat output off at the
+start, on where a heat window begins (the pre-heat dwell before a lead-in) and off
+where it ends (after the lead-out) and at the end (:mod:`.heat`).
+
 Every mode sets the TCP and the payload from the trajectory's metadata, so the
 poses of ``movel``/``movep`` (the trajectory's TCP column) are the controller's
 TCP poses, and FK(q) · TCP equals them.  ``mode="servoj"`` streams every sample
@@ -49,6 +53,7 @@ from ..io.trajectory import write_trajectory, write_trajectory_json, write_traje
 from ..robot import model_for
 from ..robot.trajectory import Trajectory
 from .decimate import decimate_tcp_path
+from .heat import urscript_heat
 from .limits import check_trajectory
 
 __all__ = [
@@ -150,8 +155,12 @@ def urscript_program(
     meta = traj.meta
     body = io.StringIO()
     w = body.write
+    heat = meta.heat
+    on = heat.on(t.size) if heat is not None else np.zeros(t.size, dtype=bool)
     w(f"  set_tcp(p{_vec(ur_vector_from_pose(meta.tcp_offset), digits)})\n")
     w(f"  set_payload({_num(meta.payload.mass, digits)}, {_vec(meta.payload.cog, digits)})\n")
+    if heat is not None:  # cold until the first pre-heat, whatever the output was
+        w(f"  {urscript_heat(heat, False)}\n")
     w('  textmsg("ruledrobot: moving to the start")\n')
     w(f"  movej({_vec(q[0], digits)}, a={_num(approach_acceleration, digits)}, "
       f"v={_num(approach_speed, digits)})\n")  # fmt: skip
@@ -161,7 +170,11 @@ def urscript_program(
         settle = max(period, 5.0 * lookahead)
         dts = np.append(np.diff(t), settle) if t.size > 1 else np.array([settle])
         la, g = _num(lookahead, digits), _num(gain, digits)
-        for qk, dt in zip(q, dts, strict=True):
+        was = False
+        for k, (qk, dt) in enumerate(zip(q, dts, strict=True)):
+            if heat is not None and on[k] != was:
+                w(f"  {urscript_heat(heat, bool(on[k]))}\n")
+                was = bool(on[k])
             w(f"  servoj({_vec(qk, digits)}, t={_num(dt, digits)}, lookahead_time={la}, "
               f"gain={g})\n")  # fmt: skip
         w("  stopj(2.0)\n")
@@ -169,17 +182,28 @@ def urscript_program(
     else:
         tcp = traj.tcp
         keep = decimate_tcp_path(tcp, tolerance, angle_tolerance)
+        if heat is not None:  # every switch of the heat at a waypoint of its own
+            edges = np.flatnonzero(np.diff(on.astype(np.int8))) + 1
+            keep = np.union1d(keep, np.r_[edges - 1, edges].clip(0, t.size - 1))
         p = tcp[:, :3]
         arc = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(p, axis=0), axis=1))]
         lengths = np.diff(arc[keep])
+        was = bool(on[0])
+        if was:
+            w(f"  {urscript_heat(heat, True)}\n")
         for n, k in enumerate(keep[1:], start=1):
             i = keep[n - 1]
+            if heat is not None and bool(on[k]) != was:
+                w(f"  {urscript_heat(heat, bool(on[k]))}\n")
+                was = bool(on[k])
             L = float(lengths[n - 1])
             v = float(np.clip(L / max(t[k] - t[i], 1e-6), 1e-4, 3.0))
             r = min(blend, 0.45 * L, 0.45 * float(lengths[n])) if n < len(keep) - 1 else 0.0
             w(f"  {mode}(p{_vec(tcp[k], digits)}, a={_num(acceleration, digits)}, "
               f"v={_num(v, digits)}, r={_num(max(r, 0.0), digits)})\n")  # fmt: skip
         motion_lines = len(keep) - 1
+    if heat is not None:
+        w(f"  {urscript_heat(heat, False)}\n")
     w('  textmsg("ruledrobot: done")\n')
     size = body.tell()
     if not allow_long and (motion_lines > MAX_MOTION_LINES or size > MAX_PROGRAM_BYTES):

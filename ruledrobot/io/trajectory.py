@@ -16,7 +16,8 @@ line, then one row per controller period, and nothing else (``csv.reader`` and
      "base": [...],                                   # robot base in the job's world
      "phases": [{"name": "approach", "start": 0, "stop": 812}, ...],
      "in_stock": [[1200, 9800]],
-     "heat": {"output": "standard:0", "value": 1.0, "windows": [[1100, 9900]]},   # or null
+     "heat": {"output": "standard:0", "value": 1.0, "preheat_s": 2.0,
+              "windows": [[1100, 9900]]},                # or null
      "job": {"path": "job.toml", "sha256": "..."}, "source": "ruledrobot plan",
      "csv": "trajectory.csv", "csv_sha256": "...", "samples": 12925}
 
@@ -99,7 +100,7 @@ def meta_to_dict(meta: TrajectoryMeta) -> dict[str, Any]:
         "in_stock": [list(r) for r in meta.in_stock],
         "heat": None if meta.heat is None else {
             "output": meta.heat.output, "value": meta.heat.value,
-            "windows": [list(w) for w in meta.heat.windows],
+            "preheat_s": meta.heat.preheat, "windows": [list(w) for w in meta.heat.windows],
         },
         "job": meta.job,
         "source": meta.source,
@@ -151,7 +152,8 @@ def _heat(d: _Doc) -> Heat | None:
     if not index.isdigit():
         raise d.fail("heat.output", f"expected KIND:N, got {h['output']!r}")
     try:
-        return Heat(kind, int(index), float(h.get("value", 1.0)), tuple(map(tuple, wins)))
+        return Heat(kind, int(index), float(h.get("value", 1.0)), tuple(map(tuple, wins)),
+                    float(h.get("preheat_s", 0.0)))
     except (TypeError, ValueError) as exc:
         raise d.fail("heat", str(exc)) from None
 

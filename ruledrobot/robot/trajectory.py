@@ -151,13 +151,16 @@ class Heat:
     ``kind`` ``"standard"``, ``"configurable"`` or ``"tool"`` (a digital output, on =
     True) or ``"analog"`` (standard analog output ``index`` at ``value``, a fraction of
     its range; off = 0); ``windows``: half-open sample ranges ``(start, stop)`` with the
-    heat on — from the start of a pre-heat dwell to the end of a lead-out.
+    heat on — from the start of a pre-heat dwell to the end of a lead-out; ``preheat``:
+    the seconds the wire heats before it moves into the stock (a run resumed inside a
+    window heats that long before it moves).
     """
 
     kind: str
     index: int
     value: float = 1.0
     windows: tuple[tuple[int, int], ...] = ()
+    preheat: float = 0.0
 
     def __post_init__(self) -> None:
         if self.kind not in HEAT_OUTPUT_KINDS:
@@ -171,6 +174,9 @@ class Heat:
         if not 0.0 <= float(self.value) <= 1.0:
             raise ValueError(f"heat.value: expected a fraction in [0, 1], got {self.value!r}")
         object.__setattr__(self, "value", float(self.value))
+        if not float(self.preheat) >= 0.0:
+            raise ValueError(f"heat.preheat: expected seconds >= 0, got {self.preheat!r}")
+        object.__setattr__(self, "preheat", float(self.preheat))
         wins = tuple((int(a), int(b)) for a, b in self.windows)
         for a, b in wins:
             if not 0 <= a < b:

@@ -157,6 +157,10 @@ class Controller:
         self.conf_do = 0
         self.tool_do = 0
         self.analog_out = [0.0, 0.0]
+        #: every change of the outputs: (controller time [s], standard, configurable and
+        #: tool digital output bits, standard analog outputs 0 and 1 [fraction])
+        self.io_log: deque[tuple[float, int, int, int, float, float]] = deque(maxlen=100_000)
+        self._io_last: tuple[int, int, int, float, float] = (0, 0, 0, 0.0, 0.0)
         self.popup: str | None = None  # the pendant's popup (compile errors, popup())
         self.compile_error: CompileError | None = None  # the last program refused
         self.last_input_names: frozenset[str] = frozenset()
@@ -357,6 +361,7 @@ class Controller:
                     if m & (1 << k):
                         x = float(values.get(f"standard_analog_output_{k}", 0.0))  # type: ignore[arg-type]
                         self.analog_out[k] = min(max(x, 0.0), 1.0)
+            self._note_io()
 
     def set_digital_out(self, kind: str, n: int, value: bool) -> None:
         """A digital output: ``kind`` ``"standard"`` (pins 0-7), ``"configurable"`` (0-7)
@@ -375,6 +380,7 @@ class Controller:
                 self.tool_do = (self.tool_do | bit) if value else (self.tool_do & ~bit)
             else:
                 self.std_do = (self.std_do | bit) if value else (self.std_do & ~bit)
+            self._note_io()
 
     def set_analog_out(self, n: int, fraction: float) -> None:
         """Standard analog output ``n`` (0-1) to ``fraction`` (0..1 of its range)."""
@@ -385,6 +391,14 @@ class Controller:
             raise ValueError(f"standard analog output {n}: value must be in [0, 1], got {f!r}")
         with self.lock:
             self.analog_out[n] = f
+            self._note_io()
+
+    def _note_io(self) -> None:
+        """Append the outputs to :attr:`io_log` when they changed (caller holds the lock)."""
+        now = (self.std_do, self.conf_do, self.tool_do, self.analog_out[0], self.analog_out[1])
+        if now != self._io_last:
+            self._io_last = now
+            self.io_log.append((self.time, *now))
 
     def set_payload(self, mass: float | None, cog: ArrayLike | None) -> None:
         """Payload mass [kg] and centre of gravity [m] (flange frame); None keeps the value."""

@@ -60,6 +60,7 @@ _CALLS = frozenset(
 )
 _PROPS = frozenset(
     {
+        "io_log",
         "actual_q",
         "tcp_pose",
         "robot_mode",
@@ -368,6 +369,13 @@ class Emulator:
     def events(self) -> list[tuple[float, int, str]]:
         """The controller's log: (controller time, level, message)."""
         return list(self._call("events"))
+
+    @property
+    def io_log(self) -> list[tuple[float, int, int, int, float, float]]:
+        """Every change of the outputs: (controller time [s], standard, configurable and
+        tool digital output bits, standard analog outputs 0 and 1 [fraction]) — what a
+        test reads to see when the wire was hot."""
+        return list(self._call("io_log"))
 
     def reset_stats(self) -> None:
         """Forget the clock's timing so far (measure one phase of a test)."""

@@ -509,6 +509,13 @@ class ThreadedEmulator:
             return list(self.controller.events)
 
     @property
+    def io_log(self) -> list[tuple[float, int, int, int, float, float]]:
+        """Every change of the outputs: (controller time [s], standard, configurable and
+        tool digital output bits, standard analog outputs 0 and 1 [fraction])."""
+        with self.controller.lock:
+            return list(self.controller.io_log)
+
+    @property
     def ports(self) -> dict[str, int]:
         """The bound ports: ``{"rtde": ..., "dashboard": ..., "script": ..., "primary": ...,
         "secondary": ...}``."""

@@ -40,22 +40,16 @@ class Cell:
     margin: float
     singular_min: float
     q_start: FloatArray | None
+    hub: FloatArray | None = None  # (2, 3) the hub's axis in the flange frame
+    hub_radius: float = 0.0
 
     @classmethod
     def of(cls, model, tool: ToolSpec, stock: Box, table_z, margin, singular_min, q_start):
         bow = BowTool.from_spec(tool)
         wire = np.array([bow.wire_start, bow.wire_end])
-        return cls(
-            model,
-            wire_frame(tool),
-            bow.segments(),
-            wire,
-            stock,
-            table_z,
-            margin,
-            singular_min,
-            q_start,
-        )
+        hub = np.array([[0.0, 0.0, 0.0], [0.0, 0.0, bow.hub_length]])
+        return cls(model, wire_frame(tool), bow.segments(), wire, stock, table_z, margin,
+                   singular_min, q_start, hub, bow.hub_radius)  # fmt: skip
 
 
 def clearance(cell: Cell, q: FloatArray, P: FloatArray) -> dict[str, np.ndarray]:
@@ -74,8 +68,12 @@ def clearance(cell: Cell, q: FloatArray, P: FloatArray) -> dict[str, np.ndarray]
     w = np.einsum("nij,kej->nkei", Pf[:, :3, :3], rods) + Pf[:, None, None, :3, 3]
     ends, radius, body = arm_capsules(model, qf)  # (n, S, 2, 3), (S,), (S,)
     n = len(qf)
+    bow_in_stock = stock.segment_hits(w[:, :3, 0], w[:, :3, 1], margin).any(axis=1)
+    if cell.hub is not None:  # the hub on the flange: a short cylinder, as a capsule
+        h = np.einsum("nij,ej->nei", Pf[:, :3, :3], cell.hub) + Pf[:, None, :3, 3]
+        bow_in_stock |= stock.segment_hits(h[:, 0], h[:, 1], margin + cell.hub_radius)
     out = {
-        "bow hits the stock": stock.segment_hits(w[:, :3, 0], w[:, :3, 1], margin).any(axis=1),
+        "bow hits the stock": bow_in_stock,
         "arm hits the stock": np.zeros(n, bool),
         "bow or wire hits the arm": np.zeros(n, bool),
         "bow below the table": np.zeros(n, bool),

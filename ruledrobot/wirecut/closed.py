@@ -2,10 +2,13 @@
 
 A closed sequence of rulings (a column, a band, a Möbius strip) has no ends to
 lead in from.  The wire enters at one ruling through a **slit**: a straight move
-normal to the ruling, from ``lead_in`` beyond the stock to the surface, on the
-waste side (outwards when no side is kept).  It then follows the loop back to
-that ruling — the cut closes on its start (after a loop with a flip, the wire is
-reversed end for end) — and leaves through the slit.
+along the loop's tangent there (the direction the wire is about to move in), from
+``lead_in`` beyond the stock — a tangent of a convex loop runs outside it, in the
+waste of a kept inside.  It then follows the loop back to that ruling — the cut
+closes on its start (after a loop with a flip, the wire is reversed end for end) —
+and leaves straight on along the tangent.  Entering and leaving along the tangent
+keeps the wire moving at the feed through the corner a slit normal to the surface
+would make (a wire that stops in the foam melts a wider kerf there).
 
 **One pass** is tried first, from the slit positions in order of their length
 (a short slit removes the least material): the redundancy search (roll, slide,
@@ -25,7 +28,7 @@ import numpy as np
 from ..geometry.box import Box
 from ..geometry.checks import FloatArray
 from .cutpath import CutPath, RefinedCut
-from .kerf import KerfOffsets, ruling_normals, waste_sign
+from .kerf import KerfOffsets
 from .redundancy import solve_redundancy
 from .spec import CutSpec, Job
 from .toolpath import chords
@@ -36,6 +39,24 @@ __all__ = ["loop_paths", "slit_direction"]
 CANDIDATES = 6
 #: spacing of the slit's frames [m]
 SLIT_STEP = 0.002
+
+
+def world_referenced(F: FloatArray) -> FloatArray:
+    """The frames turned about their z axes so that x points, as nearly as it can, along
+    one world axis — the one the rulings are most nearly normal to.  A constant roll
+    relative to these frames keeps the bow's attitude in the world as the wire goes
+    round: relative to the DH frames, which turn once with the loop, it would turn the
+    bow a full turn about the wire, through the stock and the table."""
+    z = F[:, :3, 2]
+    axis = int(np.argmin(np.abs(z).mean(axis=0)))
+    v = np.zeros(3)
+    v[axis] = 1.0
+    x = v - (z @ v)[:, None] * z
+    x /= np.linalg.norm(x, axis=1, keepdims=True)
+    out = F.copy()
+    out[:, :3, 0] = x
+    out[:, :3, 1] = np.cross(z, x)
+    return out
 
 
 def _flipped(F: FloatArray) -> FloatArray:
@@ -60,57 +81,53 @@ def _loop(F: FloatArray, flip: bool, start: int, direction: int, length: int) ->
     return out
 
 
-def slit_direction(
-    frames: FloatArray, i: int, stock: Box, keep, closed: bool = True
-) -> FloatArray:
-    """Unit direction (3,) of the slit at ruling ``i``: the surface normal at the chord's
-    middle, normal to the ruling, pointing into the waste (outwards from the loop's
-    centre when ``keep`` is None)."""
+def slit_direction(frames: FloatArray, i: int, stock: Box) -> FloatArray:
+    """Unit direction (3,) the wire moves in at ruling ``i`` of a closed sequence: the
+    tangent of the chord midpoints' loop there, normal to the ruling (central
+    differences, periodic)."""
     c0, c1, hit = chords(frames, stock)
     t = np.where(hit, 0.5 * (c0 + c1), 0.0)[:, None]
-    n = ruling_normals(frames, t, closed)[:, 0]
-    if keep is None:
-        mid = frames[:, :3, 3] + t * frames[:, :3, 2]
-        centre = mid[hit].mean(axis=0)
-        sign = 1.0 if float((mid[i] - centre) @ n[i]) > 0.0 else -1.0
-    else:
-        sign = waste_sign(frames, stock, keep, closed)
-    d = sign * n[i]
+    mid = frames[:, :3, 3] + t * frames[:, :3, 2]
+    M = len(frames)
+    d = mid[(i + 1) % M] - mid[(i - 1) % M]
     z = frames[i, :3, 2]
     d = d - (d @ z) * z
     return d / np.linalg.norm(d)
 
 
 def _slit(frame: FloatArray, direction: FloatArray, stock: Box, lead: float) -> FloatArray:
-    """Frames (K, 4, 4) from outside the stock (clear by ``lead``) to ``frame``, moving
-    along ``-direction``."""
+    """Frames (K, 4, 4) from outside the stock (clear by ``lead``) to ``frame``, the
+    wire moving along ``direction`` (from ``frame - dist * direction``)."""
     grown = Box(stock.centre, stock.size + 2.0 * lead, stock.rotation)
     o, z = frame[:3, 3], frame[:3, 2]
     dist = 0.0
-    while grown.clip_lines((o + dist * direction)[None], z[None])[2][0]:
+    while grown.clip_lines((o - dist * direction)[None], z[None])[2][0]:
         dist += SLIT_STEP
         if dist > 10.0:
             raise ValueError("slit: the ruling does not leave the stock along the normal")
     n = max(2, int(np.ceil(dist / SLIT_STEP)) + 1)
     out = np.repeat(frame[None], n, axis=0)
-    out[:, :3, 3] = o + np.linspace(dist, 0.0, n)[:, None] * direction
+    out[:, :3, 3] = o - np.linspace(dist, 0.0, n)[:, None] * direction
     return out
 
 
 def _pass(job: Job, cut: CutSpec, model, rc: RefinedCut, loop_frames: FloatArray,
-          loop_surface: FloatArray, loop_err: FloatArray, slit: FloatArray, name: str,
-          notes: tuple[str, ...], compensated: bool, **search) -> CutPath:  # fmt: skip
-    back = slit[::-1]
-    back_surface = back.copy()
-    back_surface[:, :3, 3] += loop_surface[-1, :3, 3] - loop_frames[-1, :3, 3]
-    front_surface = slit.copy()
-    front_surface[:, :3, 3] += loop_surface[0, :3, 3] - loop_frames[0, :3, 3]
-    F = np.concatenate([slit[:-1], loop_frames, back[1:]])
-    S = np.concatenate([front_surface[:-1], loop_surface, back_surface[1:]])
-    err = np.r_[np.zeros(len(slit) - 1), loop_err, np.zeros(len(back) - 1)]
+          loop_surface: FloatArray, loop_err: FloatArray, slit: FloatArray, exit_: FloatArray,
+          name: str, notes: tuple[str, ...], compensated: bool, **search) -> CutPath:  # fmt: skip
+    """Slit in, the loop's frames, slit out, as one pass through the redundancy search;
+    the target of the slits' frames is the wire's own line (they cut waste)."""
+    F = np.concatenate([slit[:-1], loop_frames, exit_[1:]])
+    S = np.concatenate([slit[:-1], loop_surface, exit_[1:]])
+    err = np.r_[np.zeros(len(slit) - 1), loop_err, np.zeros(len(exit_) - 1)]
     motion = solve_redundancy(F, job.stock, job.tool, model, **search)
-    return CutPath(F, motion, rc.steps, (len(slit) - 1, len(back) - 1), rc.input_rulings,
+    return CutPath(F, motion, rc.steps, (len(slit) - 1, len(exit_) - 1), rc.input_rulings,
                    name, S, err, compensated, True, notes)  # fmt: skip
+
+
+def _exit(frame: FloatArray, direction: FloatArray, stock: Box, lead: float) -> FloatArray:
+    """Frames (K, 4, 4) from ``frame`` straight on along ``direction`` until the wire is
+    clear of the stock by ``lead``."""
+    return _slit(frame, -direction, stock, lead)[::-1]
 
 
 def loop_paths(
@@ -124,44 +141,52 @@ def loop_paths(
 ) -> list[CutPath]:
     """The passes of a closed cut (module doc): one, or two that meet opposite the slit."""
     M = wire.shape[0]
-    S = rc.frames
+    wire = world_referenced(wire)
+    S = world_referenced(rc.frames)
     _, _, hit = chords(wire, job.stock)
     if not hit.any():
         raise ValueError(f"cut '{cut.name}': no ruling of the closed surface crosses the stock")
     cand = np.flatnonzero(hit)
     slits = {}
     for i in cand[:: max(1, cand.size // (4 * CANDIDATES))]:
-        d = slit_direction(S, int(i), job.stock, cut.keep)
-        slits[int(i)] = (_slit(wire[i], d, job.stock, cut.lead_in), d)
-    order = sorted(slits, key=lambda i: len(slits[i][0]))
+        d = slit_direction(wire, int(i), job.stock)
+        ahead = _loop(wire, rc.flip, int(i), 1, M)[-1]
+        slits[int(i)] = (_slit(wire[i], d, job.stock, cut.lead_in),
+                         _exit(ahead, d, job.stock, cut.lead_out), d)  # fmt: skip
+    order = sorted(slits, key=lambda i: len(slits[i][0]) + len(slits[i][1]))
     tried = order[:CANDIDATES]
     best = None
     for i in tried:
-        slit, _ = slits[i]
+        entry, exit_, _ = slits[i]
         lf = _loop(wire, rc.flip, i, 1, M)
         ls = _loop(S, rc.flip, i, 1, M)
         le = kerf.error[np.mod(i + np.arange(M + 1), M)]
-        cp = _pass(job, cut, model, rc, lf, ls, le, slit, cut.name,
-                   (f"closed: one pass round the loop, slit at ruling {i}",), kerf.compensated,
-                   **search)  # fmt: skip
+        cp = _pass(job, cut, model, rc, lf, ls, le, entry, exit_, cut.name,
+                   (f"closed: one pass round the loop, entered and left along the tangent at "
+                    f"ruling {i}",), kerf.compensated, **search)  # fmt: skip
         if cp.feasible:
             return [cp]
         best = best or cp
     i = tried[0]
-    slit, _ = slits[i]
+    entry, exit_, d = slits[i]
     half = M // 2
     why = "; ".join(best.motion.reasons) if best is not None else ""
-    note = (f"closed: no single pass round the loop works from {len(tried)} slit positions "
-            f"({why}); cut in two passes from the slit at ruling {i}, meeting opposite it")
+    note = (f"closed: no single pass round the loop works from {len(tried)} entry rulings "
+            f"({why}); cut in two passes from ruling {i}, meeting opposite it: each goes out "
+            "and back along its own kerf (the wire turns round in the foam at the meeting "
+            "ruling)")
     passes = []
-    for n_pass, (direction, length) in enumerate(((1, half), (-1, M - half))):
+    # forward: in along the tangent, round to the meeting ruling, back, out the way it came;
+    # backward: in from the other side (the forward pass's way out), round the other way
+    for n_pass, (direction, length, way) in enumerate(((1, half, entry),
+                                                       (-1, M - half, exit_[::-1]))):  # fmt: skip
         out = _loop(wire, rc.flip, i, direction, length)
         out_s = _loop(S, rc.flip, i, direction, length)
         idx = np.mod(i + direction * np.arange(length + 1), M)
         lf = np.concatenate([out, out[-2::-1]])  # there and back along its own kerf
         ls = np.concatenate([out_s, out_s[-2::-1]])
         le = np.r_[kerf.error[idx], kerf.error[idx][-2::-1]]
-        passes.append(_pass(job, cut, model, rc, lf, ls, le, slit,
+        passes.append(_pass(job, cut, model, rc, lf, ls, le, way, way[::-1],
                             cut.name, (note,) if n_pass == 0 else (), kerf.compensated,
                             **search))  # fmt: skip
     return passes

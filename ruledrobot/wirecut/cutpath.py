@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+import numpy as np
+
 from ..geometry.checks import FloatArray
 from .redundancy import RedundancyResult
 
@@ -16,7 +18,10 @@ class CutPath:
 
     ``frames`` are the wire's rulings (kerf-compensated), ``surface_frames`` the
     target surface's rulings at the same samples (equal when not compensated),
-    ``kerf_error`` (M,) the predicted error [m] of the kept surface there.
+    ``kerf_error`` (M,) the predicted error [m] of the kept surface there.  ``param``
+    (M,): the path parameter of the rulings, increasing (None: 0, 1, ..., M - 1; a
+    ruling added halfway between two gets the mean of theirs, so that the parameter
+    stays proportional to the distance along the surface).
     """
 
     frames: FloatArray = field(repr=False)
@@ -30,6 +35,20 @@ class CutPath:
     compensated: bool = False
     closed: bool = False
     notes: tuple[str, ...] = ()
+    param: FloatArray | None = field(default=None, repr=False)
+
+    @property
+    def s(self) -> FloatArray:
+        """(M,) the rulings' path parameter (see ``param``)."""
+        return np.arange(len(self.frames), dtype=np.float64) if self.param is None else self.param
+
+    def locate(self, s: FloatArray) -> tuple[np.ndarray, FloatArray]:
+        """For path parameters ``s`` (K,): the ruling before each (K,) int, clipped to
+        ``0 .. M - 2``, and the fraction (K,) of the way to the next."""
+        p = self.s
+        i0 = np.clip(np.searchsorted(p, s, side="right") - 1, 0, len(p) - 2)
+        frac = np.clip((np.asarray(s) - p[i0]) / (p[i0 + 1] - p[i0]), 0.0, 1.0)
+        return i0, frac
 
     @property
     def feasible(self) -> bool:

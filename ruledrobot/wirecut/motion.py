@@ -17,6 +17,7 @@ moves to and from the lifted poses), ``retract`` (after the last pass).
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -24,6 +25,7 @@ import numpy as np
 from ..geometry.angles import wrap_near
 from ..geometry.checks import FloatArray
 from ..geometry.interp import interp_linear
+from .densify import densified, pass_deviation, pass_feed_error, uneven_intervals
 from .path import CutPath, chord_ends_in_flange
 from .spec import Job
 from .timing import TimedPath, concatenate, dwell, joint_move, time_path
@@ -33,6 +35,10 @@ from .transit import TransitPlanner
 __all__ = ["LIFT", "Motion", "assemble_motion"]
 
 LIFT = 0.1  # m: approach from / retract to this far beyond the lead-in/out pose
+#: rounds of adding rulings where the timed wire leaves the surface or its feed strays,
+#: and the share of the cut's wire and feed tolerances that triggers it (:mod:`.densify`)
+DENSIFY_ROUNDS = 3
+DENSIFY_SHARE = 0.25
 
 
 @dataclass(frozen=True, eq=False)
@@ -46,6 +52,7 @@ class Motion:
     the chord ends as points of the wire in the flange frame (0 outside the stock).
     ``heat`` (M,): the wire is hot (pre-heat, lead-in, cut, lead-out) when the tool
     switches heat, else all False.  ``notes``: what the assembly decided (transits).
+    ``passes``: the passes as timed (with the rulings :mod:`.densify` added).
     """
 
     timed: TimedPath = field(repr=False)
@@ -56,6 +63,7 @@ class Motion:
     ends: FloatArray = field(repr=False)
     heat: np.ndarray = field(repr=False)
     notes: tuple[str, ...] = ()
+    passes: tuple[CutPath, ...] = field(default=(), repr=False)
 
 
 def _fill_nearest(values: FloatArray, valid: np.ndarray) -> FloatArray:
@@ -83,6 +91,27 @@ def _backed_off(model, q: FloatArray, away: FloatArray, dist: float) -> FloatArr
     return best if model.within_limits(best) else None
 
 
+def _free_pose(
+    transit: TransitPlanner, model, q: FloatArray, away: FloatArray
+) -> FloatArray | None:
+    """A pose near ``q`` clear of the stock, the table and the arm, to enter a pass from
+    or leave it to: ``LIFT`` (then twice that) further along ``away``, else raised over
+    the stock; None when none of them is free."""
+    for cand in (_backed_off(model, q, away, LIFT), _backed_off(model, q, away, 2.0 * LIFT),
+                 transit.lifted(q)):  # fmt: skip
+        if cand is not None and transit.free(cand).all():
+            return cand
+    return None
+
+
+def _legs(transit: TransitPlanner, here: FloatArray, entry: FloatArray | None,
+          start: FloatArray, notes: list[str], what: str):  # fmt: skip
+    """Joint moves from ``here`` through ``entry`` (if any) to the pass's first pose."""
+    if entry is None:
+        return transit.route(here, start, notes, what)
+    return transit.route(here, entry, notes, what) + transit.route(entry, start, notes, what)
+
+
 @dataclass
 class _Builder:
     """Collects timed parts with their labels and pass indices."""
@@ -96,17 +125,57 @@ class _Builder:
         self.kinds.append((label, pass_index))
 
 
-def _pass_timing(job: Job, model, cp: CutPath, vel, acc, dt) -> tuple[TimedPath, FloatArray]:
-    cut = next(c for c in job.cuts if c.name == cp.name)
+def _wire_arclength(cp: CutPath) -> FloatArray:
+    """(M,) the distance [m] travelled along the pass by its fastest chord end (the wire's
+    midpoint where no chord exists), from 0: the path parameter the feed is held in.
+
+    With it the speed factor is about 1 everywhere in the stock; the time law bounds the
+    feed with the largest speed factor around each node, so uneven ruling spacing — a
+    subdivided polygon, a slit meeting a loop — would otherwise pull the feed below the
+    set value by the unevenness."""
     m = cp.motion
-    s = np.arange(len(cp.frames), dtype=np.float64)
-    ends = chord_ends_in_flange(cp)
-    sf = speed_factor(m.flange, s, ends, m.hit)
-    return time_path(s, m.q, sf, cut.feed_speed, vel, acc, dt), ends
+    F = cp.frames
+    c = np.nan_to_num(m.chord)
+    ends = F[:, None, :3, 3] + c[:, :, None] * F[:, None, :3, 2]
+    step_ends = np.linalg.norm(np.diff(ends, axis=0), axis=-1).max(axis=1)
+    mid = F[:, :3, 3] + (0.5 * c.sum(axis=1))[:, None] * F[:, :3, 2]
+    step_mid = np.linalg.norm(np.diff(mid, axis=0), axis=-1)
+    both = m.hit[:-1] & m.hit[1:]
+    step = np.where(both, step_ends, step_mid)
+    step = np.maximum(step, 1e-9)  # strictly increasing, also where the wire holds still
+    return np.r_[0.0, np.cumsum(step)]
+
+
+def _pass_timing(
+    job: Job, model, cp: CutPath, vel, acc, dt
+) -> tuple[CutPath, TimedPath, FloatArray]:
+    """The pass timed at its feed, with rulings added where the timed wire leaves the
+    surface between them (:mod:`.densify`); returns the (denser) pass too."""
+    cut = next(c for c in job.cuts if c.name == cp.name)
+    cp = dataclasses.replace(cp, param=_wire_arclength(cp))
+    for attempt in range(DENSIFY_ROUNDS + 1):
+        m = cp.motion
+        s = cp.s
+        ends = chord_ends_in_flange(cp)
+        sf = speed_factor(m.flange, s, ends, m.hit)
+        timed = time_path(s, m.q, sf, cut.feed_speed, vel, acc, dt)
+        if attempt == DENSIFY_ROUNDS:
+            break
+        dev = pass_deviation(cp, timed, model, ends)
+        feed = pass_feed_error(cp, timed, model, ends, cut.feed_speed)
+        bad = np.flatnonzero((dev > DENSIFY_SHARE * cut.wire_tolerance)
+                             | (feed > DENSIFY_SHARE * cut.feed_tolerance))  # fmt: skip
+        bad = np.union1d(bad, uneven_intervals(cp, DENSIFY_SHARE * cut.feed_tolerance))
+        if not bad.size:
+            break
+        cp = densified(cp, bad, model, job.tool, job.stock)
+    return cp, timed, ends
 
 
 def assemble_motion(job: Job, model, passes: list[CutPath]) -> Motion:
-    """Time the passes and join them with approach, pre-heat, transits and retract."""
+    """Time the passes and join them with approach, pre-heat, transits and retract
+    (``Motion.passes`` are the passes as timed)."""
+    passes = list(passes)
     dt = float(model.control_period)
     vel = model.max_velocity * job.robot.speed_scale
     acc = model.max_acceleration if job.robot.acceleration is None else job.robot.acceleration
@@ -115,8 +184,9 @@ def assemble_motion(job: Job, model, passes: list[CutPath]) -> Motion:
     b = _Builder(dt)
     notes: list[str] = []
     timed_passes = []
-    for cp in passes:
-        timed_passes.append(_pass_timing(job, model, cp, vel, acc, dt))
+    for k, cp in enumerate(passes):
+        passes[k], timed, ends = _pass_timing(job, model, cp, vel, acc, dt)
+        timed_passes.append((timed, ends))
     here: FloatArray | None = None
     if job.robot.home is not None:
         here = np.asarray(job.robot.home, dtype=np.float64)
@@ -128,24 +198,23 @@ def assemble_motion(job: Job, model, passes: list[CutPath]) -> Motion:
         mids = (m.flange @ W)[[0, -1], :3, 3]
         away = mids - job.stock.centre
         away /= np.linalg.norm(away, axis=1, keepdims=True)
-        above_start = _backed_off(model, start, away[0], LIFT)
         label = "approach" if k == 0 else "transit"
-        entry = start if above_start is None else above_start
-        if here is not None:
-            if k == 0:  # home: the whole turns nearest the first pass
-                here = wrap_near(here, entry)
-            for qa, qb in transit.route(here, entry, notes, f"to {cp.name}"):
-                b.add(joint_move(qa, qb, vel, acc, dt, slow), label)
-        if above_start is not None:
-            b.add(joint_move(above_start, start, vel, acc, dt, slow), label)
+        entry = _free_pose(transit, model, start, away[0])
+        if here is None:  # no home: the trajectory starts clear of the stock, near the cut
+            here = start if entry is None else entry
+        elif k == 0:  # home: the whole turns nearest the first pass
+            here = wrap_near(here, start if entry is None else entry)
+        for qa, qb in _legs(transit, here, entry, start, notes, f"to {cp.name}"):
+            b.add(joint_move(qa, qb, vel, acc, dt, slow), label)
         if job.tool.heat is not None and job.tool.heat.preheat > 0:
             b.add(dwell(start, job.tool.heat.preheat, vel, acc, dt), "preheat", k)
         b.add(timed, "pass", k)
-        above_end = _backed_off(model, end, away[1], LIFT)
+        leave = _free_pose(transit, model, end, away[1])
         last = k == len(passes) - 1
-        if above_end is not None:
-            b.add(joint_move(end, above_end, vel, acc, dt, slow), "retract" if last else "transit")
-        here = end if above_end is None else above_end
+        if leave is not None:
+            for qa, qb in transit.route(end, leave, notes, f"from {cp.name}"):
+                b.add(joint_move(qa, qb, vel, acc, dt, slow), "retract" if last else "transit")
+        here = end if leave is None else leave
     if job.robot.home is not None and here is not None:
         home = wrap_near(job.robot.home, here)
         for qa, qb in transit.route(here, home, notes, "home"):
@@ -173,20 +242,18 @@ def _label(job, whole: TimedPath, b: _Builder, passes, timed_passes, notes) -> M
             continue
         cp, (_, cp_ends) = passes[k], timed_passes[k]
         idx = np.flatnonzero(rows)
-        # the pass's own parameter: its s_of_t restarts at 0 (the part drops no first
-        # sample when it is the first part; otherwise the dropped one is its s = 0)
-        s_k = whole.s_of_t[idx] - whole.s_of_t[idx[0]]
+        # the pass's own parameter: its s_of_t starts at cp.s[0] (the part drops no first
+        # sample when it is the first part; otherwise the dropped one is its start)
+        s_k = whole.s_of_t[idx] - whole.s_of_t[idx[0]] + cp.s[0]
         if i > 0:
             s_k = s_k + (b.parts[i].s_of_t[1] - b.parts[i].s_of_t[0])
-        n = len(cp.frames)
-        s_k = np.clip(s_k, 0.0, n - 1.0)
-        i0 = np.clip(np.floor(s_k).astype(int), 0, n - 2)
+        s_k = np.clip(s_k, cp.s[0], cp.s[-1])
+        i0, _ = cp.locate(s_k)
         hit = cp.motion.hit[i0] & cp.motion.hit[i0 + 1]
         pass_of[idx] = k
         s[idx] = s_k
         in_stock[idx] = hit
-        ends[idx] = interp_linear(s_k, np.arange(n, dtype=float),
-                                  _fill_nearest(cp_ends, cp.motion.hit))  # fmt: skip
+        ends[idx] = interp_linear(s_k, cp.s, _fill_nearest(cp_ends, cp.motion.hit))
         h = np.flatnonzero(hit)
         lab = np.full(idx.size, "lead_in", dtype=object)
         if h.size:
@@ -196,4 +263,4 @@ def _label(job, whole: TimedPath, b: _Builder, passes, timed_passes, notes) -> M
     heat = np.zeros(M, dtype=bool)
     if job.tool.heat is not None:
         heat = np.isin(labels.astype(str), ("preheat", "lead_in", "cut", "lead_out"))
-    return Motion(whole, labels, pass_of, s, in_stock, ends, heat, tuple(notes))
+    return Motion(whole, labels, pass_of, s, in_stock, ends, heat, tuple(notes), tuple(passes))

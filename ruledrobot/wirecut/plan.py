@@ -91,9 +91,8 @@ def wire_deviation(plan: Plan, q: FloatArray) -> FloatArray:
         rows = np.flatnonzero((mo.pass_of == k) & mo.in_stock)
         if not rows.size:
             continue
-        s = mo.s[rows]
-        i0 = np.clip(np.floor(s).astype(int), 0, len(cp.frames) - 2)
-        target = se3.geodesic(cp.frames[i0], cp.frames[i0 + 1], s - i0)
+        i0, frac = cp.locate(mo.s[rows])
+        target = se3.geodesic(cp.frames[i0], cp.frames[i0 + 1], frac)
         off = wire_points(flange[rows], mo.ends[rows]) - target[:, None, :3, 3]
         dist = np.linalg.norm(np.cross(off, target[:, None, :3, 2]), axis=-1).max(axis=1)
         out[rows] = dist
@@ -135,7 +134,7 @@ def _heat(job: Job, motion: Motion) -> Heat | None:
     h = job.tool.heat
     if h is None:
         return None
-    return Heat(h.kind, h.index, h.value, runs(motion.heat))
+    return Heat(h.kind, h.index, h.value, runs(motion.heat), h.preheat)
 
 
 def make_plan(
@@ -162,6 +161,7 @@ def make_plan(
     say("timing the cut")
     t1 = time.perf_counter()
     motion = assemble_motion(job, model, passes)
+    passes = list(motion.passes)
     timings["timing_s"] = time.perf_counter() - t1
     say("measuring the planned motion")
     t2 = time.perf_counter()

@@ -39,11 +39,13 @@ def _phase_bands(ax, t: FloatArray, labels: np.ndarray) -> None:
         ax.axvspan(t[a], t[b], color=PHASE_COLOURS.get(lab[a], "0.9"), alpha=0.15, lw=0)
 
 
-def plot_plan(path: str | Path, plan: Plan) -> Path:
-    """Write the plan's picture (one PNG) to ``path`` atomically."""
+def plot_plan(path: str | Path, plan: Plan, part=None) -> Path:
+    """Write the plan's picture (one PNG) to ``path`` atomically; ``part``: the kept part's
+    mesh (:func:`~.part.part_mesh`), drawn see-through in the stock."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
     from matplotlib.patches import Patch
+    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
     job, mo, me = plan.job, plan.motion, plan.measured
     fig = Figure(figsize=(14, 9))
@@ -72,10 +74,16 @@ def plot_plan(path: str | Path, plan: Plan) -> Path:
             ax.plot(*e.T, color="tab:orange", lw=1.2)
     for e in stock_edges(job):
         ax.plot(*e.T, color="0.4", lw=0.8)
+    if part is not None:
+        tri = part.vertices[part.faces]
+        step = max(1, len(tri) // 15000)  # a few thousand facets draw in a second
+        ax.add_collection3d(Poly3DCollection(tri[::step], facecolor="tab:green", alpha=0.35,
+                                             edgecolor="none"))  # fmt: skip
     names = ", ".join(c.name for c in job.cuts) if len(job.cuts) > 1 else "cut surface"
     comp = "; red: wire path offset by half the kerf" if any(
         cp.compensated for cp in plan.passes) else ""  # fmt: skip
-    ax.set_title(f"{names} in the stock; orange: planned wire{comp}", fontsize=9)
+    kept = "; green: the part" if part is not None else ""
+    ax.set_title(f"{names} in the stock; orange: planned wire{comp}{kept}", fontsize=9)
     ax.set_xlabel("x (m)")
     ax.set_ylabel("y (m)")
     ax.set_zlabel("z (m)")

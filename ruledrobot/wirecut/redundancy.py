@@ -281,6 +281,11 @@ def solve_redundancy(
     return failure(best.reverse, slide, len(scores))
 
 
+#: standard deviation [sampled rulings] of the Gaussian that smooths the dynamic
+#: program's grid rolls (the roll rate drives the wrist's accelerations)
+ROLL_SMOOTHING = 2.0
+
+
 def _ladder_roll(
     cell: Cell,
     F,
@@ -332,14 +337,21 @@ def _ladder_roll(
     for i in range(n - 1, 0, -1):
         path[i - 1] = back[i, path[i]]
     roll_s = np.unwrap(roll_of[path])
-    # smooth the piecewise-constant grid rolls (moving average over ~3 samples), then
-    # interpolate to every ruling
+    # smooth the piecewise-constant grid rolls (a Gaussian over a few samples), then
+    # interpolate to every ruling with a C2 cubic: a roll rate that jumps between
+    # samples (piecewise-linear interpolation) makes the joints' rates jump with it,
+    # and the timed motion between rulings wobble off the surface
     if n >= 3:
-        pad = np.r_[roll_s[0], roll_s, roll_s[-1]]
-        roll_s = (pad[:-2] + pad[1:-1] + pad[2:]) / 3.0
+        from scipy.ndimage import gaussian_filter1d
+
+        roll_s = gaussian_filter1d(roll_s, ROLL_SMOOTHING, mode="nearest")
     rulings = np.arange(F.shape[0])
     nearest = idx[np.abs(rulings[:, None] - idx[None, :]).argmin(axis=1)]
     branch = (path % 8)[np.searchsorted(idx, nearest)]
+    if n >= 4:
+        from scipy.interpolate import CubicSpline
+
+        return CubicSpline(idx, roll_s, bc_type="natural")(rulings), branch
     return np.interp(rulings, idx, roll_s), branch
 
 

@@ -72,7 +72,7 @@ class TransitPlanner:
         u = np.linspace(0.0, 1.0, n)[:, None]
         return bool(self.free(qa + u * (qb - qa)).all())
 
-    def _lifted(self, q: FloatArray) -> FloatArray | None:
+    def lifted(self, q: FloatArray) -> FloatArray | None:
         """Joints nearest ``q`` with the flange raised until the bow and wire are CLEAR
         above the stock's top; None when unreachable."""
         model = self.cell.model
@@ -151,9 +151,11 @@ class TransitPlanner:
     ) -> list[tuple[FloatArray, FloatArray]]:
         """Joint moves from ``qa`` to ``qb`` (rad) clear of the stock (module doc)."""
         qa, qb = np.asarray(qa, dtype=np.float64), np.asarray(qb, dtype=np.float64)
-        if np.allclose(qa, qb) or self.clear(qa, qb):
+        if np.allclose(qa, qb):
+            return []
+        if self.clear(qa, qb):
             return [(qa, qb)]
-        ua, ub = self._lifted(qa), self._lifted(qb)
+        ua, ub = self.lifted(qa), self.lifted(qb)
         if ua is not None and ub is not None:
             legs = [(qa, ua), (ua, ub), (ub, qb)]
             if all(np.allclose(a, b) or self.clear(a, b) for a, b in legs):
@@ -165,6 +167,19 @@ class TransitPlanner:
                 notes.append(f"transit {what}: around the stock through "
                              f"{len(waypoints) - 2} waypoints (the direct move would hit it)")
                 return list(itertools.pairwise(waypoints))
-        notes.append(f"transit {what}: no move clear of the stock found; the direct move "
+        why = ""
+        for name, q in (("its start", qa), ("its goal", qb)):
+            broken = self.broken(q)
+            if broken:
+                why += f"; {name} breaks the clearance rules ({', '.join(broken)})"
+        notes.append(f"transit {what}: no move clear of the stock found{why}; the direct move "
                      "is kept (see the collision checks)")  # fmt: skip
         return [(qa, qb)]
+
+    def broken(self, q: FloatArray) -> list[str]:
+        """The clearance rules the configuration ``q`` (J,) breaks (empty: free)."""
+        P = self.cell.model.fk(q[None])
+        out = [k for k, v in clearance(self.cell, q[None], P).items() if v.any()]
+        if not self.cell.model.within_limits(q):
+            out.append("outside the joint limits")
+        return out

@@ -20,6 +20,7 @@ from ..io.mesh import write_stl
 from ..io.outdir import StagedFolder
 from ..io.trajectory import write_trajectory
 from ..robot.verdict import Verdict
+from .part import RESOLUTION, part_mesh, signed_volume
 from .plan import Plan
 from .plots import plot_plan
 from .verify import Verification
@@ -71,7 +72,18 @@ def write_plan(
             files["trajectory"] = write_trajectory(folder / "trajectory.csv", plan.trajectory)
             files["trajectory_meta"] = folder / "trajectory.json"
         files.update(_surfaces(folder, plan))
-        files["plots"] = plot_plan(folder / "plots.png", plan)
+        part = part_mesh(plan.job, plan.passes)
+        if part is not None:
+            files["part"] = write_stl(folder / "part.stl", part.vertices, part.faces,
+                                      header="ruledrobot part (the stock after every cut), m")
+            volume = signed_volume(part.vertices, part.faces)
+            report["part"] = {
+                "file": "part.stl", "volume_m3": volume,
+                "removed_m3": float(np.prod(plan.job.stock.size)) - volume,
+                "triangles": len(part.faces), "grid_step_m": RESOLUTION,
+                "cuts_without_keep": [c.name for c in plan.job.cuts if c.keep is None],
+            }  # fmt: skip
+        files["plots"] = plot_plan(folder / "plots.png", plan, part)
         if ver is not None:
             sim = ver.playback.write(folder / "simulation", trajectory=ok)
             files.update({f"simulation_{k}": v for k, v in sim.items()})

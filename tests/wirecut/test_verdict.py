@@ -1,6 +1,6 @@
 """The plan's verdict gates on every check; folders never mislead; input hygiene.
 
-Jobs and files made here, not the demo: a colliding UR10e helicoid cut, duplicate
+Jobs and files made here: the demo cut from a home in the table (colliding), duplicate
 rulings, a stale output folder, a folder of someone else's files, typos.
 """
 
@@ -22,33 +22,12 @@ from ruledrobot.wirecut.path import refine_for_job
 
 runner = CliRunner()
 
-#: A UR10e cutting a helicoid through a tall block: the wire's midpoint stays near the
-#: block's axis, so the approach (backed off from the block's centre) starts with the bow's
-#: hub and the wrist inside the block — MuJoCo names what hits what, in the approach.
-COLLIDING = """\
-[surface]
-builtin = "helicoid"
-u = [-0.4, 0.4]
-rulings = 7
-pose = [0.7, 0.2, 0.35, 0.0, 0.0, 0.3]
-spacing = 0.003
-
-[stock]
-centre = [0.7, 0.2, 0.35]
-size = [0.25, 0.25, 0.2]
-
-[robot]
-model = "ur10e"
-
-[tool]
-wire_start = [-0.25, 0.0, 0.3]
-wire_end = [0.25, 0.0, 0.3]
-clearance = 0.02
-mass = 1.2
-
-[cut]
-feed_speed = 0.012
-"""
+#: The demo cut with a home pose that puts the UR5e's arm through the table: the
+#: approach from home and the retract to it cannot be made clear (the planner says so and
+#: keeps the direct moves) — MuJoCo names what hits what, and in which phase.
+COLLIDING = DEMO_JOB.replace(
+    "speed_scale = 1.0", "speed_scale = 1.0\nhome = [0.0, 0.5, 0.0, 0.0, 1.57, 0.0]"
+)
 
 
 def _text(result) -> str:
