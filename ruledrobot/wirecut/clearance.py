@@ -68,7 +68,9 @@ def clearance(cell: Cell, q: FloatArray, P: FloatArray) -> dict[str, np.ndarray]
     w = np.einsum("nij,kej->nkei", Pf[:, :3, :3], rods) + Pf[:, None, None, :3, 3]
     ends, radius, body = arm_capsules(model, qf)  # (n, S, 2, 3), (S,), (S,)
     n = len(qf)
-    bow_in_stock = stock.segment_hits(w[:, :3, 0], w[:, :3, 1], margin).any(axis=1)
+    # the rods are tubes of the bow's arm radius; the wire is the cut, not a collision
+    bow_in_stock = stock.segment_hits(w[:, :3, 0], w[:, :3, 1],
+                                      margin + BowTool.arm_radius).any(axis=1)  # fmt: skip
     if cell.hub is not None:  # the hub on the flange: a short cylinder, as a capsule
         h = np.einsum("nij,ej->nei", Pf[:, :3, :3], cell.hub) + Pf[:, None, :3, 3]
         bow_in_stock |= stock.segment_hits(h[:, 0], h[:, 1], margin + cell.hub_radius)

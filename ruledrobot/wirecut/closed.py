@@ -95,9 +95,16 @@ def slit_direction(frames: FloatArray, i: int, stock: Box) -> FloatArray:
     return d / np.linalg.norm(d)
 
 
-def _slit(frame: FloatArray, direction: FloatArray, stock: Box, lead: float) -> FloatArray:
+def _slit(frame: FloatArray, direction: FloatArray, stock: Box, lead: float,
+          turn: FloatArray | None = None) -> FloatArray:  # fmt: skip
     """Frames (K, 4, 4) from outside the stock (clear by ``lead``) to ``frame``, the
-    wire moving along ``direction`` (from ``frame - dist * direction``)."""
+    wire moving along ``direction`` (from ``frame - dist * direction``).
+
+    ``turn`` (3,): the rotation vector per metre the wire turns at where the slit meets
+    the loop.  The slit's frames then turn too, at a rate falling linearly to 0 at the
+    slit's outer end, so that the wire's angular velocity, like its velocity, is
+    continuous where the slit meets the loop (a jump there jumps the joint rates and the
+    feed with them)."""
     grown = Box(stock.centre, stock.size + 2.0 * lead, stock.rotation)
     o, z = frame[:3, 3], frame[:3, 2]
     dist = 0.0
@@ -107,7 +114,14 @@ def _slit(frame: FloatArray, direction: FloatArray, stock: Box, lead: float) -> 
             raise ValueError("slit: the ruling does not leave the stock along the normal")
     n = max(2, int(np.ceil(dist / SLIT_STEP)) + 1)
     out = np.repeat(frame[None], n, axis=0)
-    out[:, :3, 3] = o - np.linspace(dist, 0.0, n)[:, None] * direction
+    back = np.linspace(dist, 0.0, n)  # metres before the loop
+    out[:, :3, 3] = o - back[:, None] * direction
+    if turn is not None and dist > 0.0:
+        from scipy.spatial.transform import Rotation
+
+        angle = back - back**2 / (2.0 * dist)  # rate falls linearly to 0 at the outer end
+        R = Rotation.from_rotvec(-angle[:, None] * turn).as_matrix()
+        out[:, :3, :3] = R @ frame[:3, :3]
     return out
 
 
@@ -124,10 +138,22 @@ def _pass(job: Job, cut: CutSpec, model, rc: RefinedCut, loop_frames: FloatArray
                    name, S, err, compensated, True, notes)  # fmt: skip
 
 
-def _exit(frame: FloatArray, direction: FloatArray, stock: Box, lead: float) -> FloatArray:
+def _exit(frame: FloatArray, direction: FloatArray, stock: Box, lead: float,
+          turn: FloatArray | None = None) -> FloatArray:  # fmt: skip
     """Frames (K, 4, 4) from ``frame`` straight on along ``direction`` until the wire is
-    clear of the stock by ``lead``."""
-    return _slit(frame, -direction, stock, lead)[::-1]
+    clear of the stock by ``lead`` (``turn``: as :func:`_slit`, the rate the wire turns at
+    per metre as it leaves the loop)."""
+    return _slit(frame, -direction, stock, lead, None if turn is None else -turn)[::-1]
+
+
+def _turn_rate(a: FloatArray, b: FloatArray) -> FloatArray:
+    """The rotation vector (3,) per metre of wire travel, world frame, taking frame ``a``
+    to frame ``b`` (neighbouring frames of the loop) — the rate the wire turns at."""
+    from scipy.spatial.transform import Rotation
+
+    R = b[:3, :3] @ a[:3, :3].T
+    dist = float(np.linalg.norm(b[:3, 3] - a[:3, 3]))
+    return Rotation.from_matrix(R).as_rotvec() / max(dist, 1e-12)
 
 
 def loop_paths(
@@ -150,9 +176,10 @@ def loop_paths(
     slits = {}
     for i in cand[:: max(1, cand.size // (4 * CANDIDATES))]:
         d = slit_direction(wire, int(i), job.stock)
-        ahead = _loop(wire, rc.flip, int(i), 1, M)[-1]
-        slits[int(i)] = (_slit(wire[i], d, job.stock, cut.lead_in),
-                         _exit(ahead, d, job.stock, cut.lead_out), d)  # fmt: skip
+        loop = _loop(wire, rc.flip, int(i), 1, M)
+        w_in, w_out = _turn_rate(loop[0], loop[1]), _turn_rate(loop[-2], loop[-1])
+        slits[int(i)] = (_slit(loop[0], d, job.stock, cut.lead_in, w_in),
+                         _exit(loop[-1], d, job.stock, cut.lead_out, w_out), d)  # fmt: skip
     order = sorted(slits, key=lambda i: len(slits[i][0]) + len(slits[i][1]))
     tried = order[:CANDIDATES]
     best = None

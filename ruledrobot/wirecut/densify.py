@@ -97,11 +97,18 @@ def uneven_intervals(cp: CutPath, share: float) -> np.ndarray:
     return np.unique(np.r_[np.flatnonzero(bad), np.flatnonzero(bad) + 1])
 
 
+#: intervals shorter than this [in the pass parameter: m of wire travel] are not split:
+#: below it the joint samples are closer than the time law can tell apart usefully
+MIN_INTERVAL = 2e-4
+
+
 def densified(cp: CutPath, intervals: np.ndarray, model, tool, stock: Box) -> CutPath:
     """``cp`` with a ruling added halfway through each interval ``i`` (between rulings
-    ``i`` and ``i + 1``) of ``intervals`` (module doc)."""
+    ``i`` and ``i + 1``) of ``intervals`` (module doc) that is longer than
+    :data:`MIN_INTERVAL`."""
     m = cp.motion
     idx = np.unique(np.asarray(intervals, dtype=np.intp))
+    idx = idx[np.diff(cp.s)[idx] > 2.0 * MIN_INTERVAL]
     if not idx.size:
         return cp
     half = np.full(idx.size, 0.5)
@@ -130,8 +137,11 @@ def densified(cp: CutPath, intervals: np.ndarray, model, tool, stock: Box) -> Cu
         chord=merged(m.chord, np.c_[c0, c1]), hit=merged(m.hit, hit),
     )  # fmt: skip
     s = cp.s
+    a, b = cp.extended
+    M = len(cp.frames)
+    extended = (a + int(np.sum(idx < a)), b + int(np.sum(idx >= M - 1 - b)))
     return dataclasses.replace(
-        cp, frames=merged(cp.frames, F_mid), motion=motion,
+        cp, frames=merged(cp.frames, F_mid), motion=motion, extended=extended,
         surface_frames=merged(S, S_mid),
         kerf_error=merged(err, np.maximum(err[idx], err[idx + 1])),
         param=merged(s, 0.5 * (s[idx] + s[idx + 1])),

@@ -131,10 +131,11 @@ def _keep(c: Section, closed: bool | None) -> str | np.ndarray | None:
 
 def _cut(c: Section, name: str, surface: SurfaceSpec) -> CutSpec:
     closed = surface.closed
-    if closed is None and surface.file is not None:
-        closed = None  # the file decides; checked when the rulings are read
-    elif closed is None:
-        closed = False
+    if closed is None:  # the rulings decide: a closed file, a periodic built-in surface
+        try:
+            closed = bool(surface.document().closed)
+        except (OSError, ValueError) as exc:
+            raise c.fail("surface", str(exc)) from None
     cut = CutSpec(
         name=name,
         surface=surface,

@@ -53,6 +53,9 @@ class Motion:
     ``heat`` (M,): the wire is hot (pre-heat, lead-in, cut, lead-out) when the tool
     switches heat, else all False.  ``notes``: what the assembly decided (transits).
     ``passes``: the passes as timed (with the rulings :mod:`.densify` added).
+    ``surface`` (M,): the wire cuts the target surface (in the stock, phase ``cut``; not
+    the slits of a closed cut, which cut waste): where the feed and the wire's deviation
+    are checked.
     """
 
     timed: TimedPath = field(repr=False)
@@ -64,6 +67,7 @@ class Motion:
     heat: np.ndarray = field(repr=False)
     notes: tuple[str, ...] = ()
     passes: tuple[CutPath, ...] = field(default=(), repr=False)
+    surface: np.ndarray | None = field(default=None, repr=False)
 
 
 def _fill_nearest(values: FloatArray, valid: np.ndarray) -> FloatArray:
@@ -259,8 +263,14 @@ def _label(job, whole: TimedPath, b: _Builder, passes, timed_passes, notes) -> M
         if h.size:
             lab[h[0] : h[-1] + 1] = "cut"
             lab[h[-1] + 1 :] = "lead_out"
+        if cp.closed:  # a closed cut's slits cut waste: they lead in and out
+            a, z = cp.extended
+            lab[s_k < cp.s[a]] = "lead_in"
+            lab[s_k > cp.s[len(cp.s) - 1 - z]] = "lead_out"
         labels[idx] = lab
+    surface = in_stock & (labels == "cut")
     heat = np.zeros(M, dtype=bool)
     if job.tool.heat is not None:
         heat = np.isin(labels.astype(str), ("preheat", "lead_in", "cut", "lead_out"))
-    return Motion(whole, labels, pass_of, s, in_stock, ends, heat, tuple(notes), tuple(passes))
+    return Motion(whole, labels, pass_of, s, in_stock, ends, heat, tuple(notes), tuple(passes),
+                  surface)

@@ -36,8 +36,9 @@ def _cut_sections(plan: Plan, ver: Verification | None) -> tuple[list[dict], lis
     for cut in plan.job.cuts:
         ks = [k for k, cp in enumerate(plan.passes) if cp.name == cut.name]
         passes = [plan.passes[k] for k in ks]
-        rows = np.isin(mo.pass_of, ks) & mo.in_stock
+        rows = np.isin(mo.pass_of, ks) & mo.surface
         interior = rows & ~mo.timed.feed_limited
+        slits = np.isin(mo.pass_of, ks) & mo.in_stock & ~mo.surface
         feed = me.feed[rows]
         dev_p = float(me.deviation[rows].max()) if rows.any() else 0.0
         dev_s = None if ver is None else (float(ver.deviation[rows].max()) if rows.any() else 0.0)
@@ -83,6 +84,8 @@ def _cut_sections(plan: Plan, ver: Verification | None) -> tuple[list[dict], lis
             "slide_m": float(m0.slide[0]),
             "wire_reversed": bool(m0.reverse),
             "notes": [n for cp in passes for n in cp.notes],
+            "slit_feed_mm_s": [float(me.feed[slits].min() * 1e3),
+                               float(me.feed[slits].max() * 1e3)] if slits.any() else None,
         })
     return sections, measures
 
@@ -130,7 +133,7 @@ def plan_outcome(plan: Plan, ver: Verification | None) -> tuple[dict, Verdict]:
         duration_s=float(mo.timed.t[-1]), cuts=tuple(cut_measures),
     )  # fmt: skip
     verdict = plan_verdict(meas, singularity_margin=SINGULARITY_MARGIN)
-    if not mo.in_stock.any():
+    if not mo.surface.any():
         missing = Check("in_stock", "the wire passes through the stock", "no", "yes",
                         relation="==", ok=False,
                         detail="no sample has the wire inside the stock")  # fmt: skip

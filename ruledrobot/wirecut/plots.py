@@ -101,7 +101,7 @@ def plot_plan(path: str | Path, plan: Plan, part=None) -> Path:
     _phase_bands(ax3, t, mo.labels)
     for cut in job.cuts:
         ks = [k for k, cp in enumerate(plan.passes) if cp.name == cut.name]
-        rows = np.isin(mo.pass_of, ks) & mo.in_stock
+        rows = np.isin(mo.pass_of, ks) & mo.surface
         ax3.plot(t[rows], me.feed[rows] * 1e3, ".", ms=1,
                  label=f"{cut.name} (set {cut.feed_speed * 1e3:g})")  # fmt: skip
         ax3.hlines(cut.feed_speed * 1e3, t[rows].min() if rows.any() else 0,

@@ -23,7 +23,8 @@ __all__ = ["CutSpec", "HeatSpec", "Job", "RobotSpec", "SurfaceSpec", "ToolSpec"]
 class SurfaceSpec:
     """Where the rulings come from and how they are refined.
 
-    ``closed``: None takes the lines file's own flag (a built-in surface is open).
+    ``closed``: None takes the lines file's own flag; a built-in surface is closed when
+    it is periodic (hyperboloid, Möbius band) and no ``u`` range is given.
     """
 
     builtin: str | None = None
@@ -57,9 +58,9 @@ class SurfaceSpec:
             from ..geometry.surfaces import sample_surface
 
             lo, hi = self.u if self.u is not None else (None, None)
-            lines = sample_surface(self.builtin, n=self.rulings, start=lo, stop=hi,
-                                   **self.params).lines  # fmt: skip
-            closed = False
+            sample = sample_surface(self.builtin, n=self.rulings, start=lo, stop=hi,
+                                    **self.params)  # fmt: skip
+            lines, closed = sample.lines, sample.closed
         if self.closed is not None:
             closed = self.closed
         return LinesDocument(lines.transform(self.pose), closed)
