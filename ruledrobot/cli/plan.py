@@ -102,41 +102,52 @@ def plan(
         show(out)
 
 
-@app.command(epilog="Example:  ruledrobot demo --out out/demo")
+@app.command(epilog="Example:  ruledrobot demo --out out/demo     or:  ruledrobot demo --part")
 def demo(
-    out: Path = typer.Option(Path("out/demo"), "--out", "-o", help="Output folder."),
+    out: Path | None = typer.Option(None, "--out", "-o",
+                                    help="Output folder [default: out/demo, out/part]."),
+    part: bool = typer.Option(False, "--part", help="The part demo: three cuts (one all the "
+                              "way round), kerf compensated, the wire's heat switched."),
     video: bool = typer.Option(True, "--video/--no-video", help="Render video.mp4 too."),
     stream: bool = typer.Option(
         True, "--stream/--no-stream", help="Stream the cut to the embedded RTDE emulator."
     ),
 ) -> None:
-    """Run the whole chain on the built-in example (a hyperbolic paraboloid cut in foam):
-    refine, plan, time, verify in MuJoCo, render a video, export URScript, and stream
-    the cut through ur_rtde to the embedded controller emulator."""
+    """Run the whole chain on a built-in example (a hyperbolic paraboloid cut in foam; with
+    --part, a part of three cuts): refine, plan, time, verify in MuJoCo, render a video,
+    export URScript, and stream the cut through ur_rtde to the embedded controller
+    emulator."""
     import tempfile
 
     from ..export import export_trajectory
-    from ..wirecut.demo import DEMO_JOB
-    from .robot import say_program_size, stream
+    from ..export.urscript import MAX_MOTION_LINES
+    from ..wirecut.demo import DEMO_JOB, PART_JOB
+    from .robot import say_program_size
+    from .robot import stream as stream_run
 
-    console.print("[bold]ruledrobot demo[/]: hyperbolic paraboloid through a foam block, UR5e")
+    out = out if out is not None else Path("out/part" if part else "out/demo")
+    if part:
+        console.print("[bold]ruledrobot demo --part[/]: a foam plug in three cuts (saddle top, "
+                      "twisted side, all the way round), kerf compensated, heat switched, UR5e")
+    else:
+        console.print("[bold]ruledrobot demo[/]: hyperbolic paraboloid through a foam block, UR5e")
     with tempfile.TemporaryDirectory() as tmp:
         job_path = Path(tmp) / "job.toml"
-        job_path.write_text(DEMO_JOB, encoding="utf-8")
+        job_path.write_text(PART_JOB if part else DEMO_JOB, encoding="utf-8")
         result = _run_plan(job_path, out, video=video)
     traj_path = out / "trajectory.csv"
+    mode = "servoj" if result.trajectory.n <= MAX_MOTION_LINES else "movep"
     try:
-        script = export_trajectory(result.trajectory, out / "cut.script")
+        script = export_trajectory(result.trajectory, out / "cut.script", mode=mode)
     except ValueError as exc:
         raise fail(str(exc)) from None
-    console.print(f"wrote {script}  (URScript for the teach pendant; streaming is the route for "
-                  "long cuts: docs/rtde.md)", highlight=False, markup=False)  # fmt: skip
+    console.print(f"wrote {script}  (URScript for the teach pendant, mode {mode}; streaming is "
+                  "the route for long cuts: docs/rtde.md)", highlight=False,
+                  markup=False)  # fmt: skip
     say_program_size(script)
     if stream:
-        res = stream(traj_path, None, yes=True)
+        res = stream_run(traj_path, None, yes=True)
         if res.status != "completed":
             raise typer.Exit(code=1)
     console.print(f"job file: {out / 'job.toml'} (edit it and run: ruledrobot plan)",
                   highlight=False, markup=False)  # fmt: skip
-
-

@@ -254,11 +254,19 @@ class Session:
         return np.asarray(qa)
 
     def check_deviation(self, plan: np.ndarray, qa: np.ndarray, upto: int) -> None:
-        """Deviation of ``qa`` from the plan samples [k_match, upto]; advances ``k_match``."""
-        lo = self.k_match
-        hi = min(upto, lo + self.window) + 1
+        """Deviation of ``qa`` from the nearest plan sample in ``[k_match - window, upto]``
+        (at most ``window`` ahead of ``k_match``); moves ``k_match`` there.
+
+        The match may step back: where the plan creeps (the start of a move from rest),
+        a servo's small lag makes a later sample look nearest for a while, and a match
+        that only moves forward would run ahead of the arm and report its lag as a
+        deviation."""
+        lo = max(0, self.k_match - self.window)
+        hi = min(upto, self.k_match + self.window) + 1
         d = np.max(np.abs(plan[lo:hi] - qa), axis=1)
-        j = int(np.argmin(d))
+        # the last of equal minima: through a hold longer than the window (the wire
+        # heating) the plan repeats one sample, and the match must reach its end
+        j = len(d) - 1 - int(np.argmin(d[::-1]))
         self.k_match = lo + j
         dev = float(d[j])
         self.max_dev = max(self.max_dev, dev)

@@ -162,7 +162,10 @@ def run_trajectory(
         source = Path(traj)
         traj = read_trajectory(source)
     planned = model_for(traj.meta)
-    robot = planned if model is None else (load(model) if isinstance(model, str) else model)
+    if model is None or (isinstance(model, str) and model.strip().lower() == planned.name):
+        robot = planned  # the plan's arm: its kinematics and the limits it was planned in
+    else:
+        robot = load(model) if isinstance(model, str) else model
     mode = _validate(traj, robot, planned, mode, lookahead, gain, deviation_limit, start_index)
     if host is None and not dry_run:
         raise ValueError("host: a controller address is needed unless dry_run")

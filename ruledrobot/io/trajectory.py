@@ -16,6 +16,7 @@ line, then one row per controller period, and nothing else (``csv.reader`` and
      "base": [...],                                   # robot base in the job's world
      "phases": [{"name": "approach", "start": 0, "stop": 812}, ...],
      "in_stock": [[1200, 9800]],
+     "max_acceleration_rad_s2": [2.5, 2.5, 2.5, 2.5, 2.5, 2.5],   # or null: the default
      "heat": {"output": "standard:0", "value": 1.0, "preheat_s": 2.0,
               "windows": [[1100, 9900]]},                # or null
      "job": {"path": "job.toml", "sha256": "..."}, "source": "ruledrobot plan",
@@ -102,6 +103,8 @@ def meta_to_dict(meta: TrajectoryMeta) -> dict[str, Any]:
             "output": meta.heat.output, "value": meta.heat.value,
             "preheat_s": meta.heat.preheat, "windows": [list(w) for w in meta.heat.windows],
         },
+        "max_acceleration_rad_s2": None if meta.max_acceleration is None
+        else meta.max_acceleration.tolist(),
         "job": meta.job,
         "source": meta.source,
     }
@@ -216,6 +219,8 @@ def meta_from_dict(doc: Any, where: str = "trajectory metadata") -> TrajectoryMe
         stock.append((r[0], r[1]))
     base = d.numbers("base", d.get("base", default=[0.0] * 6), 6)
     heat = _heat(d)
+    acc = d.get("max_acceleration_rad_s2")
+    max_acc = None if acc is None else d.numbers("max_acceleration_rad_s2", acc, model.n_joints)
     job = d.get("job")
     if job is not None and not isinstance(job, dict):
         raise d.fail("job", f"expected an object or null, got {job!r}")
@@ -224,7 +229,7 @@ def meta_from_dict(doc: Any, where: str = "trajectory metadata") -> TrajectoryMe
             robot=model.name, control_period=float(period), tcp_offset=tcp,
             payload=Payload(mass, cog), kinematics=kinematics, base=base,
             phases=tuple(phases), in_stock=tuple(stock), job=job,
-            source=str(d.get("source", default="")), heat=heat,
+            source=str(d.get("source", default="")), heat=heat, max_acceleration=max_acc,
         )  # fmt: skip
     except ValueError as exc:
         raise ValueError(f"{where}: {exc}") from None

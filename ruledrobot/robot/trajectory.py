@@ -36,7 +36,7 @@ from numpy.typing import ArrayLike
 
 from ..geometry.se3 import pose_from_ur_vector, ur_vector_from_pose
 from ._checks import FloatArray, as_array, as_pose_or_vector, readonly
-from .model import RobotModel
+from .model import DEFAULT_ACCELERATION, RobotModel
 from .rates import finite_difference_rates
 
 __all__ = [
@@ -212,9 +212,18 @@ class TrajectoryMeta:
     job: dict[str, str] | None = None
     source: str = ""
     heat: Heat | None = None
+    #: the joint acceleration limits (J,) [rad/s^2] the trajectory was planned within, when
+    #: they are not the catalogue's default (a job's ``[robot] acceleration``)
+    max_acceleration: FloatArray | None = None
 
     def __post_init__(self) -> None:
         put = object.__setattr__
+        if self.max_acceleration is not None:
+            acc = as_array(self.max_acceleration, "max_acceleration")
+            if acc.ndim != 1 or not np.all(acc > 0):
+                raise ValueError(f"max_acceleration: expected positive limits per joint, got "
+                                 f"{acc.tolist()}")  # fmt: skip
+            put(self, "max_acceleration", readonly(acc))
         put(self, "tcp_offset", readonly(as_pose_or_vector(self.tcp_offset, "tcp_offset")))
         put(self, "base", readonly(as_pose_or_vector(self.base, "base")))
         period = float(self.control_period)
@@ -240,6 +249,8 @@ class TrajectoryMeta:
             "kinematics": KinematicsRef.of(model),
             "base": model.base,
         }
+        if not np.allclose(model.max_acceleration, DEFAULT_ACCELERATION):
+            kw["max_acceleration"] = model.max_acceleration
         kw.update(fields)
         return cls(**kw)  # type: ignore[arg-type]
 
@@ -249,8 +260,9 @@ class TrajectoryMeta:
 
 def model_for(meta: TrajectoryMeta) -> RobotModel:
     """The robot a trajectory was planned for: the catalogue model ``meta.robot`` with
-    the trajectory's kinematics, its TCP offset as tool and its payload; no base (the
-    trajectory's poses are in the robot base frame)."""
+    the trajectory's kinematics, its TCP offset as tool, its payload and the joint
+    acceleration limits it was planned within; no base (the trajectory's poses are in the
+    robot base frame)."""
     from .catalogue import load
 
     model = load(meta.robot)
@@ -268,6 +280,11 @@ def model_for(meta: TrajectoryMeta) -> RobotModel:
     if abs(meta.control_period - model.control_period) > 1e-12:
         raise ValueError(f"control_period: {meta.control_period} s, but a {meta.robot} runs at "
                          f"{model.control_period} s")  # fmt: skip
+    if meta.max_acceleration is not None:
+        if meta.max_acceleration.shape != (model.n_joints,):
+            raise ValueError(f"max_acceleration: {meta.robot} has {model.n_joints} joints, got "
+                             f"{meta.max_acceleration.shape[0]} limits")  # fmt: skip
+        model = model.with_limits(acceleration=meta.max_acceleration)
     return dataclasses.replace(
         model, tool=meta.tcp_offset, tool_mass=meta.payload.mass, tool_com=meta.payload.cog
     )

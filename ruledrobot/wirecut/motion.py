@@ -113,7 +113,8 @@ def _legs(transit: TransitPlanner, here: FloatArray, entry: FloatArray | None,
     """Joint moves from ``here`` through ``entry`` (if any) to the pass's first pose."""
     if entry is None:
         return transit.route(here, start, notes, what)
-    return transit.route(here, entry, notes, what) + transit.route(entry, start, notes, what)
+    return transit.route(here, entry, notes, what) + transit.route(entry, start, notes,
+                                                                   what.replace("to ", "into "))
 
 
 @dataclass
@@ -182,7 +183,7 @@ def assemble_motion(job: Job, model, passes: list[CutPath]) -> Motion:
     passes = list(passes)
     dt = float(model.control_period)
     vel = model.max_velocity * job.robot.speed_scale
-    acc = model.max_acceleration if job.robot.acceleration is None else job.robot.acceleration
+    acc = model.max_acceleration  # the job's [robot] acceleration when it names one
     W = wire_frame(job.tool)
     transit = TransitPlanner.of(job, model)
     b = _Builder(dt)

@@ -167,12 +167,14 @@ class Job:
 
     def robot_model(self):
         """The job's robot: the catalogue model with its calibration (if the job names
-        one) and its base; the arm every stage plans and checks with."""
+        one), its joint acceleration limits and its base; the arm every stage plans and
+        checks with."""
         from ..robot import load
 
-        return load(self.robot.model).with_calibration(self.robot.calibration).with_base(
-            self.robot.base
-        )
+        model = load(self.robot.model).with_calibration(self.robot.calibration)
+        if self.robot.acceleration is not None:
+            model = model.with_limits(acceleration=self.robot.acceleration)
+        return model.with_base(self.robot.base)
 
     def input_lines(self) -> Lines:
         """The first cut's input rulings in the robot base frame."""
