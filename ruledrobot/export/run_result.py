@@ -101,6 +101,8 @@ class RunResult:
     stop: StopPlace | None = None
     client: str = ""
     timeline: list[tuple[float, str]] = field(default_factory=list)
+    #: the controller's clock [s] at the recording's first sample (its t = 0), when known
+    recording_t0: float | None = None
 
     @property
     def completed(self) -> bool:

@@ -194,7 +194,8 @@ class Session:
         return ts, q, tcp
 
     def info(self) -> dict:
-        return {"k_match": self.k_match, "sent": self.sent, "max_dev": self.max_dev}
+        return {"k_match": self.k_match, "sent": self.sent, "max_dev": self.max_dev,
+                "recording_t0": self._ts0}  # fmt: skip
 
     def flush(self, force: bool = False) -> None:
         """Send the recording so far (and the progress) at most every CHUNK seconds."""

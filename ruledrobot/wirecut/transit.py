@@ -58,13 +58,19 @@ class TransitPlanner:
         return cls(cell, float(pts[:, 2].max()), lo, hi)
 
     def free(self, q: FloatArray) -> np.ndarray:
-        """(n,) bool: configurations (n, J) that keep every clearance rule."""
+        """(n,) bool: configurations (n, J) that keep every clearance rule and hold the
+        wire out of the stock (between cuts the wire is an obstacle like the bow)."""
         q = np.atleast_2d(q)
         P = self.cell.model.fk(q)
         bad = np.zeros(len(q), dtype=bool)
         for v in clearance(self.cell, q, P).values():
             bad |= v
+        bad |= self._wire_in_stock(P)
         return ~bad & self.cell.model.within_limits(q)
+
+    def _wire_in_stock(self, P: FloatArray) -> np.ndarray:
+        w = np.einsum("nij,kj->nki", P[:, :3, :3], self.cell.wire) + P[:, None, :3, 3]
+        return self.cell.stock.segment_hits(w[:, 0], w[:, 1], self.cell.margin)
 
     def clear(self, qa: FloatArray, qb: FloatArray) -> bool:
         """True when every sample of the straight joint move qa -> qb is free."""
@@ -180,6 +186,8 @@ class TransitPlanner:
         """The clearance rules the configuration ``q`` (J,) breaks (empty: free)."""
         P = self.cell.model.fk(q[None])
         out = [k for k, v in clearance(self.cell, q[None], P).items() if v.any()]
+        if self._wire_in_stock(P).any():
+            out.append("wire in the stock")
         if not self.cell.model.within_limits(q):
             out.append("outside the joint limits")
         return out

@@ -1,0 +1,90 @@
+"""The part demo streamed to the emulator: the wire's heat, read from the controller's own
+record of its outputs, against the joints it recorded.
+
+The wire must never be hot outside the planned heat windows and never cold inside the
+stock; the arm must follow the plan.  Independent of the planner: the controller logs
+every change of its outputs (``Emulator.io_log``, controller time), the runner records
+the actual joints (controller time from ``RunResult.recording_t0``), the wire's position
+comes from forward kinematics of the recorded joints.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+
+import numpy as np
+import pytest
+
+from ruledrobot.export import run_trajectory
+from ruledrobot.robot import model_for
+from ruledrobot.robot.tool import BowTool
+from ruledrobot.wirecut.demo import PART_JOB
+from ruledrobot.wirecut.job import load_job
+from ruledrobot.wirecut.planner import plan
+from tests.support.emulators import start_emulator
+
+#: the part demo streams for about two minutes
+DEADLINE = 400.0
+
+
+@pytest.fixture(autouse=True)
+def _deadline() -> Iterator[None]:
+    import faulthandler
+    import sys
+
+    faulthandler.dump_traceback_later(DEADLINE, exit=True, file=sys.stderr)
+    try:
+        yield
+    finally:
+        faulthandler.cancel_dump_traceback_later()
+
+
+def _hot_at(io_log: list[tuple], times: np.ndarray) -> np.ndarray:
+    """(N,) bool: standard digital output 0 at controller ``times``, from the log of changes."""
+    t = np.array([e[0] for e in io_log])
+    bit = np.array([e[1] & 1 for e in io_log], dtype=bool)
+    k = np.searchsorted(t, times, side="right") - 1
+    return np.where(k >= 0, bit[np.clip(k, 0, None)], False)
+
+
+def test_the_part_demo_runs_with_its_heat_where_the_plan_says(tmp_path, request):
+    job_path = tmp_path / "part.toml"
+    job_path.write_text(PART_JOB)
+    job = load_job(job_path)
+    result = plan(job, None, simulate=False)  # verified in MuJoCo in tests/wirecut
+    traj = result.trajectory
+    assert traj.meta.heat is not None and len(traj.meta.heat.windows) == 3
+    emu = start_emulator(request.node.nodeid, model="ur5e", unlock_delay=0.0, q0=traj.q[0])
+    try:
+        run = run_trajectory(traj, emu.host)
+        io_log = emu.io_log
+    finally:
+        emu.close()
+    assert run.status == "completed", run.message
+    assert run.max_deviation < 0.05
+    rec = run.actual
+    assert rec is not None and run.recording_t0 is not None
+    # the heat was switched exactly three times on and off, and is off at the end
+    bits = [e[1] & 1 for e in io_log]
+    rises = sum(1 for a, b in zip([0, *bits], bits, strict=False) if b and not a)
+    assert rises == 3 and bits[-1] == 0
+    hot = _hot_at(io_log, run.recording_t0 + rec.t)
+    # the wire, from the recorded joints: in the stock -> hot
+    model = model_for(rec.meta).with_tool(np.eye(4))
+    bow = BowTool.from_spec(job.tool)
+    P = model.fk(rec.q)
+    ends = np.stack([bow.wire_start, bow.wire_end])
+    w = np.einsum("mij,kj->mki", P[:, :3, :3], ends) + P[:, None, :3, 3]
+    in_stock = job.stock.segment_hits(w[:, 0], w[:, 1])
+    assert in_stock.any()
+    assert hot[in_stock].all(), f"cold in the stock at {np.flatnonzero(in_stock & ~hot)[:5]}"
+    # hot -> inside a planned heat window: the recorded pose lies on the plan within a window
+    windows = traj.meta.heat.on(traj.n)
+    k = np.array([np.argmin(np.abs(traj.q - q).max(axis=1)) for q in rec.q[hot][::25]])
+    assert windows[k].all(), "hot outside the planned windows"
+    # each window lasts (in controller time) what the plan says, within 2 %
+    t_io = np.array([e[0] for e in io_log])
+    on_times = t_io[[i for i in range(len(bits)) if bits[i] and (i == 0 or not bits[i - 1])]]
+    off_times = t_io[[i for i in range(1, len(bits)) if not bits[i] and bits[i - 1]]]
+    planned = np.array([(b - a) * traj.period for a, b in traj.meta.heat.windows])
+    np.testing.assert_allclose(off_times - on_times, planned, rtol=0.02)
