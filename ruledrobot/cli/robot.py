@@ -217,8 +217,8 @@ def ursim(
     secondary 30002) until Ctrl-C, optionally calibrated and with faults on a timer or on a
     signal (docs/rtde.md)."""
     from ..ursim import serve
+    from ..ursim.arm import emulated_model
     from ..ursim.faults import FaultSchedule, parse_fault
-    from ..ursim.server import emulated_model
 
     if physics not in ("kinematic", "mujoco"):
         raise typer.BadParameter(f"expected kinematic or mujoco, got {physics!r}",

@@ -21,10 +21,11 @@ from __future__ import annotations
 
 from ..protocol.modes import JointMode, RobotMode, RuntimeState, SafetyMode, SafetyStatusBit
 from .backend import HARDWARE_ACCELERATION, ArmBackend, ArmState, KinematicBackend
+from .clock import ClockStats
 from .controller import DEFAULT_Q, Controller
 from .handshake import Command
 from .process import EMBEDDED_HOST, Emulator, embedded_emulator
-from .server import ClockStats, ThreadedEmulator, serve
+from .server import ThreadedEmulator, serve
 
 __all__ = [
     "DEFAULT_Q",

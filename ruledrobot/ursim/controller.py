@@ -46,6 +46,8 @@ from numpy.typing import ArrayLike
 from ..protocol.modes import JointMode, RobotMode, RuntimeState, SafetyMode, SafetyStatusBit
 from ..robot import RobotModel
 from .backend import ArmBackend, ArmState, KinematicBackend
+from .controller_io import IN_DOUBLE, IN_INT, OUT_DOUBLE, OUT_INT, IOMixin
+from .controller_safety import SafetyMixin
 from .handshake import ControlScript
 from .kinematics import ArmKinematics
 from .motion import MotionError, PathMotion, Segment, StopMotion, joint_segment, linear_segment
@@ -61,10 +63,6 @@ log = logging.getLogger("ruledrobot.ursim")
 DEFAULT_Q = (0.0, -1.5707963267948966, 1.5707963267948966, -1.5707963267948966,
              -1.5707963267948966, 0.0)  # fmt: skip
 
-_IN_INT = [f"input_int_register_{i}" for i in range(48)]
-_IN_DOUBLE = [f"input_double_register_{i}" for i in range(48)]
-_OUT_INT = [f"output_int_register_{i}" for i in range(48)]
-_OUT_DOUBLE = [f"output_double_register_{i}" for i in range(48)]
 
 _ZERO6 = np.zeros(6)
 
@@ -98,12 +96,7 @@ class _IdleProgram:
         return None
 
 
-def _int32(v: int) -> int:
-    v = int(v) & 0xFFFFFFFF
-    return v - (1 << 32) if v & 0x80000000 else v
-
-
-class Controller:
+class Controller(IOMixin, SafetyMixin):
     """The controller state machine behind the emulator's three servers.
 
     Parameters
@@ -182,7 +175,7 @@ class Controller:
     def _init_values(self) -> None:
         v = self.values
         z6 = (0.0,) * 6
-        for names, zero in ((_IN_INT, 0), (_OUT_INT, 0), (_IN_DOUBLE, 0.0), (_OUT_DOUBLE, 0.0)):
+        for names, zero in ((IN_INT, 0), (OUT_INT, 0), (IN_DOUBLE, 0.0), (OUT_DOUBLE, 0.0)):
             for n in names:
                 v[n] = zero
         for i in range(64, 128):
@@ -305,147 +298,9 @@ class Controller:
         r = self.runner
         return r.line if isinstance(r, ScriptRunner) else 0
 
-    # ------------------------------------------------------------ registers and inputs
-
     def arm_state(self) -> ArmState:
         """The arm's state after the last period (:class:`~.host.ProgramHost`)."""
         return self.backend.state()
-
-    def in_int(self, i: int) -> int:
-        return self.values.get(_IN_INT[i], 0)  # type: ignore[return-value]
-
-    def in_double(self, i: int) -> float:
-        return self.values.get(_IN_DOUBLE[i], 0.0)  # type: ignore[return-value]
-
-    def set_out_int(self, i: int, value: int) -> None:
-        self.values[_OUT_INT[i]] = _int32(value)
-
-    def set_out_double(self, i: int, value: float) -> None:
-        self.values[_OUT_DOUBLE[i]] = float(value)
-
-    def set_out_bit(self, i: int, value: bool) -> None:
-        with self.lock:
-            if 64 <= i <= 127:
-                self.values[f"output_bit_register_{i}"] = int(value)
-            elif 0 <= i <= 63:
-                key = "output_bit_registers0_to_31" if i < 32 else "output_bit_registers32_to_63"
-                word = int(self.values[key])  # type: ignore[call-overload]
-                bit = 1 << (i % 32)
-                self.values[key] = (word | bit) if value else (word & ~bit)
-
-    def apply_inputs(self, values: dict[str, object], names: Sequence[str]) -> None:
-        """Apply a client's input data package (registers, I/O masks, speed slider)."""
-        with self.lock:
-            self.values.update(values)
-            self.last_input_names = frozenset(names)
-            if self._watch_name is not None and self._watch_name in self.last_input_names:
-                self._watch_last = self.time
-            if "standard_digital_output_mask" in values:
-                m = int(values["standard_digital_output_mask"])  # type: ignore[call-overload]
-                b = int(values.get("standard_digital_output", 0))  # type: ignore[call-overload]
-                self.std_do = (self.std_do & ~m) | (b & m)
-            if "configurable_digital_output_mask" in values:
-                m = int(values["configurable_digital_output_mask"])  # type: ignore[call-overload]
-                b = int(values.get("configurable_digital_output", 0))  # type: ignore[call-overload]
-                self.conf_do = (self.conf_do & ~m) | (b & m)
-            if "tool_digital_output_mask" in values:
-                m = int(values["tool_digital_output_mask"]) & 3  # type: ignore[call-overload]
-                b = int(values.get("tool_digital_output", 0))  # type: ignore[call-overload]
-                self.tool_do = (self.tool_do & ~m) | (b & m)
-            if int(values.get("speed_slider_mask", 0)) & 1:  # type: ignore[call-overload]
-                f = float(values.get("speed_slider_fraction", 1.0))  # type: ignore[arg-type]
-                self.speed_fraction = min(max(f, 0.0), 1.0)
-            if "standard_analog_output_mask" in values:
-                m = int(values["standard_analog_output_mask"])  # type: ignore[call-overload]
-                for k in (0, 1):
-                    if m & (1 << k):
-                        x = float(values.get(f"standard_analog_output_{k}", 0.0))  # type: ignore[arg-type]
-                        self.analog_out[k] = min(max(x, 0.0), 1.0)
-            self._note_io()
-
-    def set_digital_out(self, kind: str, n: int, value: bool) -> None:
-        """A digital output: ``kind`` ``"standard"`` (pins 0-7), ``"configurable"`` (0-7)
-        or ``"tool"`` (0-1); ValueError for another kind or pin."""
-        top = {"standard": 7, "configurable": 7, "tool": 1}.get(kind)
-        if top is None:
-            raise ValueError(f"digital output kind: expected standard, configurable or tool, "
-                             f"got {kind!r}")  # fmt: skip
-        if isinstance(n, bool) or not isinstance(n, int) or not 0 <= n <= top:
-            raise ValueError(f"{kind} digital output: pin must be 0..{top}, got {n!r}")
-        with self.lock:
-            bit = 1 << n
-            if kind == "configurable":
-                self.conf_do = (self.conf_do | bit) if value else (self.conf_do & ~bit)
-            elif kind == "tool":
-                self.tool_do = (self.tool_do | bit) if value else (self.tool_do & ~bit)
-            else:
-                self.std_do = (self.std_do | bit) if value else (self.std_do & ~bit)
-            self._note_io()
-
-    def set_analog_out(self, n: int, fraction: float) -> None:
-        """Standard analog output ``n`` (0-1) to ``fraction`` (0..1 of its range)."""
-        if isinstance(n, bool) or not isinstance(n, int) or not 0 <= n <= 1:
-            raise ValueError(f"standard analog output: pin must be 0..1, got {n!r}")
-        f = float(fraction)
-        if not 0.0 <= f <= 1.0:
-            raise ValueError(f"standard analog output {n}: value must be in [0, 1], got {f!r}")
-        with self.lock:
-            self.analog_out[n] = f
-            self._note_io()
-
-    def _note_io(self) -> None:
-        """Append the outputs to :attr:`io_log` when they changed (caller holds the lock)."""
-        now = (self.std_do, self.conf_do, self.tool_do, self.analog_out[0], self.analog_out[1])
-        if now != self._io_last:
-            self._io_last = now
-            self.io_log.append((self.time, *now))
-
-    def set_payload(self, mass: float | None, cog: ArrayLike | None) -> None:
-        """Payload mass [kg] and centre of gravity [m] (flange frame); None keeps the value."""
-        with self.lock:
-            if mass is not None:
-                self.values["payload"] = float(mass)
-            if cog is not None:
-                self.values["payload_cog"] = tuple(float(x) for x in np.asarray(cog).reshape(3))
-
-    def show_popup(self, text: str) -> None:
-        """The pendant shows a popup (a compile error, URScript ``popup``)."""
-        with self.lock:
-            self.popup = text
-
-    def close_popup(self) -> None:
-        """Dashboard ``close popup``."""
-        with self.lock:
-            self.popup = None
-
-    def set_watchdog(self, name: str, min_frequency: float, action: str = "stop") -> None:
-        """URScript ``rtde_set_watchdog``: act when input ``name`` is not updated in time.
-
-        ``action`` is ``"stop"`` (stop the program, the arm brakes), ``"pause"``
-        or ``"ignore"``; a frequency <= 0 removes the watchdog.  It ends with
-        the program that set it.
-        """
-        with self.lock:
-            if min_frequency <= 0 or action == "ignore":
-                self._watch_name = None
-                return
-            self._watch_name = name
-            self._watch_timeout = 1.0 / float(min_frequency)
-            self._watch_action = action
-            self._watch_last = self.time
-
-    def _check_watchdog(self) -> None:
-        if self._watch_name is None or self.runtime_state != RuntimeState.PLAYING:
-            return
-        silent = self.time - self._watch_last
-        if silent > self._watch_timeout:
-            name = self._watch_name
-            self._watch_name = None
-            self.log(f"RTDE watchdog: {name} not updated for {silent:.3f} s", level=1)
-            if self._watch_action == "pause":
-                self.pause_program()
-            else:
-                self.stop_program("RTDE watchdog", decelerate=True)
 
     # ------------------------------------------------------------ log
 
@@ -681,101 +536,6 @@ class Controller:
             self.loaded_program = str(p)
             self._loaded_script = script
         return "ok"
-
-    # ------------------------------------------------------------ power and safety
-
-    def power_on(self) -> bool:
-        with self.lock:
-            if self.safety_mode != SafetyMode.NORMAL:
-                return False
-            if self.robot_mode in (RobotMode.POWER_OFF, RobotMode.POWER_ON):
-                self.robot_mode = RobotMode.IDLE
-            return True
-
-    def brake_release(self) -> bool:
-        with self.lock:
-            if self.safety_mode != SafetyMode.NORMAL or self.robot_mode < RobotMode.POWER_ON:
-                return False
-            self.robot_mode = RobotMode.RUNNING
-            return True
-
-    def power_off(self) -> None:
-        with self.lock:
-            self.stop_program("power off", decelerate=False)
-            self.motion = None
-            self.mode = "idle"
-            self._hold_q = None
-            self.backend.hold()
-            self.robot_mode = RobotMode.POWER_OFF
-
-    def _brake(self) -> None:
-        st = self.backend.state()
-        self.motion = StopMotion(st.target_q, st.target_qd, self.fault_deceleration)
-        self.mode = "move"
-
-    def protective_stop(self, reason: str = "protective stop") -> None:
-        """Fault: protective stop (the arm brakes, the program stops)."""
-        with self.lock:
-            if self.safety_mode == SafetyMode.PROTECTIVE_STOP:
-                return
-            self.safety_mode = SafetyMode.PROTECTIVE_STOP
-            self._fault_time = time.monotonic()
-            self.log(f"protective stop: {reason}", level=1)
-            self.stop_program("protective stop", decelerate=False)
-            self._brake()
-
-    def unlock_protective_stop(self) -> tuple[bool, str]:
-        """Dashboard ``unlock protective stop``: (accepted, reply)."""
-        with self.lock:
-            if self.safety_mode != SafetyMode.PROTECTIVE_STOP:
-                return True, "Protective stop releasing"
-            if time.monotonic() - self._fault_time < self.unlock_delay:
-                return False, (
-                    f"Cannot unlock protective stop until {self.unlock_delay:g}s after occurrence. "
-                    "Always inspect cause of protective stop before unlocking"
-                )
-            self.safety_mode = SafetyMode.NORMAL
-            self.log("protective stop released")
-            return True, "Protective stop releasing"
-
-    def emergency_stop(self, reason: str = "emergency stop button pressed") -> None:
-        """Fault: robot emergency stop (the arm brakes, then power goes off)."""
-        with self.lock:
-            if self.safety_mode == SafetyMode.ROBOT_EMERGENCY_STOP:
-                return
-            self.safety_mode = SafetyMode.ROBOT_EMERGENCY_STOP
-            self.log(f"emergency stop: {reason}", level=1)
-            self.stop_program("emergency stop", decelerate=False)
-            self._brake()
-            self._power_off_when_stopped = True
-
-    def restart_safety(self) -> None:
-        """Dashboard ``restart safety``: the safety system restarts after a fault or a
-        violation, the robot is then powered off.  An emergency stop stays: it is
-        released on the robot (the button), never from the network."""
-        with self.lock:
-            if self.safety_mode in (SafetyMode.ROBOT_EMERGENCY_STOP,
-                                    SafetyMode.SYSTEM_EMERGENCY_STOP):  # fmt: skip
-                self.log("restart safety: the emergency stop is still pressed; it must be "
-                         "released on the robot", level=2)  # fmt: skip
-            elif self.safety_mode in (SafetyMode.FAULT, SafetyMode.VIOLATION):
-                self.log(f"restart safety: {self.safety_mode.name} cleared")
-                self.safety_mode = SafetyMode.NORMAL
-            self.power_off()
-
-    def release_emergency_stop(self) -> None:
-        """The e-stop button is released: safety NORMAL; power on + brake release to run."""
-        with self.lock:
-            if self.safety_mode == SafetyMode.ROBOT_EMERGENCY_STOP:
-                self.safety_mode = SafetyMode.NORMAL
-                self.log("emergency stop released")
-
-    def clear_faults(self) -> None:
-        """Back to NORMAL and RUNNING at once (test helper; a real robot needs the steps)."""
-        with self.lock:
-            self.safety_mode = SafetyMode.NORMAL
-            self.robot_mode = RobotMode.RUNNING
-            self._power_off_when_stopped = False
 
     # ------------------------------------------------------------ tick
 

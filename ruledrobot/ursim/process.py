@@ -34,8 +34,9 @@ from numpy.typing import ArrayLike
 from ..protocol.modes import RobotMode, RuntimeState, SafetyMode
 from ..protocol.primary import KinematicsInfo
 from ..robot import Calibration, RobotModel
+from .arm import emulated_model
 from .backend import ArmBackend
-from .server import ThreadedEmulator, emulated_model
+from .server import ThreadedEmulator
 
 __all__ = ["EMBEDDED_HOST", "Emulator", "embedded_emulator"]
 

@@ -22,17 +22,16 @@ import threading
 import time
 from collections import deque
 from collections.abc import Callable
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..io.calibration import load_calibration
 from ..protocol.modes import RobotMode, RuntimeState, SafetyMode
-from ..protocol.primary import KinematicsInfo
-from ..robot import Calibration, RobotModel, load, random_calibration
+from ..robot import Calibration, RobotModel
+from .arm import emulated_model, kinematics_info_of
 from .backend import ArmBackend, KinematicBackend
+from .clock import ClockStats
 from .controller import Controller
 from .dashboard import DashboardServer
 from .primary_port import PrimaryPublisher, PrimaryServer
@@ -61,49 +60,6 @@ _switch_users = 0
 _switch_saved = 0.005
 
 
-@dataclass
-class ClockStats:
-    """Timing of the controller clock.
-
-    ``ticks``: control periods run.  ``missed``: periods the clock was too
-    late to publish (it steps the controller to catch up, without sending).
-    ``lateness``: recent publish times minus their scheduled times [s].
-    ``tick_errors`` / ``publish_errors``: controller periods / publishes that
-    raised (logged, rate-limited; the clock goes on).  ``gaps``: recent
-    intervals between consecutive publishes [s] (one period when all is well;
-    a stall shows here even when the clock resynchronises after it).
-    ``gc_max``: the longest garbage-collector pause [s] (it holds the GIL, so
-    it stalls the clock too).
-    """
-
-    ticks: int = 0
-    missed: int = 0
-    resyncs: int = 0
-    tick_errors: int = 0
-    publish_errors: int = 0
-    gc_max: float = 0.0
-    lateness: deque | None = None
-    gaps: deque | None = None
-
-    def summary(self) -> dict[str, float]:
-        lat = np.asarray(self.lateness or [0.0])
-        gap = np.asarray(self.gaps or [0.0])
-        return {
-            "ticks": float(self.ticks),
-            "missed": float(self.missed),
-            "missed_fraction": self.missed / max(1, self.ticks),
-            "tick_errors": float(self.tick_errors),
-            "lateness_mean_ms": float(lat.mean() * 1e3),
-            "lateness_p99_ms": float(np.percentile(lat, 99) * 1e3),
-            "lateness_max_ms": float(lat.max() * 1e3),
-            "gap_p99_ms": float(np.percentile(gap, 99) * 1e3),
-            "gap_max_ms": float(gap.max() * 1e3),
-            "gaps_over_10ms": float(np.count_nonzero(gap > 0.010)),
-            "resyncs": float(self.resyncs),
-            "gc_max_ms": self.gc_max * 1e3,
-        }
-
-
 def _check_host(host: str, allow_remote: bool) -> None:
     try:
         addr = ipaddress.ip_address(socket.gethostbyname(host))
@@ -114,53 +70,6 @@ def _check_host(host: str, allow_remote: bool) -> None:
             f"host: {host!r} is not a loopback address; pass allow_remote=True to serve "
             "a network interface"
         )
-
-
-def emulated_model(
-    model: str | RobotModel, calibration: Calibration | str | os.PathLike | None = None
-) -> RobotModel:
-    """The arm an emulator runs: ``model`` (a catalogue name or a :class:`RobotModel`) with
-    ``calibration`` (a :class:`~ruledrobot.robot.Calibration`, a ``ruledrobot.calibration/1``
-    file, or ``"random:SEED"`` for a seeded realistic one) attached.  ValueError (naming both
-    models) for a calibration of another model, :class:`~ruledrobot.robot.CalibrationError`
-    for a bad file."""
-    arm = load(model) if isinstance(model, str) else model
-    if not isinstance(arm, RobotModel):
-        raise ValueError(f"model: expected a model name or a RobotModel, got {type(arm).__name__}")
-    if calibration is None:
-        return arm
-    if isinstance(calibration, str) and calibration.startswith("random:"):
-        seed_text = calibration[len("random:") :]
-        if not seed_text.isdigit():
-            raise ValueError(f"random:SEED needs a seed >= 0, got {seed_text!r}")
-        calibration = random_calibration(arm.name, int(seed_text))
-    if isinstance(calibration, (str, os.PathLike)):
-        cal, where = load_calibration(calibration), f"{os.fspath(calibration)}: "
-    else:
-        cal, where = calibration, ""
-    if not isinstance(cal, Calibration):
-        raise ValueError(f"calibration: expected a Calibration or a file, got {type(cal).__name__}")
-    if cal.model != arm.name:
-        raise ValueError(
-            f"{where}a calibration of a {cal.model} (source {cal.source!r}), but the emulator "
-            f"is a {arm.name}: refused"
-        )
-    return arm.with_calibration(cal)
-
-
-def kinematics_info_of(model: RobotModel) -> KinematicsInfo:
-    """The KinematicsInfo an emulator of ``model`` serves: its calibration's (effective table,
-    checksums, status; checksums 0 and status 2 where the calibration has none), or for
-    an uncalibrated model its DH table with checksums 0 and status 2 ("linearised": the
-    table is the emulated arm's exact kinematics)."""
-    if model.calibration is not None:
-        return model.calibration.kinematics_info()
-    if model.n_joints != 6:
-        raise ValueError(f"model {model.name!r}: KinematicsInfo needs 6 joints")
-    return KinematicsInfo(
-        checksum=(0,) * 6, theta=np.array(model.theta_offset), a=np.array(model.a),
-        d=np.array(model.d), alpha=np.array(model.alpha), calibration_status=2,
-    )  # fmt: skip
 
 
 class ThreadedEmulator:

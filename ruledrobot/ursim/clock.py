@@ -1,0 +1,53 @@
+"""Timing statistics of the emulator's controller clock (:class:`ClockStats`)."""
+
+from __future__ import annotations
+
+from collections import deque
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["ClockStats"]
+
+
+@dataclass
+class ClockStats:
+    """Timing of the controller clock.
+
+    ``ticks``: control periods run.  ``missed``: periods the clock was too
+    late to publish (it steps the controller to catch up, without sending).
+    ``lateness``: recent publish times minus their scheduled times [s].
+    ``tick_errors`` / ``publish_errors``: controller periods / publishes that
+    raised (logged, rate-limited; the clock goes on).  ``gaps``: recent
+    intervals between consecutive publishes [s] (one period when all is well;
+    a stall shows here even when the clock resynchronises after it).
+    ``gc_max``: the longest garbage-collector pause [s] (it holds the GIL, so
+    it stalls the clock too).
+    """
+
+    ticks: int = 0
+    missed: int = 0
+    resyncs: int = 0
+    tick_errors: int = 0
+    publish_errors: int = 0
+    gc_max: float = 0.0
+    lateness: deque | None = None
+    gaps: deque | None = None
+
+    def summary(self) -> dict[str, float]:
+        lat = np.asarray(self.lateness or [0.0])
+        gap = np.asarray(self.gaps or [0.0])
+        return {
+            "ticks": float(self.ticks),
+            "missed": float(self.missed),
+            "missed_fraction": self.missed / max(1, self.ticks),
+            "tick_errors": float(self.tick_errors),
+            "lateness_mean_ms": float(lat.mean() * 1e3),
+            "lateness_p99_ms": float(np.percentile(lat, 99) * 1e3),
+            "lateness_max_ms": float(lat.max() * 1e3),
+            "gap_p99_ms": float(np.percentile(gap, 99) * 1e3),
+            "gap_max_ms": float(gap.max() * 1e3),
+            "gaps_over_10ms": float(np.count_nonzero(gap > 0.010)),
+            "resyncs": float(self.resyncs),
+            "gc_max_ms": self.gc_max * 1e3,
+        }

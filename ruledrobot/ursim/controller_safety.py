@@ -1,0 +1,123 @@
+"""The controller's power and safety: power on and off, brakes, protective and emergency
+stops, their unlocking and release, clearing faults.
+
+A mixin of :class:`~.controller.Controller` (its ``lock``, modes, motion and program
+control); thread safety as the controller's: every method takes ``lock``.
+"""
+
+from __future__ import annotations
+
+import time
+from threading import RLock
+from typing import Any
+
+from ..protocol.modes import RobotMode, SafetyMode
+from .motion import StopMotion
+
+__all__ = ["SafetyMixin"]
+
+
+class SafetyMixin:
+    """Power and safety transitions (module doc)."""
+
+    lock: RLock
+    robot_mode: RobotMode
+    safety_mode: SafetyMode
+    motion: Any
+    backend: Any
+    fault_deceleration: float
+    unlock_delay: float
+
+    def power_on(self) -> bool:
+        with self.lock:
+            if self.safety_mode != SafetyMode.NORMAL:
+                return False
+            if self.robot_mode in (RobotMode.POWER_OFF, RobotMode.POWER_ON):
+                self.robot_mode = RobotMode.IDLE
+            return True
+
+    def brake_release(self) -> bool:
+        with self.lock:
+            if self.safety_mode != SafetyMode.NORMAL or self.robot_mode < RobotMode.POWER_ON:
+                return False
+            self.robot_mode = RobotMode.RUNNING
+            return True
+
+    def power_off(self) -> None:
+        with self.lock:
+            self.stop_program("power off", decelerate=False)
+            self.motion = None
+            self.mode = "idle"
+            self._hold_q = None
+            self.backend.hold()
+            self.robot_mode = RobotMode.POWER_OFF
+
+    def _brake(self) -> None:
+        st = self.backend.state()
+        self.motion = StopMotion(st.target_q, st.target_qd, self.fault_deceleration)
+        self.mode = "move"
+
+    def protective_stop(self, reason: str = "protective stop") -> None:
+        """Fault: protective stop (the arm brakes, the program stops)."""
+        with self.lock:
+            if self.safety_mode == SafetyMode.PROTECTIVE_STOP:
+                return
+            self.safety_mode = SafetyMode.PROTECTIVE_STOP
+            self._fault_time = time.monotonic()
+            self.log(f"protective stop: {reason}", level=1)
+            self.stop_program("protective stop", decelerate=False)
+            self._brake()
+
+    def unlock_protective_stop(self) -> tuple[bool, str]:
+        """Dashboard ``unlock protective stop``: (accepted, reply)."""
+        with self.lock:
+            if self.safety_mode != SafetyMode.PROTECTIVE_STOP:
+                return True, "Protective stop releasing"
+            if time.monotonic() - self._fault_time < self.unlock_delay:
+                return False, (
+                    f"Cannot unlock protective stop until {self.unlock_delay:g}s after occurrence. "
+                    "Always inspect cause of protective stop before unlocking"
+                )
+            self.safety_mode = SafetyMode.NORMAL
+            self.log("protective stop released")
+            return True, "Protective stop releasing"
+
+    def emergency_stop(self, reason: str = "emergency stop button pressed") -> None:
+        """Fault: robot emergency stop (the arm brakes, then power goes off)."""
+        with self.lock:
+            if self.safety_mode == SafetyMode.ROBOT_EMERGENCY_STOP:
+                return
+            self.safety_mode = SafetyMode.ROBOT_EMERGENCY_STOP
+            self.log(f"emergency stop: {reason}", level=1)
+            self.stop_program("emergency stop", decelerate=False)
+            self._brake()
+            self._power_off_when_stopped = True
+
+    def restart_safety(self) -> None:
+        """Dashboard ``restart safety``: the safety system restarts after a fault or a
+        violation, the robot is then powered off.  An emergency stop stays: it is
+        released on the robot (the button), never from the network."""
+        with self.lock:
+            if self.safety_mode in (SafetyMode.ROBOT_EMERGENCY_STOP,
+                                    SafetyMode.SYSTEM_EMERGENCY_STOP):  # fmt: skip
+                self.log("restart safety: the emergency stop is still pressed; it must be "
+                         "released on the robot", level=2)  # fmt: skip
+            elif self.safety_mode in (SafetyMode.FAULT, SafetyMode.VIOLATION):
+                self.log(f"restart safety: {self.safety_mode.name} cleared")
+                self.safety_mode = SafetyMode.NORMAL
+            self.power_off()
+
+    def release_emergency_stop(self) -> None:
+        """The e-stop button is released: safety NORMAL; power on + brake release to run."""
+        with self.lock:
+            if self.safety_mode == SafetyMode.ROBOT_EMERGENCY_STOP:
+                self.safety_mode = SafetyMode.NORMAL
+                self.log("emergency stop released")
+
+    def clear_faults(self) -> None:
+        """Back to NORMAL and RUNNING at once (test helper; a real robot needs the steps)."""
+        with self.lock:
+            self.safety_mode = SafetyMode.NORMAL
+            self.robot_mode = RobotMode.RUNNING
+            self._power_off_when_stopped = False
+
