@@ -46,6 +46,9 @@ TABLE_GEOM = "table"
 _BOW_RGBA = "0.95 0.55 0.10 1"
 _WIRE_RGBA = "0.90 0.05 0.05 1"
 _STOCK_RGBA = "0.93 0.88 0.62 0.55"
+#: with the part drawn inside it, the stock is the material the cuts remove: fainter
+_STOCK_WITH_PART_RGBA = "0.93 0.88 0.62 0.22"
+_PART_RGBA = "0.35 0.70 0.40 1"
 _TABLE_RGBA = "0.55 0.42 0.30 1"
 
 
@@ -108,7 +111,9 @@ class Scene:
     top (robot base frame), ``"auto"`` (:func:`default_table`) or None;
     ``width`` x ``height`` the video resolution (sets the offscreen buffer);
     ``camera`` ``(position, target)`` in the base frame or None
-    (:func:`default_camera`).
+    (:func:`default_camera`); ``part`` the kept part's mesh (``vertices`` (V, 3) m and
+    ``faces`` (F, 3) in the base frame, e.g. :func:`ruledrobot.wirecut.part.part_mesh`)
+    or None — drawn in green inside a fainter stock, for looking only (no contacts).
     """
 
     robot: RobotModel
@@ -119,6 +124,7 @@ class Scene:
     height: int = 480
     camera: tuple[ArrayLike, ArrayLike] | None = field(default=None, repr=False)
     gains: ServoGains | None = field(default=None, repr=False)
+    part: Any = field(default=None, repr=False)
 
     @classmethod
     def from_job(cls, job: Any, robot: RobotModel | None = None, **kw: Any) -> Scene:
@@ -140,6 +146,7 @@ class Scene:
             height=self.height,
             camera=self.camera,
             gains=self.gains,
+            part=self.part,
         )
 
 
@@ -158,6 +165,7 @@ def scene_mjcf(
     camera: tuple[ArrayLike, ArrayLike] | None = None,
     gains: ServoGains | None = None,
     floor: bool = True,
+    part: Any = None,
 ) -> str:
     """MJCF text of the work cell: arm on a table, bow tool, stock, lights, camera.
 
@@ -327,10 +335,17 @@ def scene_mjcf(
             name=STOCK_GEOM,
             type="box",
             size=0.5 * stock.size,
-            rgba=_STOCK_RGBA,
+            rgba=_STOCK_RGBA if part is None else _STOCK_WITH_PART_RGBA,
             contype=1,
             conaffinity=1,
         )
+    if part is not None and len(part.faces):
+        v = np.asarray(part.vertices, dtype=np.float64)
+        f = np.asarray(part.faces, dtype=np.int64)
+        sub(asset, "mesh", name="part", vertex=" ".join(f"{x:.6g}" for x in v.ravel()),
+            face=" ".join(str(int(i)) for i in f.ravel()))  # fmt: skip
+        placed(world, "geom", _in_base(model, np.eye(4)), name="part", type="mesh", mesh="part",
+               rgba=_PART_RGBA, contype=0, conaffinity=0, group=1)  # fmt: skip
 
     if tool is not None:
         bow = placed(tree.last_body, "body", tree.flange, name="bow", gravcomp=1)

@@ -27,6 +27,9 @@ from .verify import Verification
 
 __all__ = ["write_plan"]
 
+#: grid step of the part drawn in the video [m] (a lighter mesh than part.stl)
+VIDEO_RESOLUTION = 0.005
+
 
 def _lines_of(frames: np.ndarray) -> Lines:
     z, o = frames[:, :3, 2], frames[:, :3, 3]
@@ -91,7 +94,8 @@ def write_plan(
                 from ..sim import RenderUnavailable, Scene, render_video
 
                 try:
-                    scene = Scene.from_job(plan.job, robot=plan.model)
+                    coarse = part_mesh(plan.job, plan.passes, VIDEO_RESOLUTION)
+                    scene = Scene.from_job(plan.job, robot=plan.model, part=coarse)
                     mo = plan.motion
                     files["video"] = render_video(scene, folder / "video.mp4", mo.timed.t,
                                                   ver.playback.q,
