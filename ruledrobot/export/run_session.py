@@ -255,14 +255,15 @@ class Session:
         return np.asarray(qa)
 
     def check_deviation(self, plan: np.ndarray, qa: np.ndarray, upto: int) -> None:
-        """Deviation of ``qa`` from the nearest plan sample in ``[k_match - window, upto]``
-        (at most ``window`` ahead of ``k_match``); moves ``k_match`` there.
+        """Deviation of ``qa`` from the nearest plan sample in ``[k_match - window / 4,
+        upto]`` (at most ``window`` ahead of ``k_match``); moves ``k_match`` there.
 
-        The match may step back: where the plan creeps (the start of a move from rest),
-        a servo's small lag makes a later sample look nearest for a while, and a match
-        that only moves forward would run ahead of the arm and report its lag as a
-        deviation."""
-        lo = max(0, self.k_match - self.window)
+        The match may step back a little (a quarter of the window, about the servo's
+        lag): where the plan creeps (the start of a move from rest) a later sample can
+        look nearest for a while, and a match that only moves forward would run ahead of
+        the arm and report its lag as a deviation.  Not further: a path that comes back
+        near itself (a move there and back) would pull the match to its earlier visit."""
+        lo = max(0, self.k_match - self.window // 4)
         hi = min(upto, self.k_match + self.window) + 1
         d = np.max(np.abs(plan[lo:hi] - qa), axis=1)
         # the last of equal minima: through a hold longer than the window (the wire
