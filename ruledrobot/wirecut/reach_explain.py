@@ -85,8 +85,8 @@ def reach_reasons(plan) -> tuple[str, ...]:
         at = pm.reason[d][np.argmax(pm.margin[d], axis=0), np.arange(pm.idx.size)]
         for r in np.unique(at[best < 0]):
             mask = (best < 0) & (at == r)
-            text = f"{head}rulings {ruling_ranges(pm, mask)} (of {pm.rulings}): {REASON_TEXT[Reason(r)]}"
-            text += " at every roll of the wire"
+            text = (f"{head}rulings {ruling_ranges(pm, mask)} (of {pm.rulings}): "
+                    f"{REASON_TEXT[Reason(r)]} at every roll of the wire")
             if r == Reason.OUT_OF_REACH:
                 worst = int(np.flatnonzero(mask)[np.argmin(best[mask])])
                 text += (f"; out of reach by up to {_excess_words(cell, cp, pm, worst)} "

@@ -198,8 +198,8 @@ def plot_reach(path: str | Path, rm: ReachMap) -> Path:
                 out = (pm.reason[d] == Reason.OUT_OF_REACH).all(axis=0)
                 if out.any():
                     far = float(-pm.margin[d][:, out].max(axis=0).min())
-                    words.append(f"rulings {ruling_ranges(pm, out)} out of reach at every roll, by up "
-                                 f"to {far * 1e3:.0f} mm")
+                    words.append(f"rulings {ruling_ranges(pm, out)} out of reach at every "
+                                 f"roll, by up to {far * 1e3:.0f} mm")
             if x0 > 0:
                 ax.axvline(x0 + x[0] - half, color="w", lw=3)
             x0 += x[-1] + 2 * half
