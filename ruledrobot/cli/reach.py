@@ -86,10 +86,18 @@ def place(
     from ..wirecut.place_run import run_place
     from ..wirecut.placement import Region, parse_range, parse_turns
 
-    def program(trajectory, folder: Path) -> Path:
+    def program(trajectory, folder: Path) -> Path | None:
+        """URScript for the pendant (servoj; movep when servoj would be too long; none when
+        both are: the trajectory in plan/ is then streamed with ruledrobot run)."""
         from ..export import export_trajectory
 
-        return export_trajectory(trajectory, folder / "cut.script")
+        for mode in ("servoj", "movep"):
+            try:
+                return export_trajectory(trajectory, folder / "cut.script", mode=mode)
+            except ValueError as exc:
+                why = str(exc)
+        err.print(f"note: no cut.script in {folder}: {why}", highlight=False, markup=False)
+        return None
 
     try:
         spec = load_job(job)

@@ -9,19 +9,21 @@ metres: the smallest of
   branch cannot reach gets ``-`` the distance it misses by
   (:func:`~ruledrobot.robot.workspace.reach_excess`);
 * **joint limits**: radians from the nearest joint limit (best ``2 pi``
-  representative) times :attr:`Rules.limit_lever` (0.1 m per radian: the wire's
-  lever about a wrist joint);
+  representative) times the joint's lever (:func:`limit_levers`: the arm's length
+  for the shoulder joints, the forearm for the elbow, ``d5 + d6`` for the wrists),
+  the arc the arm could still move along before the limit;
 * **singularity**: ``(measure - singular_min) * (|a2| + |a3| + |d5|)``, where
   ``measure * (|a2| + |a3| + |d5|) = |sin q3 sin q5| |s|`` is the shoulder factor
   ``s`` (m) discounted by the elbow and wrist sines (0 at the planner's threshold);
 * **clearance**: the free space (m) beyond the planner's safety margin between the
   arm and the stock and table, and the bow and the table — the planner's own rules
   (:func:`ruledrobot.wirecut.clearance.clearance`) checked at the levels
-  :attr:`Rules.levels`, so the value is quantised down to them (0, 10, 25, 45 mm
-  above the 5 mm safety margin; -5, -35, -55 mm below it).  45 mm is the most
-  clearance counts for: the arm's shoulder housing stands about 10 cm above the
-  table on every UR, so the arm-table rule never holds at a 10 cm level, and more
-  free space than that does not make a placement better.  The bow against the
+  :attr:`Rules.levels`, so the value is quantised down to them (0, 10, 25 mm above
+  the 5 mm safety margin; -5, -35, -55 mm below it).  From 45 mm on the clearance
+  is **ample** and bounds nothing (the value is infinite): the margin is then the
+  arm's own room — reach, limits, singularity.  (A higher level would not work as
+  a bound: the arm's shoulder housing stands about 10 cm above the table on every
+  UR, so the arm-table rule never holds at a 10 cm level.)  The bow against the
   stock (decided by the roll and slide alone, wherever the block is) and the bow
   and wire against the arm (decided by the tool and the wrist; the bow's hub sits a
   few centimetres from wrist 1 whatever the placement) are rules a configuration
@@ -57,6 +59,7 @@ __all__ = [
     "clearance_margins",
     "joint_limit_margin",
     "kinematic_margins",
+    "limit_levers",
 ]
 
 
@@ -107,23 +110,25 @@ class Rules:
     """Thresholds of the margins (m, rad).
 
     ``singular_min`` and ``margin`` are the planner's (``solve_redundancy``);
-    ``limit_lever`` converts radians to the joint limit into metres; ``levels`` the
+    ``levels`` the
     clearance levels (m, absolute, ascending; ``margin`` among them) at which the
-    clearance rules are checked.
+    clearance rules are checked (from the top one on the clearance is ample).
     """
 
     singular_min: float = 0.02
     margin: float = 0.005
-    limit_lever: float = 0.1
     levels: tuple[float, ...] = (-0.03, 0.0, 0.005, 0.015, 0.03, 0.05)
+    #: the scale of margins on pictures (m): the map's darkest green
+    shown: float = 0.2
 
     def __post_init__(self) -> None:
         if self.margin not in self.levels or list(self.levels) != sorted(self.levels):
             raise ValueError("Rules.levels: expected ascending levels that include margin")
 
     @property
-    def top(self) -> float:
-        """The largest clearance value (m): the top level minus the margin."""
+    def ample(self) -> float:
+        """Clearance (m) beyond the safety margin from which on it is ample: it no longer
+        bounds the margin (the top level minus the margin)."""
         return self.levels[-1] - self.margin
 
 
@@ -131,9 +136,18 @@ class Rules:
 DEFAULT_RULES = Rules()
 
 
-def joint_limit_margin(model, q: FloatArray) -> FloatArray:
-    """Radians (...) from the nearest joint limit of joint positions ``q`` (..., 6), for the
-    best whole-turn representative of each joint (negative: no representative fits).
+def limit_levers(model) -> FloatArray:
+    """Metres per radian (6,) that turn each joint's distance to its limit into a length:
+    ``|a2| + |a3|`` for joints 1-2, ``|a3|`` for the elbow, ``d5 + d6`` for the wrists."""
+    g = model.nominal.ur_geometry
+    arm, fore, wrist = abs(g.a2) + abs(g.a3), abs(g.a3), abs(g.d5) + abs(g.d6)
+    return np.array([arm, arm, fore, wrist, wrist, wrist])
+
+
+def joint_limit_margin(model, q: FloatArray, levers: FloatArray | None = None) -> FloatArray:
+    """Distance (...) of joint positions ``q`` (..., 6) from the nearest joint limit, for
+    the best whole-turn representative of each joint (negative: no representative fits):
+    radians, or metres with ``levers`` (6,) m/rad (:func:`limit_levers`).
 
     The best representative is the one nearest the middle of the limits.
     """
@@ -142,10 +156,11 @@ def joint_limit_margin(model, q: FloatArray) -> FloatArray:
     if not fin.any():
         return np.full(q.shape[:-1], np.inf)
     mid, half = 0.5 * (lo[fin] + hi[fin]), 0.5 * (hi[fin] - lo[fin])
+    scale = 1.0 if levers is None else np.asarray(levers)[fin]
     qf = q[..., fin] if not fin.all() else q
     if np.all(mid == 0.0) and np.all(np.abs(qf) <= np.pi):  # principal values: no wrap
-        return (half - np.abs(qf)).min(axis=-1)
-    return (half - np.abs(wrap_angle(qf - mid))).min(axis=-1)
+        return ((half - np.abs(qf)) * scale).min(axis=-1)
+    return ((half - np.abs(wrap_angle(qf - mid))) * scale).min(axis=-1)
 
 
 def kinematic_margins(
@@ -163,9 +178,9 @@ def kinematic_margins(
     g = model.nominal.ur_geometry
     scale = abs(g.a2) + abs(g.a3) + abs(g.d5)
     reach = reach_margin(model, qz)
-    limit = joint_limit_margin(model, qz)
+    limit = joint_limit_margin(model, qz, limit_levers(model))
     sing = scale * (model.singularity_measure(qz) - rules.singular_min)
-    margin = np.minimum(np.minimum(reach, rules.limit_lever * limit), sing)
+    margin = np.minimum(np.minimum(reach, limit), sing)
     reason = np.where(limit < 0.0, Reason.JOINT_LIMIT,
                       np.where(sing < 0.0, Reason.SINGULARITY, Reason.OK)).astype(np.int8)
     if not valid.all():
@@ -197,10 +212,12 @@ def clearance_margins(
     stock and against the arm (:data:`GATES`: the tool and the wrist decide them) only
     pass or fail; the others — arm against stock and table, bow against the table —
     give the value: the highest level (:attr:`Rules.levels`) at which they hold, minus
-    the planner's margin.  Levels above the margin are tried from the top, only where
-    their value is below ``cap`` (n,) (a margin already known from the other rules;
-    None: no cap); levels below it only with ``depth`` (else a failure is worth 20 mm
-    below the lowest level).  A broken gate makes the value at most ``-margin``.
+    the planner's margin, and infinite at the top level (ample clearance).  Levels
+    above the margin are tried from the top, only where the result can matter: where
+    ``cap`` (n,) (a margin already known from the other rules; None: no cap) exceeds
+    the value of the level below; levels below the margin only with ``depth`` (else a
+    failure is worth 20 mm below the lowest level).  A broken gate makes the value at
+    most ``-margin``.
     ``cell.stock`` may hold one box per configuration (:class:`~.reach_grid.RowBoxes`).
     """
     n = len(q)
@@ -228,11 +245,13 @@ def clearance_margins(
         return ~bad
 
     pending = np.flatnonzero(~env)
-    for level in levels[k0 + 1:][::-1]:
-        v = float(level) - rules.margin
-        sel = pending if cap is None else pending[cap[pending] > v]
+    upper = levels[k0:]  # the margin, then the levels above it
+    for i in range(len(upper) - 1, 0, -1):
+        v = np.inf if i == len(upper) - 1 else float(upper[i]) - rules.margin
+        below = float(upper[i - 1]) - rules.margin
+        sel = pending if cap is None else pending[cap[pending] > below]
         if sel.size:
-            ok = kept(float(level), sel)
+            ok = kept(float(upper[i]), sel)
             value[sel[ok]] = v
             pending = np.setdiff1d(pending, sel[ok], assume_unique=True)
     idx = np.flatnonzero(env) if depth else np.zeros(0, np.intp)

@@ -34,6 +34,7 @@ from .margins import (
     best_of,
     clearance_margins,
     kinematic_margins,
+    limit_levers,
 )
 from .reach import job_cell
 from .reach_grid import RowBoxes, directions_needed, pass_poses, planner_slide, sample_rulings
@@ -186,16 +187,16 @@ class Evaluator:
                 val[go] = np.minimum(val[go] - TIE * base[go], rest) + TIE * base[go]
             return val
 
-        bound = np.minimum(kin, rules.top) + TIE * kin
+        bound = kin + TIE * kin
         best, arg, exact = best_of(bound, evaluate, self.per_round, self.max_rounds)
         d, k, b = np.unravel_index(arg, (D, K, 8))
         base = np.minimum(kin[np.arange(C), arg], self._travel_margin(q[np.arange(C), d, k, :, b]))
         return best - TIE * base, best, arg, exact
 
     def _travel_margin(self, q: FloatArray) -> FloatArray:
-        """Per column (m,) of joints ``q`` (m, R, 6) along the pass: radians left (times
-        the limit lever) when each joint's unwrapped travel is centred in its limits
-        (inf for unlimited joints, -inf for a column without a solution throughout)."""
+        """Per column (m,) of joints ``q`` (m, R, 6) along the pass: the radians left when
+        each joint's unwrapped travel is centred in its limits, times the joint's lever
+        (:func:`~.margins.limit_levers`; inf for unlimited joints)."""
         lo, hi = np.asarray(self.model.lower), np.asarray(self.model.upper)
         span = hi - lo
         fin = np.isfinite(span)
@@ -203,8 +204,8 @@ class Evaluator:
             return np.full(len(q), np.inf)
         qq = np.unwrap(np.nan_to_num(q[..., fin]), axis=1)
         travel = qq.max(axis=1) - qq.min(axis=1)
-        left = (0.5 * (span[fin] - travel)).min(axis=-1)
-        return self.rules.limit_lever * left
+        left = (0.5 * (span[fin] - travel) * limit_levers(self.model)[fin]).min(axis=-1)
+        return left
 
 
 @dataclass(frozen=True, eq=False)
@@ -228,7 +229,7 @@ class ColumnDetail:
 def details(ev: Evaluator, T: FloatArray) -> list[ColumnDetail]:
     """The best column of every pass for the placement T (4, 4), ruling by ruling."""
     from ..robot.workspace import reach_margin
-    from .margins import REASON_TEXT, joint_limit_margin
+    from .margins import REASON_TEXT, joint_limit_margin, limit_levers
 
     sc = ev(T[None])
     model, rules = ev.model, ev.rules
@@ -245,7 +246,7 @@ def details(ev: Evaluator, T: FloatArray) -> list[ColumnDetail]:
         ok = ~np.isnan(q[:, 0])
         parts = {
             "reach": np.where(ok, reach_margin(model, np.nan_to_num(q)), -np.inf),
-            "joint limits": rules.limit_lever * joint_limit_margin(model, np.nan_to_num(q)),
+            "joint limits": joint_limit_margin(model, np.nan_to_num(q), limit_levers(model)),
             "singularity": scale * (model.singularity_measure(np.nan_to_num(q))
                                     - rules.singular_min),
         }

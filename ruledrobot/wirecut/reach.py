@@ -66,7 +66,7 @@ def classify(
             reason[gi, oi] = np.where(reason[gi, oi] == 0, cr, reason[gi, oi])
         return val
 
-    best, arg, _ = best_of(np.minimum(km, rules.top), evaluate)
+    best, arg, _ = best_of(km, evaluate)
     n = np.arange(len(Pf))
     r = np.where(best >= 0.0, np.int8(Reason.OK), reason[n, arg]).astype(np.int8)
     qb = qs[n, arg]

@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from ..io.atomic import atomic_write_bytes, atomic_write_text
-from .margins import REASON_TEXT, Reason
+from .margins import REASON_TEXT, Reason, limit_levers
 from .reach import PassMap, ReachMap
 
 __all__ = [
@@ -118,7 +118,8 @@ def write_reach_json(path: str | Path, rm: ReachMap, job_ref: dict | None) -> Pa
         "job": job_ref,
         "robot": rm.job.robot.model,
         "rules": {"singularity_min": r.singular_min, "clearance_margin_m": r.margin,
-                  "limit_lever_m_per_rad": r.limit_lever, "clearance_levels_m": list(r.levels)},
+                  "limit_levers_m_per_rad": limit_levers(rm.job.robot_model()).tolist(),
+                  "clearance_levels_m": list(r.levels)},
         "reasons": {int(k): v for k, v in REASON_TEXT.items()},
         "margin": "mm: the least of reach, joint-limit, singularity and clearance room "
                   "(docs/place.md); negative where the arm cannot hold the wire",
@@ -158,7 +159,7 @@ def plot_reach(path: str | Path, rm: ReachMap) -> Path:
     from matplotlib.patches import Patch
 
     cuts = list(dict.fromkeys(pm.cut for pm in rm.passes))
-    top = rm.rules.top
+    top = rm.rules.shown
     fig = Figure(figsize=(13, 1.2 + 3.4 * len(cuts)))
     FigureCanvasAgg(fig)
     present: set[int] = set()
