@@ -36,7 +36,8 @@ __all__ = ["Candidate", "PlaceResult", "job_passes", "search", "verify_best"]
 @dataclass(frozen=True)
 class Candidate:
     """A scored placement: ``margin`` (m, the worst over every pass), ``score`` (the
-    ranking value), ``cut_margins`` (m, per cut), ``xyz`` its ``[x, y, yaw]``."""
+    ranking value), ``cut_margins`` (m, per cut scored: every cut of the job, or a
+    setup's), ``xyz`` its ``[x, y, yaw]``."""
 
     placement: Placement
     margin: float
@@ -155,14 +156,15 @@ def search(
         S = np.concatenate(ss)
         seeds = X[np.argsort(-S, kind="stable")[:top]]
         new = region.clip((seeds[:, None, :] + offsets[None] * steps).reshape(-1, 3))
-        new = np.unique(new.round(9), axis=0)
-        seen = {tuple(v) for v in np.concatenate(xs).round(9)}
+        new = np.unique(new.round(7), axis=0)
+        seen = {tuple(v) for v in np.concatenate(xs).round(7)}
         new = np.array([v for v in new if tuple(v) not in seen])
         if new.size:
             say(f"refining around the best {top} (step {level + 1} of {refine})")
             run(new)
     X, M, S, CM, E = (np.concatenate(v) for v in (xs, ms, ss, cms, exs))
-    order = np.argsort(-S, kind="stable")
+    _, first = np.unique(X.round(7), axis=0, return_index=True)
+    order = first[np.argsort(-S[first], kind="stable")]
     ranked = tuple(Candidate(Placement(*map(float, X[i]), move=region.move, turn=turn),
                              float(M[i]), float(S[i]), tuple(map(float, CM[i])), bool(E[i]))
                    for i in order[:10])  # fmt: skip

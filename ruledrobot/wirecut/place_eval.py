@@ -109,6 +109,15 @@ class Evaluator:
             self.samples.append(PassSample(names.index(cp.name), cp.name, idx, P0, ~bow,
                                            float(np.max(too_long))))  # fmt: skip
 
+    def subset(self, cuts: list[int]) -> Evaluator:
+        """This evaluator for the passes of ``cuts`` only (indices into the job's cuts);
+        :meth:`cut_margins` is then inf for the others."""
+        import copy
+
+        out = copy.copy(self)
+        out.samples = [s for s in self.samples if s.cut in cuts]
+        return out
+
     @property
     def rulings_checked(self) -> int:
         """Rulings each candidate checks (over all passes)."""

@@ -26,9 +26,11 @@ def _outline(job, cand: Candidate | None) -> np.ndarray:
     return pts[:, :2]
 
 
-def plot_place(path: str | Path, res: PlaceResult, extra: list[Candidate] | None = None) -> Path:
+def plot_place(path: str | Path, res: PlaceResult, extra: list[Candidate] | None = None,
+               sweep: tuple[np.ndarray, np.ndarray] | None = None) -> Path:  # fmt: skip
     """Write the search's picture (module doc) to ``path`` atomically; ``extra``: more
-    placements to outline (setups), numbered."""
+    placements to outline (setups), numbered; ``sweep``: yaws (rad) and margins (m) at
+    the best place (else the samples nearest it are drawn)."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.colors import TwoSlopeNorm
     from matplotlib.figure import Figure
@@ -83,10 +85,13 @@ def plot_place(path: str | Path, res: PlaceResult, extra: list[Candidate] | None
     fig.colorbar(sc, ax=ax, fraction=0.04, pad=0.02).set_label("worst margin (mm)")
     # margin against yaw near the best place
     b = res.best.placement
-    near = np.hypot(X[:, 0] - b.x, X[:, 1] - b.y)
-    sel = near <= near.min() + 1e-9
-    order = np.argsort(X[sel, 2])
-    ax2.plot(np.degrees(X[sel, 2][order]), M[sel][order], "o-", ms=3, color="tab:blue")
+    if sweep is not None:
+        ax2.plot(np.degrees(sweep[0]), sweep[1] * 1e3, "o-", ms=3, color="tab:blue")
+    else:
+        near = np.hypot(X[:, 0] - b.x, X[:, 1] - b.y)
+        sel = near <= near.min() + 1e-9
+        order = np.argsort(X[sel, 2])
+        ax2.plot(np.degrees(X[sel, 2][order]), M[sel][order], "o-", ms=3, color="tab:blue")
     ax2.axhline(0.0, color="0.3", lw=0.8)
     ax2.axvline(np.degrees(b.yaw), color="tab:blue", ls=":", lw=1)
     ax2.set_xlabel("yaw of the block (deg)" if reg.move == "stock" else "turn of the base (deg)")

@@ -27,7 +27,7 @@ from .margins import Rules
 from .place import Candidate, PlaceResult, Verified, job_passes, search, verify_best
 from .place_eval import Evaluator, details
 from .place_plot import plot_place
-from .placement import Region, Turn
+from .placement import Region, Turn, transforms
 from .plan import job_reference
 from .setups import SetupPlan, operator_steps, plan_setups
 from .spec import Job
@@ -108,6 +108,14 @@ def run_place(
         lines.append(f"best found: {_cand_line(res.best)} "
                      f"({limiting(ev, res.best.placement.transform(job))})")  # fmt: skip
         verified = None
+        if not verify and res.feasible:  # the best, unverified: its job file only
+            from .jobfile import write_job_file
+            from .placement import moved_job
+
+            write_job_file(moved_job(job, res.best.placement.transform(job)),
+                           stage.path / "job.toml", check_as=out / "job.toml",
+                           note=f"placed by ruledrobot place (not verified): "
+                                f"{res.best.placement.describe()}")  # fmt: skip
         if verify and res.feasible:
             verified = verify_best(job, list(res.ranked), stage.path, out, tries, progress=say,
                                    program=program)
@@ -134,14 +142,22 @@ def run_place(
             not verify or all(c.candidate is not None for c in checks))  # fmt: skip
         if single_ok and verify:
             ok = True
+        b = res.best.placement
+        yaws = np.linspace(*region.yaw, 37) if region.yaw[1] > region.yaw[0] else None
+        sweep = None
+        if yaws is not None:
+            xyz = np.c_[np.full(37, b.x), np.full(37, b.y), yaws]
+            sweep = (yaws, ev(transforms(job, xyz, region.move, b.turn)).margin)
         plot_place(stage.path / "margin.png", res,
-                   [s.candidate for s in setups.setups] if setups else None)  # fmt: skip
+                   [s.candidate for s in setups.setups] if setups else None, sweep)  # fmt: skip
         doc = _document(job, res, verified, setups, checks, steps, ev, lines, ok)
         atomic_write_text(stage.path / "place.json", json.dumps(doc, indent=1) + "\n")
         target = stage.commit({"kind": "place", "ok": ok})
     files = {"place": target / "place.json", "margin": target / "margin.png"}
     if single_ok and verified is not None:
         files |= {"job": target / "job.toml", "plan": target / "plan"}
+    elif res.feasible and not verify:
+        files["job"] = target / "job.toml"
     if setups is not None:
         files["setups"] = target / "setups.txt"
         for s in setups.setups:
@@ -177,7 +193,8 @@ def _document(job: Job, res: PlaceResult, verified: Verified | None, setups: Set
         },
         "setups": None if setups is None else [
             {"setup": s.number, "cuts": [names[i] for i in s.cuts],
-             "placement": s.candidate.as_dict(names), "operator": steps[k],
+             "placement": s.candidate.as_dict([names[i] for i in s.cuts]),
+             "operator": steps[k],
              "verified": None if not checks else list(checks[k].tried),
              "passes": None if not checks else checks[k].candidate is not None}
             for k, s in enumerate(setups.setups)],

@@ -122,7 +122,8 @@ def plan_setups(
         values = [float(r.cut_margins[:, list(group)].min(axis=1).max()) for _, r in options]
         turn = options[int(np.argmax(values))][0]
         say(f"setups: placing setup {number} ({', '.join(job.cuts[i].name for i in group)})")
-        res = search(job, region, evaluator, grid, refine, turn=turn, cuts=list(group))
+        res = search(job, region, evaluator.subset(list(group)), grid, refine, turn=turn,
+                     cuts=list(group))  # fmt: skip
         setups.append(Setup(number, group, res.best, res.ranked))
     worst = min(s.candidate.margin for s in setups)
     return SetupPlan(tuple(setups), worst, tried)
