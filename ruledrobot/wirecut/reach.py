@@ -46,7 +46,9 @@ def classify(
 ) -> tuple[FloatArray, np.ndarray, np.ndarray, FloatArray]:
     """Best IK branch of each flange pose ``P`` (..., 4, 4): ``(margin (...) m, reason
     (...) int8, branch (...) int8, q (..., 6))`` (:mod:`.margins`; q NaN where no branch
-    has a solution).  ``depth``: resolve how deep failing clearances fail (else they
+    has a solution).  A pose is judged by the branches that reach it; only when none
+    does is it out of reach (by the least excess over the branches, :mod:`~ruledrobot.
+    robot.workspace`).  ``depth``: resolve how deep failing clearances fail (else they
     are worth the value below the lowest level)."""
     shape = P.shape[:-2]
     Pf = P.reshape(-1, 4, 4)
@@ -66,7 +68,11 @@ def classify(
             reason[gi, oi] = np.where(reason[gi, oi] == 0, cr, reason[gi, oi])
         return val
 
-    best, arg, _ = best_of(km, evaluate)
+    # a pose some branch reaches is judged by the branches that reach it: "out of reach"
+    # only where none does
+    valid = ~np.isnan(qs[..., 0])
+    bound = np.where(valid | ~valid.any(axis=1, keepdims=True), km, -np.inf)
+    best, arg, _ = best_of(bound, evaluate)
     n = np.arange(len(Pf))
     r = np.where(best >= 0.0, np.int8(Reason.OK), reason[n, arg]).astype(np.int8)
     qb = qs[n, arg]
