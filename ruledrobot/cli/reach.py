@@ -122,6 +122,8 @@ def place(
 def _print_place(res) -> None:
     from rich.table import Table
 
+    from ..wirecut.placement import mm
+
     for line in res.lines:
         console.print(line, highlight=False, markup=False)
     names = [c.name for c in res.result.job.cuts]
@@ -132,7 +134,7 @@ def _print_place(res) -> None:
         table.add_column(col, justify="right")
     for k, c in enumerate(res.result.ranked, start=1):
         p = c.placement
-        row = [str(k), f"{p.x * 1e3:.0f}", f"{p.y * 1e3:.0f}", f"{math.degrees(p.yaw):.1f}",
+        row = [str(k), mm(p.x), mm(p.y), f"{math.degrees(p.yaw) + 0.0:.1f}",
                p.turn.label, f"{c.margin * 1e3:.1f}"]
         if len(names) > 1:
             row += [f"{m * 1e3:.1f}" for m in c.cut_margins]

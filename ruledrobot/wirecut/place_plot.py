@@ -12,7 +12,7 @@ import numpy as np
 
 from ..io.atomic import atomic_write_bytes
 from .place import Candidate, PlaceResult
-from .placement import moved_job
+from .placement import mm, moved_job
 
 __all__ = ["plot_place"]
 
@@ -96,7 +96,7 @@ def plot_place(path: str | Path, res: PlaceResult, extra: list[Candidate] | None
     ax2.axvline(np.degrees(b.yaw), color="tab:blue", ls=":", lw=1)
     ax2.set_xlabel("yaw of the block (deg)" if reg.move == "stock" else "turn of the base (deg)")
     ax2.set_ylabel("worst margin (mm)")
-    ax2.set_title(f"at x = {b.x * 1e3:.0f} mm, y = {b.y * 1e3:.0f} mm; {len(X)} placements, "
+    ax2.set_title(f"at x = {mm(b.x)} mm, y = {mm(b.y)} mm; {len(X)} placements, "
                   f"{res.rulings} rulings x {res.rolls} rolls each", fontsize=9)  # fmt: skip
     ax2.grid(alpha=0.3)
     fig.tight_layout()

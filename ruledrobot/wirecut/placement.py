@@ -28,9 +28,23 @@ from ..geometry.box import Box
 from ..geometry.checks import FloatArray
 from .spec import Job
 
-__all__ = ["AS_CLAMPED", "Placement", "Region", "Turn", "moved_job", "parse_range", "parse_turns"]
+__all__ = [
+    "AS_CLAMPED",
+    "Placement",
+    "Region",
+    "Turn",
+    "mm",
+    "moved_job",
+    "parse_range",
+    "parse_turns",
+]
 
 MOVES = ("stock", "robot")
+
+
+def mm(v: float) -> str:
+    """Metres as whole millimetres, for messages (never "-0")."""
+    return str(round(float(v) * 1e3) + 0)
 
 
 def parse_range(text: str, what: str, unit: float = 1.0) -> tuple[float, float]:
@@ -166,9 +180,9 @@ class Placement:
     def describe(self) -> str:
         turn = "" if self.turn.degrees == 0 else f", after turning it {self.turn.label}"
         if self.move == "stock":
-            return (f"block centre at x = {self.x * 1e3:.0f} mm, y = {self.y * 1e3:.0f} mm, "
+            return (f"block centre at x = {mm(self.x)} mm, y = {mm(self.y)} mm, "
                     f"yaw {np.degrees(self.yaw):+.1f} deg{turn}")  # fmt: skip
-        return (f"robot base moved by x = {self.x * 1e3:.0f} mm, y = {self.y * 1e3:.0f} mm, "
+        return (f"robot base moved by x = {mm(self.x)} mm, y = {mm(self.y)} mm, "
                 f"turned {np.degrees(self.yaw):+.1f} deg{turn}")  # fmt: skip
 
 

@@ -17,6 +17,7 @@ import numpy as np
 from ..geometry.checks import FloatArray
 from ..robot.workspace import REACH_DIRECTIONS, reach_excess
 from .margins import DEFAULT_RULES, REASON_TEXT, Reason
+from .placement import mm
 from .reach import job_cell, map_pass
 from .reach_report import ruling_ranges
 
@@ -103,8 +104,8 @@ def reach_reasons(plan) -> tuple[str, ...]:
         out.append(f"no move suggested: {exc}")
     if move is not None:
         words, dist, centre = move
-        out.append(f"moving the block {dist * 1e3:.0f} mm {words} (block centre to x = "
-                   f"{centre[0] * 1e3:.0f} mm, y = {centre[1] * 1e3:.0f} mm, surfaces with it) "
+        out.append(f"moving the block {mm(dist)} mm {words} (block centre to x = "
+                   f"{mm(centre[0])} mm, y = {mm(centre[1])} mm, surfaces with it) "
                    "gives every sampled ruling a configuration within the rules; "
                    "ruledrobot place searches position and yaw")
     else:

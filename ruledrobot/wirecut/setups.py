@@ -31,7 +31,7 @@ from ..geometry.checks import FloatArray
 from .order import check_cut_order
 from .place import Candidate, PlaceResult, search
 from .place_eval import Evaluator
-from .placement import AS_CLAMPED, Region, Turn, moved_job
+from .placement import AS_CLAMPED, Region, Turn, mm, moved_job
 from .spec import Job
 
 __all__ = ["Setup", "SetupPlan", "corners", "operator_steps", "plan_setups"]
@@ -150,7 +150,7 @@ def _down_face(job: Job, T: FloatArray) -> str:
 
 
 def _mm(p: FloatArray) -> str:
-    return "(" + ", ".join(f"{v * 1e3:.0f}" for v in p) + ") mm"
+    return "(" + ", ".join(mm(v) for v in p) + ") mm"
 
 
 def operator_steps(job: Job, plan: SetupPlan) -> list[str]:
