@@ -171,8 +171,7 @@ class Evaluator:
 
         def clear(g, d, k, b, rows: np.ndarray) -> FloatArray:
             """Worst clearance margin (m,) of columns over the rulings ``rows``."""
-            use = usable[g, d, k][:, rows][..., :].copy()  # (m, r, 8)
-            use = use[np.arange(len(g)), :, b]
+            use = usable[g[:, None], d[:, None], k[:, None], rows[None, :], b[:, None]]  # (m, r)
             gi, ri = np.nonzero(use)
             out = np.full(len(g), np.inf)
             if gi.size:

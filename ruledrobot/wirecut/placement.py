@@ -37,6 +37,7 @@ __all__ = [
     "moved_job",
     "parse_range",
     "parse_turns",
+    "transforms",
 ]
 
 MOVES = ("stock", "robot")
