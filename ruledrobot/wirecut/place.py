@@ -26,7 +26,7 @@ import numpy as np
 from ..geometry.checks import FloatArray
 from .cutpath import CutPath
 from .path import cut_paths
-from .place_eval import Evaluator, Scores
+from .place_eval import Evaluator
 from .placement import AS_CLAMPED, Placement, Region, Turn, moved_job, transforms
 from .spec import Job
 
@@ -103,14 +103,6 @@ def job_passes(job: Job, model=None, progress: Callable[[str], None] | None = No
         say(f"refining {cut.name}")
         out += cut_paths(job, cut, model)
     return out
-
-
-def _candidates(region: Region, turn: Turn, xyz: FloatArray, sc: Scores, cuts: FloatArray,
-                exact: np.ndarray) -> list[Candidate]:  # fmt: skip
-    return [Candidate(Placement(float(a), float(b), float(c), region.move, turn),
-                      float(m), float(s), tuple(float(v) for v in cm), bool(e))
-            for (a, b, c), m, s, cm, e in zip(xyz, sc.margin, sc.score, cuts, exact,
-                                               strict=True)]  # fmt: skip
 
 
 def search(

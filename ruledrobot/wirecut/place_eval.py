@@ -11,7 +11,7 @@ the pass gets its best column.  A candidate's margin is the worst over its passe
 Vectorised over candidates x directions x rolls x rulings x branches for the IK and
 the kinematic margins; the clearance rules run for the most promising columns only,
 best bound first, until no remaining column can beat the best one found
-(:func:`~.margins.best_of`), with every candidate's stock in one call
+(:func:`~.branch_bound.best_of`), with every candidate's stock in one call
 (:class:`~.reach_grid.RowBoxes`).  Ties between columns and candidates whose margins
 are equal (the clearance is quantised) are broken by the kinematic margin
 (reach, limits, singularity): the score is ``margin + TIE * kinematic``.
@@ -25,13 +25,13 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..geometry.checks import FloatArray
+from .branch_bound import best_of
 from .clearance import clearance
 from .cutpath import CutPath
 from .margins import (
     DEFAULT_RULES,
     Reason,
     Rules,
-    best_of,
     clearance_margins,
     kinematic_margins,
     limit_levers,

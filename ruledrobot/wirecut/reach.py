@@ -7,7 +7,7 @@ lead-in/out), the slide is the planner's (the chosen motion's, else the one its
 search starts from), and the path the planner chose is kept to be drawn on the map
 and checked against it.  Vectorised over rulings x rolls x directions x IK branches;
 the clearance rules run only on the branch that can still be the best of its cell
-(:func:`~.margins.best_of`).
+(:func:`~.branch_bound.best_of`).
 """
 
 from __future__ import annotations
@@ -18,13 +18,13 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..geometry.checks import FloatArray
+from .branch_bound import best_of
 from .clearance import Cell
 from .cutpath import CutPath
 from .margins import (
     DEFAULT_RULES,
     Reason,
     Rules,
-    best_of,
     clearance_margins,
     kinematic_margins,
 )

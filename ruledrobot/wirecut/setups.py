@@ -26,7 +26,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..geometry import se3
 from ..geometry.checks import FloatArray
 from .order import check_cut_order
 from .place import Candidate, PlaceResult, search
@@ -192,13 +191,3 @@ def _yaw(job: Job, T: FloatArray) -> float:
     """The block's x axis direction in the horizontal plane after T (rad)."""
     x = (T[:3, :3] @ job.stock.rotation)[:, 0]
     return float(np.arctan2(x[1], x[0]))
-
-
-def describe_turn(T: FloatArray) -> str:
-    """A rotation (4, 4) as axis and angle, for reports."""
-    rv = se3.rotvec_from_matrix(T[:3, :3])
-    angle = float(np.linalg.norm(rv))
-    if angle < 1e-9:
-        return "no turn"
-    axis = rv / angle
-    return f"{np.degrees(angle):.0f} deg about ({axis[0]:.2f}, {axis[1]:.2f}, {axis[2]:.2f})"

@@ -11,11 +11,11 @@ import pytest
 
 from ruledrobot.geometry.box import Box
 from ruledrobot.robot import load
+from ruledrobot.wirecut.branch_bound import best_of
 from ruledrobot.wirecut.clearance import Cell, clearance
 from ruledrobot.wirecut.margins import (
     DEFAULT_RULES,
     GATES,
-    best_of,
     clearance_margins,
     joint_limit_margin,
     limit_levers,
