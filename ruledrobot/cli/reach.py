@@ -16,6 +16,9 @@ def reach(
     out: Path = typer.Option(Path("out/reach"), "--out", "-o", help="Output folder."),
     rulings: int = typer.Option(240, min=2, help="Rulings per pass on the map."),
     rolls: int = typer.Option(72, min=4, help="Rolls of the wire over a turn."),
+    slides: int = typer.Option(1, min=1, max=9, help="Slides of the wire along the ruling: "
+                               "the planner's, and more spread over the chord's freedom "
+                               "(each cell keeps its best)."),
 ) -> None:
     """Map where the arm can hold the wire: for every ruling of every pass and every roll
     about the wire, the margin or why not (out of reach, joint limit, singularity, which
@@ -28,7 +31,8 @@ def reach(
         spec = load_job(job)
         with console.status("mapping") as status:
             rm, files = write_reach(spec, out, rulings, rolls,
-                                    progress=lambda msg: status.update(msg))  # fmt: skip
+                                    progress=lambda msg: status.update(msg),
+                                    slides=slides)  # fmt: skip
     except ValueError as exc:
         raise fail(str(exc)) from None
     for line in summary_lines(rm):

@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..geometry.angles import wrap_angle
 from ..geometry.checks import FloatArray
 from .branch_bound import best_of
 from .clearance import Cell
@@ -29,9 +30,9 @@ from .margins import (
     kinematic_margins,
 )
 from .path import cut_paths
-from .reach_grid import pass_poses, planner_slide, sample_rulings
+from .reach_grid import directions_needed, pass_poses, planner_slide, sample_rulings
 from .spec import Job, ToolSpec
-from .toolpath import flange_poses, wire_poses
+from .toolpath import chords, flange_poses, slide_bounds, wire_poses
 
 __all__ = ["PassMap", "ReachMap", "classify", "job_cell", "map_pass", "reach_map"]
 
@@ -84,8 +85,9 @@ def classify(
 class PassMap:
     """The map of one pass: ``idx`` (R,) the sampled rulings (of ``rulings``), ``rolls``
     (K,) rad; per (direction, roll, ruling) (2, K, R) the margin (m), the reason
-    (:class:`~.margins.Reason`), the best IK branch and its joints (2, K, R, 6).
-    ``slide`` (R,) m; ``in_stock`` (R,) whether the ruling crosses the stock.  The
+    (:class:`~.margins.Reason`), the best IK branch and its joints (2, K, R, 6), and the
+    slide (index into ``slides`` (S, R) m) where it is best.  ``slide`` (R,) m: the
+    planner's (``slides[0]``); ``in_stock`` (R,) whether the ruling crosses the stock.  The
     planner's choice: ``chosen_roll`` (R,) rad (None when the pass is infeasible),
     ``chosen_reverse``, and the map's verdict along it, ``path_margin`` / ``path_reason``
     (R,) (classified at the chosen roll itself, not the nearest grid roll)."""
@@ -106,6 +108,8 @@ class PassMap:
     chosen_reverse: bool
     path_margin: FloatArray | None = field(repr=False)
     path_reason: np.ndarray | None = field(repr=False)
+    slides: FloatArray | None = field(default=None, repr=False)
+    slide_index: np.ndarray | None = field(default=None, repr=False)
 
     @property
     def shown(self) -> int:
@@ -139,9 +143,13 @@ def map_pass(
     rules: Rules,
     rulings: int = 240,
     rolls: int = 72,
+    slides: int = 1,
 ) -> PassMap:
     """The map of one planned pass ``cp`` (see :class:`PassMap`) with the job's ``tool``:
-    ``rulings`` sampled evenly (ends included), ``rolls`` evenly over a turn."""
+    ``rulings`` sampled evenly (ends included), ``rolls`` evenly over a turn, and
+    ``slides`` slides per ruling: the planner's, then ``slides - 1`` spread over the
+    interval in which the wire covers the ruling's chord (the common interval of the
+    pass for rulings outside the stock); each cell keeps its best slide."""
     F = cp.frames
     M = len(F)
     slide, too_long = planner_slide(F, cell.stock, tool)
@@ -149,8 +157,23 @@ def map_pass(
         slide = cp.motion.slide
     idx = sample_rulings(M, rulings)
     grid = np.linspace(-np.pi, np.pi, rolls, endpoint=False)
-    P = pass_poses(cell.W, F[idx], slide[idx], grid)
-    margin, reason, branch, q = classify(cell, P, rules)
+    options = _slide_options(F[idx], slide[idx], cell.stock, tool, slides)  # (S, R)
+    dirs = directions_needed(cell.W)
+    best = None
+    for s, sl in enumerate(options):
+        res = classify(cell, pass_poses(cell.W, F[idx], sl, grid, dirs), rules)
+        if len(dirs) == 1:  # the reversed wire: the same arm with q6 + pi
+            q2 = res[3].copy()
+            q2[..., 5] = wrap_angle(q2[..., 5] + np.pi)
+            res = tuple(np.concatenate([a, b]) for a, b in zip(res, (*res[:3], q2), strict=True))
+        if best is None:
+            best = [*res, np.zeros(res[0].shape, np.int8)]
+            continue
+        better = res[0] > best[0]
+        for k in range(4):
+            best[k] = np.where(better[..., None] if k == 3 else better, res[k], best[k])
+        best[4] = np.where(better, np.int8(s), best[4])
+    margin, reason, branch, q, slide_index = best
     bad = too_long[idx] > 0.0
     if bad.any():
         margin[..., bad] = np.minimum(margin[..., bad], -too_long[idx][bad])
@@ -162,7 +185,21 @@ def map_pass(
         path_m, path_r, _, _ = classify(cell, Pc, rules)
     return PassMap(cp.name, index, M, idx, grid, margin, reason, branch, q, slide[idx],
                    ~np.isnan(cp.motion.chord[idx, 0]), cp.feasible, chosen,
-                   bool(cp.motion.reverse), path_m, path_r)  # fmt: skip
+                   bool(cp.motion.reverse), path_m, path_r, options, slide_index)  # fmt: skip
+
+
+def _slide_options(F: FloatArray, slide: FloatArray, stock, tool: ToolSpec, n: int) -> FloatArray:
+    """Slides (n, R): ``slide`` first, then ``n - 1`` spread over each ruling's interval."""
+    if n <= 1:
+        return slide[None]
+    c0, c1, hit = chords(F, stock)
+    lo, hi, _ = slide_bounds(c0, c1, hit, tool)
+    common = (lo[hit].max(), hi[hit].min()) if hit.any() else (slide.min(), slide.max())
+    lo = np.where(hit, lo, common[0])
+    hi = np.where(hit, np.maximum(hi, lo), common[1])
+    hi = np.maximum(hi, lo)
+    frac = (np.arange(n - 1) + 0.5) / (n - 1)
+    return np.concatenate([slide[None], lo + frac[:, None] * (hi - lo)])
 
 
 def reach_map(
@@ -173,9 +210,10 @@ def reach_map(
     rules: Rules = DEFAULT_RULES,
     progress: Callable[[str], None] | None = None,
     passes: list[CutPath] | None = None,
+    slides: int = 1,
 ) -> ReachMap:
     """The reachability map of every pass of ``job`` (the planner's passes, or ``passes``
-    when already planned): see :class:`PassMap`."""
+    when already planned): see :class:`PassMap` and :func:`map_pass`."""
     import time
 
     say = progress or (lambda msg: None)
@@ -190,5 +228,5 @@ def reach_map(
     maps = []
     for k, cp in enumerate(passes):
         say(f"mapping pass {k + 1} of {len(passes)} ({cp.name})")
-        maps.append(map_pass(cell, job.tool, cp, k, rules, rulings, rolls))
+        maps.append(map_pass(cell, job.tool, cp, k, rules, rulings, rolls, slides))
     return ReachMap(job, tuple(maps), rules, time.perf_counter() - t0)

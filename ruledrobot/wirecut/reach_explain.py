@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..geometry.angles import wrap_angle
 from ..geometry.checks import FloatArray
 from ..robot.workspace import REACH_DIRECTIONS, reach_excess
 from .margins import DEFAULT_RULES, REASON_TEXT, Reason
@@ -69,6 +70,22 @@ def _excess_words(cell, cp, pm, ruling: int) -> str:
     return f"{e[b] * 1e3:.0f} mm, the wrist {REACH_DIRECTIONS[int(kind[b])]}"
 
 
+_JOINTS = ("shoulder pan", "shoulder lift", "elbow", "wrist 1", "wrist 2", "wrist 3")
+
+
+def _joints_out(model, pm, d: int, mask: np.ndarray) -> str:
+    """Which joints' limits the best configurations of the rulings ``mask`` break."""
+    k = np.argmax(pm.margin[d], axis=0)[mask]
+    q = pm.q[d, k, np.flatnonzero(mask)]
+    lo, hi = np.asarray(model.lower), np.asarray(model.upper)
+    mid, half = 0.5 * (lo + hi), 0.5 * (hi - lo)
+    with np.errstate(invalid="ignore"):
+        out = (np.abs(wrap_angle(np.nan_to_num(q) - np.where(np.isfinite(mid), mid, 0.0)))
+               > half).any(axis=0)  # fmt: skip
+    names = [f"joint {j + 1} ({_JOINTS[j]})" for j in np.flatnonzero(out)]
+    return "limits of " + ", ".join(names) if names else "joint limits"
+
+
 def reach_reasons(plan) -> tuple[str, ...]:
     """Extra reasons for a plan some pass of which is infeasible (module doc); () when
     every pass is feasible."""
@@ -86,8 +103,12 @@ def reach_reasons(plan) -> tuple[str, ...]:
         at = pm.reason[d][np.argmax(pm.margin[d], axis=0), np.arange(pm.idx.size)]
         for r in np.unique(at[best < 0]):
             mask = (best < 0) & (at == r)
-            text = (f"{head}rulings {ruling_ranges(pm, mask)} (of {pm.rulings}): "
-                    f"{REASON_TEXT[Reason(r)]} at every roll of the wire")
+            every = (pm.reason[d][:, mask] == r).all()
+            text = f"{head}rulings {ruling_ranges(pm, mask)} (of {pm.rulings}): "
+            text += (f"{REASON_TEXT[Reason(r)]} at every roll of the wire" if every else
+                     f"no roll of the wire works, the nearest miss: {REASON_TEXT[Reason(r)]}")
+            if r == Reason.JOINT_LIMIT:
+                text += f" ({_joints_out(plan.model, pm, d, mask)})"
             if r == Reason.OUT_OF_REACH:
                 worst = int(np.flatnonzero(mask)[np.argmin(best[mask])])
                 text += (f"; out of reach by up to {_excess_words(cell, cp, pm, worst)} "

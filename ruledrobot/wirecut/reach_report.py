@@ -104,6 +104,9 @@ def write_reach_json(path: str | Path, rm: ReachMap, job_ref: dict | None) -> Pa
             "branch": pm.branch.astype(int).tolist(),
             "in_stock": pm.in_stock.tolist(),
             "slide_m": np.round(pm.slide, 6).tolist(),
+            "slides_m": None if pm.slides is None else np.round(pm.slides, 6).tolist(),
+            "slide_index": None if pm.slide_index is None else pm.slide_index.astype(
+                int).tolist(),
             "planned": None if pm.chosen_roll is None else {
                 "roll_deg": np.round(np.degrees(pm.chosen_roll), 3).tolist(),
                 "reversed": pm.chosen_reverse,
@@ -238,7 +241,7 @@ def _roll_text(roll: np.ndarray) -> str:
 
 
 def write_reach(job, out: str | Path, rulings: int = 240, rolls: int = 72,
-                progress=None) -> tuple[ReachMap, dict[str, Path]]:  # fmt: skip
+                progress=None, slides: int = 1) -> tuple[ReachMap, dict[str, Path]]:  # fmt: skip
     """Map ``job`` (:func:`~.reach.reach_map`) and write ``reach.png`` and ``reach.json``
     into the folder ``out`` (written whole, swapped in at the end)."""
     from ..io.outdir import StagedFolder
@@ -246,7 +249,7 @@ def write_reach(job, out: str | Path, rulings: int = 240, rolls: int = 72,
     from .reach import reach_map
 
     with StagedFolder(out) as stage:
-        rm = reach_map(job, rulings=rulings, rolls=rolls, progress=progress)
+        rm = reach_map(job, rulings=rulings, rolls=rolls, progress=progress, slides=slides)
         write_reach_json(stage.path / "reach.json", rm, job_reference(job))
         plot_reach(stage.path / "reach.png", rm)
         ok = all(pm.feasible for pm in rm.passes)

@@ -169,9 +169,17 @@ def operator_steps(job: Job, plan: SetupPlan) -> list[str]:
                    f"block on its {face} face")  # fmt: skip
         else:
             how = "Unclamp the block. "
-            if face != _down_face(job, prev):
-                how += f"Tip it over an edge onto its {face} face (the {first_face} face "
-                how += "was down at first), then turn it about the vertical"
+            old = _down_face(job, prev)
+            if face != old:
+                opposite = {"+x": "-x", "-x": "+x", "+y": "-y", "-y": "+y", "top": "bottom",
+                            "bottom": "top"}  # fmt: skip
+                if opposite[face] == old:
+                    how += f"Turn it upside down, onto its {face} face"
+                else:
+                    how += (f"Tip it 90 deg over its bottom edge between the {old} and {face} "
+                            f"faces, onto its {face} face")  # fmt: skip
+                how += (f" (the {first_face} face was down at first), then turn it about the "
+                        "vertical")  # fmt: skip
             else:
                 yaw = np.degrees(np.arctan2(rel[1, 0], rel[0, 0]))
                 turn = ("counter-clockwise" if yaw > 0 else "clockwise")

@@ -29,14 +29,16 @@ def demo(tmp_path_factory):
     job = load_job(path)
     model = job.robot_model()
     passes = cut_paths(job, job.cut, model)
-    return job, model, passes, reach_map(job, model, rulings=40, rolls=36, passes=passes)
+    return job, model, passes, reach_map(job, model, rulings=40, rolls=36, passes=passes,
+                                         slides=2)
 
 
 def _cell_poses(pm, frames, W):
     D, K, R = pm.margin.shape
     shape = (D, K, R)
     roll = np.broadcast_to(pm.rolls[None, :, None], shape)
-    slide = np.broadcast_to(pm.slide[None, None, :], shape)
+    # each cell's own slide: the planner's (index 0) or another of the chord's freedom
+    slide = np.take_along_axis(pm.slides, pm.slide_index.reshape(-1, R), axis=0).reshape(shape)
     rev = np.broadcast_to(np.array([False, True])[:, None, None], shape)
     return flange_poses(wire_poses(frames[pm.idx], roll, slide, rev), W)
 
@@ -48,6 +50,7 @@ def test_every_reachable_cell_has_a_solution_the_planner_accepts(demo):
     P = _cell_poses(pm, cp.frames, cell.W)
     ok = pm.margin >= 0
     assert 0.1 < ok.mean() < 0.9  # the map has both kinds of cells
+    assert (pm.slide_index[ok] == 1).any() and (pm.slides[0] == pm.slide).all()
     q = pm.q[ok]
     np.testing.assert_allclose(model.fk(q), P[ok], atol=1e-9)  # a solution of the cell's pose
     assert model.within_limits(q).all()
