@@ -29,7 +29,7 @@ from .place_eval import Evaluator, details
 from .place_plot import plot_place
 from .placement import Region, Turn, transforms
 from .plan import job_reference
-from .setups import SetupPlan, operator_steps, plan_setups
+from .setups import MAX_SETUPS, SetupPlan, operator_steps, plan_setups
 from .spec import Job
 
 __all__ = ["PLACE_FORMAT", "PlaceOutcome", "limiting", "run_place"]
@@ -125,6 +125,13 @@ def run_place(
         if not single_ok and len(job.cuts) > 1 and turns:
             small = tuple(max(3, min(g, 7)) for g in grid)
             setups = plan_setups(job, region, ev, turns, small, refine, say)
+            allowed = ", ".join(t.label for t in turns)
+            if setups is None:
+                lines.append(f"no grouping of the cuts into at most {MAX_SETUPS} setups (the "
+                             f"block as clamped or turned {allowed}) serves the job either")
+            else:
+                lines.append(f"{len(setups.setups)} setups (turns allowed: {allowed}): worst "
+                             f"margin {setups.margin * 1e3:.0f} mm; setups.txt says what to do")
             if setups is not None:
                 steps = tuple(operator_steps(job, setups))
                 if verify:
@@ -135,6 +142,8 @@ def run_place(
                                          + steps[s.number - 1], progress=say, program=program)
                         for s in setups.setups)  # fmt: skip
                 atomic_write_text(stage.path / "setups.txt", "\n\n".join(steps) + "\n")
+                for s, c in zip(setups.setups, checks, strict=False):
+                    lines += [f"setup {s.number} verified: {t}" for t in c.tried]
         if not res.feasible and setups is None:
             lines.append(f"no placement in the region serves the job: the best worst margin "
                          f"found is {res.best.margin * 1e3:.0f} mm")  # fmt: skip
