@@ -4,10 +4,14 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import typer
 
 from ._common import app, console, err, fail
+
+if TYPE_CHECKING:
+    from ..wirecut.place_run import PlaceOutcome
 
 
 @app.command(epilog="Example:  ruledrobot reach job.toml --out out/reach   (docs/place.md)")
@@ -123,7 +127,7 @@ def place(
         raise typer.Exit(code=1)
 
 
-def _print_place(res) -> None:
+def _print_place(res: PlaceOutcome) -> None:
     from rich.table import Table
 
     from ..wirecut.placement import mm

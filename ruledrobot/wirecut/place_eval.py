@@ -151,7 +151,9 @@ class Evaluator:
         worst = np.argmin(score, axis=1)
         return Scores(pm.min(axis=1), score[np.arange(C), worst], pm, col, exact)
 
-    def _pass(self, T: FloatArray, s: PassSample):
+    def _pass(
+        self, T: FloatArray, s: PassSample
+    ) -> tuple[FloatArray, FloatArray, np.ndarray, np.ndarray]:
         model, rules = self.model, self.rules
         C, K, R = len(T), len(self.rolls), s.idx.size
         D = len(self.directions)

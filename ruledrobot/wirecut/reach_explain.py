@@ -12,15 +12,24 @@ whole job): the shortest move with a worst margin >= 0 is suggested.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from ..geometry.angles import wrap_angle
 from ..geometry.checks import FloatArray
 from ..robot.workspace import REACH_DIRECTIONS, reach_excess
+from .clearance import Cell
+from .cutpath import CutPath
 from .margins import DEFAULT_RULES, REASON_TEXT, Reason
 from .placement import mm
-from .reach import job_cell, map_pass
+from .reach import PassMap, job_cell, map_pass
 from .reach_report import ruling_ranges
+
+if TYPE_CHECKING:
+    from ..robot.model import RobotModel
+    from .plan import Plan
+    from .spec import Job
 
 __all__ = ["reach_reasons", "suggest_move"]
 
@@ -32,7 +41,9 @@ _NAMES = ("towards the robot", "towards the robot and to its left", "to the robo
           "towards the robot and to its right")  # fmt: skip
 
 
-def suggest_move(job, passes, model=None) -> tuple[str, float, FloatArray] | None:
+def suggest_move(
+    job: Job, passes: list[CutPath], model: RobotModel | None = None
+) -> tuple[str, float, FloatArray] | None:
     """The shortest horizontal move of the block that gives every sampled ruling of every
     pass a configuration with margin >= 0: ``(direction in words, distance m, new block
     centre (3,))``, or None when none of the moves tried does."""
@@ -57,7 +68,7 @@ def suggest_move(job, passes, model=None) -> tuple[str, float, FloatArray] | Non
     return _NAMES[k % 8], float(SHIFTS[k // 8]), job.stock.centre + moves[k]
 
 
-def _excess_words(cell, cp, pm, ruling: int) -> str:
+def _excess_words(cell: Cell, cp: CutPath, pm: PassMap, ruling: int) -> str:
     """How far, and which way, the best configuration of a sampled ruling misses."""
     d = pm.shown
     k = int(np.argmax(pm.margin[d, :, ruling]))
@@ -73,7 +84,7 @@ def _excess_words(cell, cp, pm, ruling: int) -> str:
 _JOINTS = ("shoulder pan", "shoulder lift", "elbow", "wrist 1", "wrist 2", "wrist 3")
 
 
-def _joints_out(model, pm, d: int, mask: np.ndarray) -> str:
+def _joints_out(model: RobotModel, pm: PassMap, d: int, mask: np.ndarray) -> str:
     """Which joints' limits the best configurations of the rulings ``mask`` break."""
     k = np.argmax(pm.margin[d], axis=0)[mask]
     q = pm.q[d, k, np.flatnonzero(mask)]
@@ -86,7 +97,7 @@ def _joints_out(model, pm, d: int, mask: np.ndarray) -> str:
     return "limits of " + ", ".join(names) if names else "joint limits"
 
 
-def reach_reasons(plan) -> tuple[str, ...]:
+def reach_reasons(plan: Plan) -> tuple[str, ...]:
     """Extra reasons for a plan some pass of which is infeasible (module doc); () when
     every pass is feasible."""
     bad = [(k, cp) for k, cp in enumerate(plan.passes) if not cp.feasible]

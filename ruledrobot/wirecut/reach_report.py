@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import io
 import json
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -14,6 +15,7 @@ import numpy as np
 from ..io.atomic import atomic_write_bytes, atomic_write_text
 from .margins import REASON_TEXT, Reason, limit_levers
 from .reach import PassMap, ReachMap
+from .spec import Job
 
 __all__ = [
     "REACH_FORMAT",
@@ -136,7 +138,7 @@ def write_reach_json(path: str | Path, rm: ReachMap, job_ref: dict | None) -> Pa
 FAR = 0.2
 
 
-def _image(pm: PassMap, d: int, top: float):
+def _image(pm: PassMap, d: int, top: float) -> np.ndarray:
     """RGB (K, R, 3) of one direction's map: green by margin, red by how far out of
     reach, the other reasons in their colours."""
     from matplotlib import colormaps
@@ -240,8 +242,14 @@ def _roll_text(roll: np.ndarray) -> str:
     return f"{lo:.0f} deg" if abs(hi - lo) < 0.5 else f"{lo:.0f} to {hi:.0f} deg"
 
 
-def write_reach(job, out: str | Path, rulings: int = 240, rolls: int = 72,
-                progress=None, slides: int = 1) -> tuple[ReachMap, dict[str, Path]]:  # fmt: skip
+def write_reach(
+    job: Job,
+    out: str | Path,
+    rulings: int = 240,
+    rolls: int = 72,
+    progress: Callable[[str], None] | None = None,
+    slides: int = 1,
+) -> tuple[ReachMap, dict[str, Path]]:
     """Map ``job`` (:func:`~.reach.reach_map`) and write ``reach.png`` and ``reach.json``
     into the folder ``out`` (written whole, swapped in at the end)."""
     from ..io.outdir import StagedFolder

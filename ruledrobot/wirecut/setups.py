@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import dataclasses
 import itertools
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 
 import numpy as np
@@ -61,7 +61,7 @@ class SetupPlan:
     tried: int
 
 
-def _partitions(n: int, k: int):
+def _partitions(n: int, k: int) -> Iterator[list[tuple[int, ...]]]:
     """Set partitions of ``range(n)`` into ``k`` non-empty groups, each group sorted,
     groups ordered by their first element."""
     for labels in itertools.product(range(k), repeat=n):
