@@ -73,6 +73,10 @@ def pass_summary(pm: PassMap) -> dict:
         "cells": counts,
         "rulings_without_any_roll": ruling_ranges(pm, per_ruling < 0),
     }
+    out_all = (cells == Reason.OUT_OF_REACH).all(axis=0)
+    if out_all.any():
+        out["rulings_out_of_reach_at_every_roll"] = ruling_ranges(pm, out_all)
+        out["out_of_reach_by_up_to_mm"] = float(-per_ruling[out_all].min() * 1e3)
     if pm.chosen_roll is not None and pm.path_margin is not None:
         w = int(np.argmin(pm.path_margin))
         out["planned"] = {
@@ -284,5 +288,9 @@ def summary_lines(rm: ReachMap) -> list[str]:
                      f"reaches {100 * b['reachable_fraction']:.0f} % of the rulings")
         if s["rulings_without_any_roll"]:
             text += f"; no roll works at rulings {s['rulings_without_any_roll']}"
+        if "out_of_reach_by_up_to_mm" in s:
+            text += (f" (out of reach at every roll: rulings "
+                     f"{s['rulings_out_of_reach_at_every_roll']}, by up to "
+                     f"{s['out_of_reach_by_up_to_mm']:.0f} mm)")
         lines.append(text)
     return lines
