@@ -13,6 +13,7 @@ import numpy as np
 from ..robot.verdict import Check, Verdict
 from .checks import CutMeasurements, Measurements, plan_verdict
 from .plan import SINGULARITY_MARGIN, Plan, job_reference
+from .reach_explain import reach_reasons
 from .verify import Verification
 
 __all__ = ["REPORT_FORMAT", "plan_outcome"]
@@ -91,9 +92,10 @@ def _cut_sections(plan: Plan, ver: Verification | None) -> tuple[list[dict], lis
 
 
 def _unreachable(plan: Plan) -> tuple[dict, Verdict]:
+    reasons = tuple(plan.reasons) + reach_reasons(plan)  # how far, which rule, where to move
     verdict = Verdict((Check("reach", "every ruling reachable, clear of stock and table",
                              "no", "yes", relation="==", ok=False,
-                             detail="; ".join(plan.reasons)),))  # fmt: skip
+                             detail="; ".join(reasons)),))  # fmt: skip
     cp = plan.passes[0]
     report = {
         "format": REPORT_FORMAT,
@@ -103,7 +105,7 @@ def _unreachable(plan: Plan) -> tuple[dict, Verdict]:
         "refinement_steps": cp.steps,
         "path_rulings": int(sum(len(p.frames) for p in plan.passes)),
         "rulings_in_stock": int(sum(int(p.motion.hit.sum()) for p in plan.passes)),
-        "reasons": list(plan.reasons),
+        "reasons": list(reasons),
         "notes": list(plan.notes),
         "feasible": False,
         "verdict": verdict.as_dict(),

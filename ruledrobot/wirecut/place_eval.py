@@ -1,0 +1,283 @@
+"""Scoring many placements of a job's block at once: the worst margin over every pass.
+
+A placement moves the block (and every cut surface with it) by a rigid motion T of
+the base frame (:mod:`.placement`); the wire's poses move with it, ``P_c = T_c P``.
+For each candidate and pass, every **column** — a wire direction, a roll about the
+wire and an IK branch, held along the whole pass (the planner's constant offset;
+a feasible path never changes analytic branch, since every branch change crosses a
+singularity) — gets the worst margin over the sampled rulings (:mod:`.margins`), and
+the pass gets its best column.  A candidate's margin is the worst over its passes.
+
+Vectorised over candidates x directions x rolls x rulings x branches for the IK and
+the kinematic margins; the clearance rules run for the most promising columns only,
+best bound first, until no remaining column can beat the best one found
+(:func:`~.branch_bound.best_of`), with every candidate's stock in one call
+(:class:`~.reach_grid.RowBoxes`).  Ties between columns and candidates whose margins
+are equal (the clearance is quantised) are broken by the kinematic margin
+(reach, limits, singularity): the score is ``margin + TIE * kinematic``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..geometry.checks import FloatArray
+from .branch_bound import best_of
+from .clearance import clearance
+from .cutpath import CutPath
+from .margins import (
+    DEFAULT_RULES,
+    Reason,
+    Rules,
+    clearance_margins,
+    kinematic_margins,
+    limit_levers,
+)
+from .reach import job_cell
+from .reach_grid import RowBoxes, directions_needed, pass_poses, planner_slide, sample_rulings
+from .spec import Job
+
+__all__ = ["TIE", "Evaluator", "PassSample", "Scores"]
+
+#: weight of the kinematic margin in the score (ties of the quantised clearance)
+TIE = 1e-3
+#: poses (candidates x directions x rolls x rulings) per IK batch
+CHUNK_POSES = 120_000
+#: the clearance of a column is screened on every SCREEN-th sampled ruling first
+SCREEN = 6
+
+
+@dataclass(frozen=True, eq=False)
+class PassSample:
+    """A pass as the search samples it: its cut (index, name), the sampled rulings
+    ``idx`` (R,), the flange poses ``P0`` (2, K, R, 4, 4) at the job's placement,
+    ``bow_ok`` (2, K, R) whether the bow clears the stock there (a rule placement does
+    not change), and ``too_long`` (m, > 0 when a chord is longer than the wire allows)."""
+
+    cut: int
+    name: str
+    idx: np.ndarray
+    P0: FloatArray = field(repr=False)
+    bow_ok: np.ndarray = field(repr=False)
+    too_long: float
+
+
+@dataclass(frozen=True, eq=False)
+class Scores:
+    """Scores of C candidates: ``margin`` (C,) m, the worst over passes; per pass
+    ``pass_margin`` (C, n) m and ``column`` (C, n) the best column (index into
+    directions x rolls x branches); ``score`` (C,) the ranking value (module doc);
+    ``exact`` (C,) False where the search of columns was cut short."""
+
+    margin: FloatArray
+    score: FloatArray
+    pass_margin: FloatArray
+    column: np.ndarray
+    exact: np.ndarray
+
+
+class Evaluator:
+    """Scores placements of ``job`` (see the module doc).
+
+    ``passes``: the planner's passes at the job's placement (their frames are what
+    moves); ``rulings`` sampled per pass, ``rolls`` over a turn; ``max_rounds`` rounds
+    of ``per_round`` columns per candidate and pass at most (None: until exact).  A
+    calibrated arm is scored on its nominal table (its FK differs by millimetres, and
+    the closed-form IK is about 30 times faster than the calibrated one); the
+    verification plans on the calibration.
+    """
+
+    def __init__(self, job: Job, passes: list[CutPath], model=None, rulings: int = 48,
+                 rolls: int = 24, rules: Rules = DEFAULT_RULES, per_round: int = 8,
+                 max_rounds: int | None = None) -> None:  # fmt: skip
+        self.job = job
+        self.model = (job.robot_model() if model is None else model).nominal
+        self.rules = rules
+        self.cell = job_cell(job, self.model, rules)
+        self.rolls = np.linspace(-np.pi, np.pi, rolls, endpoint=False)
+        self.directions = directions_needed(self.cell.W)
+        self.rulings = rulings
+        self.per_round, self.max_rounds = per_round, max_rounds
+        names = [c.name for c in job.cuts]
+        self.samples: list[PassSample] = []
+        for cp in passes:
+            F = cp.frames
+            slide, too_long = planner_slide(F, job.stock, job.tool)
+            idx = sample_rulings(len(F), rulings)
+            P0 = pass_poses(self.cell.W, F[idx], slide[idx], self.rolls, self.directions)
+            bow = clearance(self.cell, np.zeros((*P0.shape[:-2], 6)), P0)["bow hits the stock"]
+            self.samples.append(PassSample(names.index(cp.name), cp.name, idx, P0, ~bow,
+                                           float(np.max(too_long))))  # fmt: skip
+
+    def subset(self, cuts: list[int]) -> Evaluator:
+        """This evaluator for the passes of ``cuts`` only (indices into the job's cuts);
+        :meth:`cut_margins` is then inf for the others."""
+        import copy
+
+        out = copy.copy(self)
+        out.samples = [s for s in self.samples if s.cut in cuts]
+        return out
+
+    @property
+    def rulings_checked(self) -> int:
+        """Rulings each candidate checks (over all passes)."""
+        return int(sum(s.idx.size for s in self.samples))
+
+    def cut_margins(self, scores: Scores) -> FloatArray:
+        """Per cut (C, n_cuts) the worst margin of its passes."""
+        out = np.full((len(scores.margin), len(self.job.cuts)), np.inf)
+        for k, s in enumerate(self.samples):
+            out[:, s.cut] = np.minimum(out[:, s.cut], scores.pass_margin[:, k])
+        return out
+
+    def __call__(self, T: FloatArray) -> Scores:
+        """Scores of candidate placements T (C, 4, 4) (rigid motions of the base frame)."""
+        T = np.asarray(T, dtype=np.float64).reshape(-1, 4, 4)
+        per = max(1, CHUNK_POSES // max(s.P0[..., 0, 0].size for s in self.samples))
+        parts = [self._chunk(T[i:i + per]) for i in range(0, len(T), per)]
+        return Scores(*(np.concatenate([getattr(p, f.name) for p in parts])
+                        for f in dataclasses.fields(Scores)))  # fmt: skip
+
+    def _chunk(self, T: FloatArray) -> Scores:
+        C, n = len(T), len(self.samples)
+        pm = np.empty((C, n))
+        score = np.empty((C, n))
+        col = np.empty((C, n), dtype=np.intp)
+        exact = np.ones(C, bool)
+        for k, s in enumerate(self.samples):
+            best, score[:, k], col[:, k], ex = self._pass(T, s)
+            pm[:, k] = best
+            exact &= ex
+        worst = np.argmin(score, axis=1)
+        return Scores(pm.min(axis=1), score[np.arange(C), worst], pm, col, exact)
+
+    def _pass(
+        self, T: FloatArray, s: PassSample
+    ) -> tuple[FloatArray, FloatArray, np.ndarray, np.ndarray]:
+        model, rules = self.model, self.rules
+        C, K, R = len(T), len(self.rolls), s.idx.size
+        D = len(self.directions)
+        P = T[:, None, None, None] @ s.P0[None]  # (C, D, K, R, 4, 4)
+        q = model.ik(P, check=False)  # (C, D, K, R, 8, 6)
+        km, kr = kinematic_margins(model, q, P, rules)
+        bow = s.bow_ok[None, ..., None]
+        km = np.where(bow, km, np.minimum(km, -rules.margin))
+        if s.too_long > 0.0:
+            km = np.minimum(km, -s.too_long)
+        usable = ~np.isnan(q[..., 0]) & (kr != Reason.JOINT_LIMIT) & bow
+        kin = km.min(axis=3).reshape(C, D * K * 8)  # each column's worst over the rulings
+        # the clearance is checked on every SCREEN-th ruling first, the rest only for the
+        # columns that can still beat their candidate's best
+        first = np.zeros(R, bool)
+        first[::SCREEN] = True
+
+        def clear(g, d, k, b, rows: np.ndarray) -> FloatArray:
+            """Worst clearance margin (m,) of columns over the rulings ``rows``."""
+            use = usable[g[:, None], d[:, None], k[:, None], rows[None, :], b[:, None]]  # (m, r)
+            gi, ri = np.nonzero(use)
+            out = np.full(len(g), np.inf)
+            if gi.size:
+                r = rows[ri]
+                cell = dataclasses.replace(self.cell, stock=RowBoxes(self.job.stock, T[g[gi]]))
+                cm, _ = clearance_margins(cell, q[g[gi], d[gi], k[gi], r, b[gi]],
+                                          P[g[gi], d[gi], k[gi], r], rules,
+                                          cap=km[g[gi], d[gi], k[gi], r, b[gi]],
+                                          depth=False)  # fmt: skip
+                np.minimum.at(out, gi, cm)
+            return out
+
+        def evaluate(g: np.ndarray, o: np.ndarray, floor: FloatArray) -> FloatArray:
+            d, k, b = np.unravel_index(o, (D, K, 8))
+            base = np.minimum(kin[g, o], self._travel_margin(q[g, d, k, :, b]))
+            val = np.minimum(base, clear(g, d, k, b, np.flatnonzero(first)))
+            val = val + TIE * base
+            go = np.flatnonzero(val > floor)
+            if go.size:
+                rest = clear(g[go], d[go], k[go], b[go], np.flatnonzero(~first))
+                val[go] = np.minimum(val[go] - TIE * base[go], rest) + TIE * base[go]
+            return val
+
+        bound = kin + TIE * kin
+        best, arg, exact = best_of(bound, evaluate, self.per_round, self.max_rounds)
+        d, k, b = np.unravel_index(arg, (D, K, 8))
+        base = np.minimum(kin[np.arange(C), arg], self._travel_margin(q[np.arange(C), d, k, :, b]))
+        return best - TIE * base, best, arg, exact
+
+    def _travel_margin(self, q: FloatArray) -> FloatArray:
+        """Per column (m,) of joints ``q`` (m, R, 6) along the pass: the radians left when
+        each joint's unwrapped travel is centred in its limits, times the joint's lever
+        (:func:`~.margins.limit_levers`; inf for unlimited joints)."""
+        lo, hi = np.asarray(self.model.lower), np.asarray(self.model.upper)
+        span = hi - lo
+        fin = np.isfinite(span)
+        if not fin.any():
+            return np.full(len(q), np.inf)
+        qq = np.unwrap(np.nan_to_num(q[..., fin]), axis=1)
+        travel = qq.max(axis=1) - qq.min(axis=1)
+        left = (0.5 * (span[fin] - travel) * limit_levers(self.model)[fin]).min(axis=-1)
+        return left
+
+
+@dataclass(frozen=True, eq=False)
+class ColumnDetail:
+    """One pass of one placement in detail: its best column (``reverse``, ``roll`` rad,
+    IK ``branch``), per sampled ruling (R,) the margin (m) and the reason it fails
+    (:class:`~.margins.Reason`), and which part of the margin is the least there
+    (``limit``: "reach", "joint limits", "singularity", "clearance" or a reason)."""
+
+    name: str
+    idx: np.ndarray
+    reverse: bool
+    roll: float
+    branch: int
+    margin: FloatArray = field(repr=False)
+    reason: np.ndarray = field(repr=False)
+    limit: tuple[str, ...] = field(repr=False)
+    q: FloatArray = field(repr=False)
+
+
+def details(ev: Evaluator, T: FloatArray) -> list[ColumnDetail]:
+    """The best column of every pass for the placement T (4, 4), ruling by ruling."""
+    from ..robot.workspace import reach_margin
+    from .margins import REASON_TEXT, joint_limit_margin, limit_levers
+
+    sc = ev(T[None])
+    model, rules = ev.model, ev.rules
+    g = model.nominal.ur_geometry
+    scale = abs(g.a2) + abs(g.a3) + abs(g.d5)
+    out = []
+    K = len(ev.rolls)
+    for k, s in enumerate(ev.samples):
+        d, kk, b = np.unravel_index(sc.column[0, k], (len(ev.directions), K, 8))
+        P = T @ s.P0[d, kk]  # (R, 4, 4)
+        q = model.ik(P, check=False)[:, b]  # (R, 6)
+        km, kr = kinematic_margins(model, q[:, None], P, rules)
+        km, kr = km[:, 0], kr[:, 0]
+        ok = ~np.isnan(q[:, 0])
+        parts = {
+            "reach": np.where(ok, reach_margin(model, np.nan_to_num(q)), -np.inf),
+            "joint limits": joint_limit_margin(model, np.nan_to_num(q), limit_levers(model)),
+            "singularity": scale * (model.singularity_measure(np.nan_to_num(q))
+                                    - rules.singular_min),
+        }
+        clear = np.full(len(P), np.inf)
+        creason = np.zeros(len(P), np.int8)
+        use = ok & s.bow_ok[d, kk] & (kr != Reason.JOINT_LIMIT)
+        if use.any():
+            cell = dataclasses.replace(ev.cell, stock=RowBoxes(ev.job.stock, np.repeat(
+                T[None], int(use.sum()), axis=0)))
+            clear[use], creason[use] = clearance_margins(cell, q[use], P[use], rules)
+        parts["clearance"] = np.where(s.bow_ok[d, kk], clear, -rules.margin)
+        margin = np.minimum(km, clear)
+        reason = np.where(kr != 0, kr, np.where(margin < 0, creason, 0))
+        reason = np.where(~s.bow_ok[d, kk] & (reason == 0), Reason.BOW_STOCK, reason)
+        names = list(parts)
+        stack = np.stack([parts[n] for n in names])
+        limit = tuple(REASON_TEXT[Reason(r)] if r else names[int(i)]
+                      for r, i in zip(reason, stack.argmin(axis=0), strict=True))  # fmt: skip
+        out.append(ColumnDetail(s.name, s.idx, bool(ev.directions[d]), float(ev.rolls[kk]),
+                                int(b), margin, reason.astype(np.int8), limit, q))  # fmt: skip
+    return out
