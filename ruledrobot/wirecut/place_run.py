@@ -107,6 +107,10 @@ def run_place(
                      f"({limiting(ev, cur_T)})")  # fmt: skip
         lines.append(f"best found: {_cand_line(res.best)} "
                      f"({limiting(ev, res.best.placement.transform(job))})")  # fmt: skip
+        edge = region.edges(res.best.xyz)
+        if edge:
+            lines.append(f"note: the best lies on the edge of the searched region ({edge}); "
+                         "a wider range may hold a better placement")
         verified = None
         if not verify and res.feasible:  # the best, unverified: its job file only
             from .jobfile import write_job_file

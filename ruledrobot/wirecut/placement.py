@@ -156,6 +156,23 @@ class Region:
                 for (lo, hi), k in zip((self.x, self.y, self.yaw), n, strict=True)]  # fmt: skip
         return np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
 
+    def edges(self, xyz: FloatArray) -> str:
+        """Which ends of the region ``xyz`` ``[x, y, yaw]`` (3,) lies on, as the options
+        that would widen them (``"the low end of --x"``...); '' when inside.  A range of
+        one value has no edge; a yaw range of a full turn neither."""
+        out = []
+        full_turn = self.yaw[1] - self.yaw[0] >= 2.0 * np.pi - 1e-9
+        for k, (name, (lo, hi)) in enumerate(zip(("x", "y", "yaw"), (self.x, self.y, self.yaw),
+                                                  strict=True)):  # fmt: skip
+            if hi <= lo or (name == "yaw" and full_turn):
+                continue
+            tol = 1e-6 * max(hi - lo, 1.0)
+            if xyz[k] <= lo + tol:
+                out.append(f"the low end of --{name}")
+            elif xyz[k] >= hi - tol:
+                out.append(f"the high end of --{name}")
+        return ", ".join(out)
+
     def clip(self, xyz: FloatArray) -> FloatArray:
         """Samples (N, 3) clipped into the region."""
         lo = np.array([self.x[0], self.y[0], self.yaw[0]])

@@ -161,3 +161,14 @@ def test_job_files_keep_comments_rebase_paths_and_drop_cuts(tmp_path):
     path = write_job_file(one, tmp_path / "out" / "far.toml", keep_cuts=[1])
     back = load_job(path)
     assert [c.name for c in back.cuts] == ["far end"] and "near end" not in path.read_text()
+
+
+def test_region_edges_name_the_option_to_widen():
+    from ruledrobot.wirecut.placement import Region
+
+    r = Region((0.5, 1.0), (-0.2, 0.2), (-1.0, 1.0))
+    assert r.edges(np.array([0.7, 0.0, 0.0])) == ""
+    assert r.edges(np.array([0.5, 0.2, 0.0])) == "the low end of --x, the high end of --y"
+    assert r.edges(np.array([0.7, 0.0, -1.0])) == "the low end of --yaw"
+    fixed = Region((0.5, 0.5), (-0.2, 0.2), (-np.pi, np.pi))  # one x; yaw a whole turn
+    assert fixed.edges(np.array([0.5, 0.0, np.pi])) == ""
