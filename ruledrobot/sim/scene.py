@@ -129,10 +129,12 @@ class Scene:
     @classmethod
     def from_job(cls, job: Any, robot: RobotModel | None = None, **kw: Any) -> Scene:
         """The cell of a cut job (``ruledrobot.wirecut.job.Job``, read by attribute):
-        ``job.robot_model()`` (model, calibration, base; unless ``robot`` is given), the bow
-        of ``job.tool`` (:meth:`BowTool.from_spec`) and ``job.stock``."""
+        ``job.robot_model()`` (model, calibration; unless ``robot`` is given) placed at the
+        job's ``[robot] base``, the bow of ``job.tool`` (:meth:`BowTool.from_spec`) and
+        ``job.stock`` (in the robot base frame, like every pose of a job)."""
         if robot is None:
             robot = job.robot_model()
+        robot = robot.with_base(job.robot.base)
         return cls(robot, tool=BowTool.from_spec(job.tool), stock=job.stock, **kw)
 
     def mjcf(self) -> str:

@@ -133,7 +133,7 @@ class PlanScene:
 def _robot(folder: PlanFolder, notes: list[str]) -> RobotModel:
     """The arm as the simulation built it: the job's model, calibration and base; the
     trajectory's kinematics when the job's calibration could not be read."""
-    robot = folder.job.robot_model()
+    robot = folder.job.cell_robot()
     traj = folder.trajectory
     if traj is not None and KinematicsRef.of(robot).checksum != traj.meta.kinematics.checksum:
         robot = dataclasses.replace(model_for(traj.meta), tool=np.eye(4)).with_base(robot.base)

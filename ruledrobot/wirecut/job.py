@@ -26,7 +26,7 @@ metres, radians, seconds)::
 
     [robot]
     model = "ur5e"
-    base = [0.0, 0.0, 0.0, 0.0, 0.0, 0.0]
+    base = [0.0, 0.0, 0.0, 0.0, 0.0, 0.0]   # the cell in the simulation's world; plans ignore it
     speed_scale = 1.0          # fraction of the catalogue joint speed limits
     acceleration = 1.4         # rad/s^2, one value or six
     # home = [3.14, -1.57, 1.57, -1.57, -1.57, 0.0]   # optional (rad): start and end here

@@ -1,9 +1,9 @@
 """Writing a job file with the block moved (and, for setups, some of its cuts only).
 
 The user's file is edited in place, line by line, so its comments and layout stay:
-``[stock] centre`` and ``rotvec``, each cut's surface ``pose`` and ``keep`` point
-get the values of the moved job (:func:`~.placement.moved_job`); cuts not kept are
-removed with their tables; paths to other files (``file``, ``calibration``,
+``[stock] centre`` and ``rotvec``, each cut's surface ``pose`` and ``keep`` point and
+``[robot] base`` get the values of the placed job (:meth:`~.placement.Placement.job`);
+cuts not kept are removed with their tables; paths to other files (``file``, ``calibration``,
 ``root``, ``tip``, ``gcode`` ...) are rewritten relative to the new file's folder.
 The text written is read back with the job parser and compared with the moved job;
 when the edit cannot be made (a table written inline, say) or does not read back
@@ -124,6 +124,10 @@ def _edit(text: str, job: Job, keep_cuts: list[int] | None) -> str:
         edits.append(("cut.surface" if multi else "surface", k, "pose", pose))
         if cut.keep is not None and not isinstance(cut.keep, str):
             edits.append(("cut", k, "keep", _vec(cut.keep)))
+    base = _vec(se3.ur_vector_from_pose(job.robot.base))
+    has_robot = any(name == "robot" for name, _, _, _ in _table_spans(lines))
+    if has_robot or not np.allclose(job.robot.base, np.eye(4)):
+        edits.append(("robot", -1, "base", base))
     for table, k, key, value in edits:
         span = next(((a, b) for name, i, a, b in _table_spans(lines)
                      if name == table and i == k), None)  # fmt: skip
@@ -141,7 +145,8 @@ def _same(job: Job, back: Job) -> bool:
     if len(job.cuts) != len(back.cuts) or [c.name for c in job.cuts] != [c.name for c in back.cuts]:
         return False
     if not (_close(job.stock.centre, back.stock.centre) and
-            _close(job.stock.rotation, back.stock.rotation)):  # fmt: skip
+            _close(job.stock.rotation, back.stock.rotation) and
+            _close(job.robot.base, back.robot.base)):  # fmt: skip
         return False
     for a, b in zip(job.cuts, back.cuts, strict=True):
         if not _close(a.surface.pose, b.surface.pose):
@@ -200,6 +205,8 @@ def _moved_doc(doc: dict, job: Job, keep_cuts: list[int] | None) -> dict:
     st = job.stock
     doc["stock"] = {**doc.get("stock", {}), "centre": list(map(float, st.centre)),
                     "rotvec": list(map(float, se3.rotvec_from_matrix(st.rotation)))}  # fmt: skip
+    doc["robot"] = {**doc.get("robot", {}),
+                    "base": list(map(float, se3.ur_vector_from_pose(job.robot.base)))}
     if isinstance(doc.get("cut"), list):
         entries = doc["cut"] if keep_cuts is None else [doc["cut"][i] for i in keep_cuts]
         new = []

@@ -27,7 +27,7 @@ from ..geometry.checks import FloatArray
 from .cutpath import CutPath
 from .path import cut_paths
 from .place_eval import Evaluator
-from .placement import AS_CLAMPED, Placement, Region, Turn, moved_job, transforms
+from .placement import AS_CLAMPED, Placement, Region, Turn, transforms
 from .spec import Job
 
 __all__ = ["Candidate", "PlaceResult", "job_passes", "search", "verify_best"]
@@ -219,7 +219,7 @@ def verify_best(
     tried: list[str] = []
     final = folder if final is None else final
     for k, cand in enumerate([c for c in candidates if c.margin >= 0.0][:tries]):
-        moved = moved_job(job, cand.placement.transform(job))
+        moved = cand.placement.job(job)
         if cuts is not None:
             moved = dataclasses.replace(moved, cuts=tuple(moved.cuts[i] for i in cuts))
         say(f"verifying candidate {k + 1} with the planner and MuJoCo")

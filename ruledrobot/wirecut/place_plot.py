@@ -12,14 +12,14 @@ import numpy as np
 
 from ..io.atomic import atomic_write_bytes
 from .place import Candidate, PlaceResult
-from .placement import mm, moved_job
+from .placement import mm
 
 __all__ = ["plot_place"]
 
 
 def _outline(job, cand: Candidate | None) -> np.ndarray:
     """The block's footprint (5, 2) [m] (closed) after ``cand``'s placement (None: as is)."""
-    j = job if cand is None else moved_job(job, cand.placement.transform(job))
+    j = job if cand is None else cand.placement.job(job)
     st = j.stock
     c = np.array([[-1, -1, -1], [1, -1, -1], [1, 1, -1], [-1, 1, -1], [-1, -1, -1]]) * 0.5
     pts = st.centre + (c * st.size) @ st.rotation.T

@@ -114,9 +114,8 @@ def run_place(
         verified = None
         if not verify and res.feasible:  # the best, unverified: its job file only
             from .jobfile import write_job_file
-            from .placement import moved_job
 
-            write_job_file(moved_job(job, res.best.placement.transform(job)),
+            write_job_file(res.best.placement.job(job),
                            stage.path / "job.toml", check_as=out / "job.toml",
                            note=f"placed by ruledrobot place (not verified): "
                                 f"{res.best.placement.describe()}")  # fmt: skip

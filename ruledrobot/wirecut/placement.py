@@ -13,7 +13,9 @@ support height) followed by a shift and a yaw on the table.
   orientation after the turn).  ``T = Tr(x, y, 0) Rz(yaw) Tr(-c_x, -c_y, 0) T_turn``.
 * ``move = "robot"``: the block stays where it is and the robot's base moves by
   ``x, y`` (m) and turns by ``yaw`` (rad) in its current base frame: in the new base
-  frame the block has moved by the inverse, ``T = (Tr(x, y, 0) Rz(yaw))^-1 T_turn``.
+  frame the block has moved by the inverse, ``T = (Tr(x, y, 0) Rz(yaw))^-1 T_turn``;
+  the placed job's ``[robot] base`` moves by ``Tr(x, y, 0) Rz(yaw)``
+  (:meth:`Placement.job`), so in the simulation's world the block stays put.
 """
 
 from __future__ import annotations
@@ -195,6 +197,23 @@ class Placement:
         """The rigid motion T (4, 4) of the base frame that places the job's block."""
         return transforms(job, np.array([[self.x, self.y, self.yaw]]), self.move, self.turn)[0]
 
+    def base_motion(self) -> FloatArray:
+        """How the robot's base moves (4, 4), in its present base frame: ``Tr(x, y, 0)
+        Rz(yaw)`` for ``move = "robot"``, the identity when the block moves."""
+        if self.move != "robot":
+            return np.eye(4)
+        return transforms_of_base(np.array([[self.x, self.y, self.yaw]]))[0]
+
+    def job(self, job: Job) -> Job:
+        """``job`` placed: its block moved (:func:`moved_job`) and, when the robot moves,
+        its ``[robot] base`` moved with it (``base @`` :meth:`base_motion`), so the
+        simulation's world keeps the block where it stands."""
+        moved = moved_job(job, self.transform(job))
+        if self.move != "robot":
+            return moved
+        robot = dataclasses.replace(job.robot, base=job.robot.base @ self.base_motion())
+        return dataclasses.replace(moved, robot=robot)
+
     def describe(self) -> str:
         turn = "" if self.turn.degrees == 0 else f", after turning it {self.turn.label}"
         if self.move == "stock":
@@ -204,14 +223,20 @@ class Placement:
                 f"turned {np.degrees(self.yaw):+.1f} deg{turn}")  # fmt: skip
 
 
-def transforms(job: Job, xyz: FloatArray, move: str, turn: Turn = AS_CLAMPED) -> FloatArray:
-    """Rigid motions (N, 4, 4) of samples ``[x, y, yaw]`` (N, 3) (module doc)."""
+def transforms_of_base(xyz: FloatArray) -> FloatArray:
+    """``Tr(x, y, 0) Rz(yaw)`` (N, 4, 4) of samples ``[x, y, yaw]`` (N, 3)."""
     xyz = np.asarray(xyz, dtype=np.float64).reshape(-1, 3)
     c, s = np.cos(xyz[:, 2]), np.sin(xyz[:, 2])
     M = np.zeros((len(xyz), 4, 4))
     M[:, 0, 0], M[:, 0, 1], M[:, 1, 0], M[:, 1, 1] = c, -s, s, c
     M[:, 2, 2] = M[:, 3, 3] = 1.0
     M[:, 0, 3], M[:, 1, 3] = xyz[:, 0], xyz[:, 1]
+    return M
+
+
+def transforms(job: Job, xyz: FloatArray, move: str, turn: Turn = AS_CLAMPED) -> FloatArray:
+    """Rigid motions (N, 4, 4) of samples ``[x, y, yaw]`` (N, 3) (module doc)."""
+    M = transforms_of_base(xyz)
     Tt = turn.matrix(job.stock)
     if move == "robot":
         return se3.inverse(M) @ Tt

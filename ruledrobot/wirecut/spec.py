@@ -167,14 +167,21 @@ class Job:
 
     def robot_model(self):
         """The job's robot: the catalogue model with its calibration (if the job names
-        one), its joint acceleration limits and its base; the arm every stage plans and
+        one) and its joint acceleration limits, in its own base frame (``base`` the
+        identity) -- the frame of every pose of the job; the arm every stage plans and
         checks with."""
         from ..robot import load
 
         model = load(self.robot.model).with_calibration(self.robot.calibration)
         if self.robot.acceleration is not None:
             model = model.with_limits(acceleration=self.robot.acceleration)
-        return model.with_base(self.robot.base)
+        return model
+
+    def cell_robot(self):
+        """:meth:`robot_model` placed in the world at ``[robot] base``: the arm of the
+        MuJoCo scene and the viewer, which place the stock and table at ``base @ pose``
+        with it (so ``[robot] base`` moves the whole cell, never the plan)."""
+        return self.robot_model().with_base(self.robot.base)
 
     def input_lines(self) -> Lines:
         """The first cut's input rulings in the robot base frame."""

@@ -128,6 +128,11 @@ def test_the_robot_can_move_instead(tmp_path):
     # in the new base frame the block is nearer by the robot's move
     placed = load_job(out / "job.toml")
     assert placed.stock.centre[0] == pytest.approx(1.25 - best["x_m"], abs=1e-6)
+    # ... and the base moved by it, so in the world (base @ stock) the block stays put
+    np.testing.assert_allclose(placed.robot.base[:3, 3], [best["x_m"], best["y_m"], 0.0],
+                               atol=1e-6)  # fmt: skip
+    world = placed.robot.base[:3, :3] @ placed.stock.centre + placed.robot.base[:3, 3]
+    np.testing.assert_allclose(world, load_job(src).stock.centre, atol=1e-6)
 
 
 def test_job_files_keep_comments_rebase_paths_and_drop_cuts(tmp_path):
