@@ -130,7 +130,7 @@ def run_path(
         t0 = c.initPeriod()
         s.kick()
         qa = s.poll()
-        s.check_deviation(q_grid, qa, K - 1)
+        s.check_deviation(q_grid, qa, K - 1, timed=False)
         s.service()
         prog = c.getAsyncOperationProgress()
         started = started or prog >= 0

@@ -98,6 +98,7 @@ class Session:
         self.hot = False
         self.max_dev = 0.0
         self.k_match = 0
+        self.k_high = 0  # the furthest plan sample matched so far
         self.sent = 0
         self.window = 10
         self.recording = False
@@ -254,22 +255,32 @@ class Session:
             raise Stop("program_stopped", "the control script stopped running on the controller")
         return np.asarray(qa)
 
-    def check_deviation(self, plan: np.ndarray, qa: np.ndarray, upto: int) -> None:
-        """Deviation of ``qa`` from the nearest plan sample in ``[k_match - window / 4,
-        upto]`` (at most ``window`` ahead of ``k_match``); moves ``k_match`` there.
+    def check_deviation(self, plan: np.ndarray, qa: np.ndarray, upto: int,
+                        timed: bool = True) -> None:  # fmt: skip
+        """Deviation of ``qa`` from the nearest plan sample in ``[k_high - window / 4,
+        upto]`` (at most ``window`` ahead of ``k_match``), ``k_high`` the furthest sample
+        matched so far; moves ``k_match`` there.  ``timed`` (streaming: sample ``upto``
+        was commanded now): the arm must also be at most ``window`` samples behind it.
 
-        The match may step back a little (a quarter of the window, about the servo's
-        lag): where the plan creeps (the start of a move from rest) a later sample can
-        look nearest for a while, and a match that only moves forward would run ahead of
-        the arm and report its lag as a deviation.  Not further: a path that comes back
-        near itself (a move there and back) would pull the match to its earlier visit."""
-        lo = max(0, self.k_match - self.window // 4)
-        hi = min(upto, self.k_match + self.window) + 1
+        The match may step back a little behind the furthest it reached (a quarter of the
+        window, about the servo's lag): where the plan creeps (the start of a move from
+        rest) a later sample can look nearest for a while, and a match that only moves
+        forward would run ahead of the arm and report its lag as a deviation.  Never
+        further, and never step by step: a path that leaves the way it came (the lead-in
+        after a pre-heat hold, a pass that turns round in its own kerf) looks, to a
+        nearest-sample match, like its arrival run backwards, and a match allowed to
+        step back from wherever it is would walk back along the arrival while the arm
+        goes on (found on the part demo: 0.05 rad reported for an arm 0.001 rad from the
+        plan)."""
+        lo = max(0, self.k_high - self.window // 4)
+        hi = max(lo, min(upto, self.k_match + self.window)) + 1
         d = np.max(np.abs(plan[lo:hi] - qa), axis=1)
-        # the last of equal minima: through a hold longer than the window (the wire
-        # heating) the plan repeats one sample, and the match must reach its end
-        j = len(d) - 1 - int(np.argmin(d[::-1]))
+        # the last of the minima (equal to a micro-radian): through a hold longer than
+        # the window (the wire heating) the plan repeats one sample, up to rounding of
+        # the resampling, and the match must reach its end
+        j = int(np.flatnonzero(d <= d.min() + 1e-6)[-1])
         self.k_match = lo + j
+        self.k_high = max(self.k_high, self.k_match)
         dev = float(d[j])
         self.max_dev = max(self.max_dev, dev)
         if dev > self.deviation_limit:
@@ -278,6 +289,26 @@ class Session:
                 f"joint deviation {dev:.4f} rad from the plan exceeds the "
                 f"limit {self.deviation_limit:.4f} rad",
             )
+        if timed and self._behind(plan, qa, upto):
+            raise Stop(
+                "deviation",
+                f"the arm is {(upto - self.k_match) / self.frequency:.2f} s behind the plan "
+                f"(limit {self.window / self.frequency:.2f} s, three servo look-aheads and "
+                "0.1 s): it stopped following the commands",
+            )
+
+    def _behind(self, plan: np.ndarray, qa: np.ndarray, upto: int) -> bool:
+        """The arm has stopped following: matched more than ``window`` samples behind the
+        command ``upto`` *and* further from it than the plan was ``window`` samples ago
+        (plus a tenth of the deviation limit).  The distance matters: where the plan
+        comes to rest the servo filter closes the last micro-radians slowly, and the
+        matched sample then lags far in index while the arm is where it should be."""
+        if upto - self.k_match <= self.window:
+            return False
+        target = plan[upto]
+        arm = float(np.max(np.abs(qa - target)))
+        plan_then = float(np.max(np.abs(plan[upto - self.window] - target)))
+        return arm > plan_then + 0.1 * self.deviation_limit
 
     def classify(self, what: str, exc: Exception | None = None) -> Stop:
         """Why did a command fail or return False?  (The stream may be a period behind.)"""
