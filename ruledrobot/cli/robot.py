@@ -172,6 +172,11 @@ def stream(trajectory: Path, host: str | None, *, yes: bool = False, **options):
     elif result.moved:
         console.print(f"  max deviation actual vs plan: {result.max_deviation:.3g} rad",
                       highlight=False)  # fmt: skip
+        if result.samples_skipped:
+            console.print(f"  the stream fell behind its schedule by up to "
+                          f"{1e3 * result.max_slip:.0f} ms and skipped "
+                          f"{result.samples_skipped} samples to keep the plan's timing",
+                          highlight=False)  # fmt: skip
     if result.stop is not None and result.status != "completed":
         console.print(Text(f"  stopped at {result.stop.describe()}"), highlight=False)
         cmd = resume_command(trajectory, host, options.get("mode", "servoj"),

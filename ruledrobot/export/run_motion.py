@@ -73,7 +73,15 @@ def stream(
     hot: np.ndarray | None = None,
 ) -> None:
     """servoJ every controller period, monitored, then hold the last sample until settled.
-    ``hot`` (K,): the wire's heat at each grid sample (switched where it changes)."""
+    ``hot`` (K,): the wire's heat at each grid sample (switched where it changes).
+
+    The stream keeps the plan's schedule on the wall clock: sample ``k`` goes out at
+    ``k`` periods after the start.  A period that overran (a switch of the heat, the
+    machine busy) is made up by skipping the samples whose time has passed — a feed
+    held at the plan's speed, not a wire that slows in the foam and widens the kerf;
+    a slip longer than ``max_latency`` at once stops the run (``client_slow``: the
+    jump would be a burst of speed).  Skipped samples and the longest slip are in
+    :meth:`Session.info`."""
     c = s.c
     dt = 1.0 / s.frequency
     K = q_grid.shape[0]
@@ -81,7 +89,9 @@ def stream(
     s.link.stage("streaming", heartbeat)
     s.start_recording()
     s.start_clock()
-    for k in range(K):
+    start = time.monotonic()
+    k = 0
+    while k < K:
         if hot is not None and bool(hot[k]) != s.hot:
             s.set_heat(bool(hot[k]))
         t0 = c.initPeriod()
@@ -92,6 +102,7 @@ def stream(
         s.check_deviation(q_grid, qa, k)
         s.service()
         c.waitPeriod(t0)
+        k = s.keep_schedule(k, time.monotonic() - start, K)
     # hold the final target until the filter has converged
     last = rows[-1]
     deadline = time.monotonic() + 10.0 * lookahead + 0.5

@@ -69,7 +69,7 @@ class RunResult:
     ``status``: ``"completed"``, ``"dry_run"``, ``"refused"`` (a check failed;
     nothing moved), ``"cancelled"`` (not confirmed), or why the motion stopped:
     ``"deviation"``, ``"protective_stop"``, ``"emergency_stop"``,
-    ``"connection_lost"``, ``"controller_slow"``, ``"program_stopped"``,
+    ``"connection_lost"``, ``"controller_slow"``, ``"client_slow"``, ``"program_stopped"``,
     ``"command_failed"``, ``"interrupted"``, ``"client_died"`` (the ur_rtde
     process crashed), ``"client_hung"`` (it stopped answering and was killed).
     ``start_index``: the first sample streamed (the entry), ``requested_index``:
@@ -103,6 +103,10 @@ class RunResult:
     timeline: list[tuple[float, str]] = field(default_factory=list)
     #: the controller's clock [s] at the recording's first sample (its t = 0), when known
     recording_t0: float | None = None
+    #: servoJ streams: samples skipped to keep the plan's schedule, and the longest the
+    #: stream was behind it [s] (``Session.keep_schedule``)
+    samples_skipped: int = 0
+    max_slip: float = 0.0
 
     @property
     def completed(self) -> bool:

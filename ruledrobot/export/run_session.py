@@ -99,6 +99,8 @@ class Session:
         self.max_dev = 0.0
         self.k_match = 0
         self.k_high = 0  # the furthest plan sample matched so far
+        self.skipped = 0  # samples skipped to keep the schedule (stream)
+        self.max_slip = 0.0  # the longest the stream was behind its schedule [s]
         self.sent = 0
         self.window = 10
         self.recording = False
@@ -196,7 +198,29 @@ class Session:
 
     def info(self) -> dict:
         return {"k_match": self.k_match, "sent": self.sent, "max_dev": self.max_dev,
-                "recording_t0": self._ts0}  # fmt: skip
+                "recording_t0": self._ts0, "skipped": self.skipped,
+                "max_slip": self.max_slip}  # fmt: skip
+
+    def keep_schedule(self, k: int, elapsed: float, n: int) -> int:
+        """The sample to send after sample ``k``, ``elapsed`` seconds into a stream of
+        ``n`` samples: ``k + 1``, or the sample due now when periods overran (the ones
+        passed are skipped; the last sample is always sent).  Raises :class:`Stop`
+        (``client_slow``) when the stream is more than ``max_latency`` behind."""
+        due = int(elapsed * self.frequency)  # the sample whose period has begun
+        slip = elapsed - (k + 1) / self.frequency
+        self.max_slip = max(self.max_slip, slip)
+        if slip > self.max_latency:
+            raise Stop(
+                "client_slow",
+                f"the runner sent grid sample {k + 1} {1e3 * slip:.0f} ms late (limit "
+                f"{1e3 * self.max_latency:.0f} ms): this computer could not keep the "
+                "controller period; catching up would jump the arm",
+            )
+        nxt = k + 1
+        if due > nxt and nxt < n:
+            nxt = min(due, n - 1)
+            self.skipped += nxt - (k + 1)
+        return nxt
 
     def flush(self, force: bool = False) -> None:
         """Send the recording so far (and the progress) at most every CHUNK seconds."""

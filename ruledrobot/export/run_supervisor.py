@@ -222,7 +222,7 @@ class Child:
                     elif kind == "done":
                         d = msg[1]
                         out.status, out.message = d["status"], d["message"]
-                        out.info = {k: d[k] for k in ("k_match", "sent", "max_dev")}
+                        out.info = {k: v for k, v in d.items() if k not in ("status", "message")}
                         out.timeline.append((last, "done"))
                         return out
                 except ChildGone as gone:

@@ -384,6 +384,8 @@ def _move(
     result.status, result.message = out.status, out.message
     result.max_deviation = float(info["max_dev"])
     result.samples_sent = int(info["sent"])
+    result.samples_skipped = int(info.get("skipped", 0))
+    result.max_slip = float(info.get("max_slip", 0.0))
     t0 = info.get("recording_t0")
     result.recording_t0 = None if t0 is None else float(t0)
     if out.status in ("client_died", "client_hung") or out.killed:

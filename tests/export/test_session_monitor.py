@@ -1,8 +1,7 @@
-"""The runner's deviation match (``Session.check_deviation``) on synthetic plans: an
-arm that follows the plan with the servo's lag is never reported off it, and an arm
-that leaves the plan is, whatever the shape of the path.
-
-No controller: the match is pure arithmetic on the plan and the measured joints.
+"""The runner's monitoring on synthetic plans, no controller: the deviation match
+(``Session.check_deviation``: an arm that follows the plan with the servo's lag is never
+reported off it, an arm that leaves or stops is, whatever the shape of the path) and
+the stream's schedule (``Session.keep_schedule``).
 """
 
 from __future__ import annotations
@@ -125,3 +124,17 @@ def test_a_path_run_is_matched_without_time():
     for k in range(0, len(plan), 7):
         s.check_deviation(plan, plan[k], len(plan) - 1, timed=False)
     assert s.max_dev < 1e-9 and s.k_match >= len(plan) - 7
+
+
+def test_the_stream_keeps_the_plans_schedule():
+    s = session()
+    dt = 1.0 / 500.0
+    assert s.keep_schedule(10, 11 * dt, 1000) == 11  # on time
+    assert s.keep_schedule(11, 12.9 * dt, 1000) == 12  # late within the period
+    assert s.keep_schedule(12, 16.5 * dt, 1000) == 16  # three periods late: 13-15 skipped
+    assert s.skipped == 3 and s.max_slip == pytest.approx(3.5 * dt)
+    assert s.keep_schedule(997, 999.5 * dt, 1000) == 999  # the last sample is always sent
+    assert s.keep_schedule(998, 1003 * dt, 1000) == 999
+    with pytest.raises(Stop) as stop:
+        s.keep_schedule(100, 101 * dt + 0.101, 1000)
+    assert stop.value.status == "client_slow" and "101 ms late" in stop.value.message
