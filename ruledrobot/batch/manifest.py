@@ -67,7 +67,8 @@ class JobRecord:
     (:data:`FIGURES`, and ``collisions``: their count); ``margins``: per gating check
     with a numeric limit, the relative margin (limit - value) / |limit| (``<=``
     checks; value - limit for ``>=``): negative fails; ``files``: the output files,
-    relative to the batch's folder; ``code``: the code identity it was planned with.
+    relative to the batch's folder; ``code``: the code identity it was planned with;
+    ``attempts``: how often the batch dispatched it (2: its first worker died).
     """
 
     name: str
@@ -84,6 +85,7 @@ class JobRecord:
     margins: dict[str, float] = field(default_factory=dict)
     files: tuple[str, ...] = ()
     code: str | None = None
+    attempts: int | None = None
 
     @property
     def worst_check(self) -> str | None:
@@ -166,6 +168,7 @@ def load_records(out: Path) -> dict[str, JobRecord]:
 
 _CSV_COLUMNS = (
     "name", "status", "job", "failed_checks", "message", "planned_at", "plan_s", "wait_s",
+    "attempts",
     *FIGURES, "collisions", "worst_check", "worst_margin", "files", "worker", "hash",
 )  # fmt: skip
 
@@ -208,4 +211,3 @@ def write_manifest(out: Path, records: list[JobRecord], earlier: list[JobRecord]
 def pending(name: str, job: str, digest: str, code: str) -> JobRecord:
     """The record of a job not (yet) planned."""
     return JobRecord(name, job, "pending", digest, code=code)
-

@@ -58,8 +58,11 @@ class BatchBar:
         rate = p.throughput
         rate_text = f"{rate * 60:.1f} jobs/min" if rate is not None else "- jobs/min"
         kept = f" · {p.kept} kept" if p.kept else ""
-        text = (f"{p.done}/{p.to_plan} done · {p.failed} failed · {p.running} running{kept}"
-                f" · {rate_text} · {_clock(p.eta_s)} left")  # fmt: skip
+        workers = "" if p.workers is None else f" on {p.workers} workers"
+        if p.workers == 0:
+            workers = " · waiting for a worker"
+        text = (f"{p.done}/{p.to_plan} done · {p.failed} failed · {p.running} running"
+                f"{workers}{kept} · {rate_text} · {_clock(p.eta_s)} left")  # fmt: skip
         self.progress.update(self.task, completed=p.done, text=text)
 
     def stop(self) -> None:

@@ -36,9 +36,13 @@ from .task import JobTask, TaskResult, run_task
 
 __all__ = ["BatchProgress", "BatchResult", "run_batch"]
 
-#: seconds between looks for newly joined workers while jobs wait
+#: seconds between looks for finished jobs, and for newly joined workers while jobs wait
 _POLL_S = 0.1
 _REFILL_S = 2.0
+#: seconds a local cluster may have no worker before the batch stops (workers that cannot
+#: start: out of memory, a broken installation); a cluster's scheduler may wait for its
+#: workers as long as it takes
+NO_WORKER_S = 120.0
 
 
 @dataclass(frozen=True)
@@ -46,7 +50,8 @@ class BatchProgress:
     """Where a batch stands: ``total`` jobs, ``kept`` (earlier results kept),
     ``to_plan`` (planned by this run), of which ``done`` have a result (``failed``:
     infeasible, bad input or crashed) and ``running`` are on workers; ``elapsed_s``
-    since the run started; ``last`` the record that just came back."""
+    since the run started; ``last`` the record that just came back; ``workers`` the
+    worker threads the scheduler has (None: not started)."""
 
     total: int
     kept: int
@@ -56,6 +61,7 @@ class BatchProgress:
     running: int
     elapsed_s: float
     last: JobRecord | None = None
+    workers: int | None = None
 
     @property
     def throughput(self) -> float | None:
@@ -72,7 +78,8 @@ class BatchProgress:
 @dataclass(frozen=True)
 class BatchResult:
     """What :func:`run_batch` did: the records of the batch's jobs in order, how many it
-    planned and kept, whether Ctrl-C stopped it, the engine it ran on."""
+    planned and kept, whether Ctrl-C stopped it, the engine it ran on, and why it
+    stopped early if it did (``error``: the local cluster lost its workers)."""
 
     out: Path
     records: tuple[JobRecord, ...]
@@ -81,6 +88,7 @@ class BatchResult:
     interrupted: bool
     elapsed_s: float
     engine: dict[str, Any] | None = None
+    error: str | None = None
 
     @property
     def manifest(self) -> Path:
@@ -118,12 +126,12 @@ def _write_folder(out: Path, res: TaskResult) -> tuple[str, ...]:
     return tuple(f"{res.name}/{rel}" for rel in names)
 
 
-def _record(content: JobContent, res: TaskResult, out: Path, code: str,
-            wall_s: float) -> JobRecord:  # fmt: skip
+def _record(content: JobContent, res: TaskResult, out: Path, code: str, wall_s: float,
+            attempts: int) -> JobRecord:  # fmt: skip
     entry = content.entry
     base = JobRecord(entry.name, entry.label, res.status, content.digest, res.message,
                      res.failed_checks, now(), res.plan_s, max(0.0, wall_s - res.plan_s),
-                     res.worker or None, code=code)  # fmt: skip
+                     res.worker or None, code=code, attempts=attempts)  # fmt: skip
     if res.status not in ("feasible", "infeasible"):
         return base
     try:
@@ -131,29 +139,150 @@ def _record(content: JobContent, res: TaskResult, out: Path, code: str,
     except (ValueError, OSError) as exc:
         return JobRecord(entry.name, entry.label, "bad_input", content.digest,
                          f"the plan could not be written: {exc}", (), base.planned_at,
-                         base.plan_s, base.wait_s, base.worker, code=code)  # fmt: skip
+                         base.plan_s, base.wait_s, base.worker, code=code,
+                         attempts=attempts)  # fmt: skip
     report = next((json.loads(d) for rel, d in res.files if rel == "report.json"), {})
     figures, margins = figures_of(report)
     return JobRecord(entry.name, entry.label, res.status, content.digest, res.message,
                      res.failed_checks, base.planned_at, base.plan_s, base.wait_s,
-                     base.worker, figures, margins, files, code)  # fmt: skip
+                     base.worker, figures, margins, files, code, attempts)  # fmt: skip
 
 
-def _failed_future(content: JobContent, future: Any, code: str, wall_s: float) -> JobRecord:
-    """The record of a job whose task did not return: its worker died twice (KilledWorker),
-    or the task raised (a result that could not be sent back, a cancelled task)."""
+def _crashed(content: JobContent, exc: BaseException, code: str, wall_s: float,
+             attempts: int) -> JobRecord:  # fmt: skip
+    """The record of a job whose task did not return: its worker died (KilledWorker), or
+    the task raised (a result that could not be sent back, a cancelled task)."""
     entry = content.entry
-    exc = future.exception() if future.status == "error" else None
     if type(exc).__name__ == "KilledWorker":
-        msg = (f"the worker planning it died, and so did the one that tried again: killed, "
-               f"or out of memory? ({exc})")  # fmt: skip
-    elif exc is not None:
-        tb = future.traceback()
-        msg = "".join(traceback.format_exception(type(exc), exc, tb))
+        times = "twice" if attempts > 1 else "while planning it"
+        msg = (f"the worker planning it died {times}: killed, or out of memory? ({exc})")
     else:
-        msg = f"the task ended as {future.status!r} without a result"
+        msg = "".join(traceback.format_exception(type(exc), exc, exc.__traceback__))
     return JobRecord(entry.name, entry.label, "crashed", content.digest, msg, (), now(), None,
-                     wall_s, None, code=code)  # fmt: skip
+                     wall_s, None, code=code, attempts=attempts)  # fmt: skip
+
+
+def _outcome(future: Any) -> TaskResult | BaseException:
+    """The task's result, fetched now (a result left on a worker dies with it), or the
+    exception that stands for it."""
+    try:
+        return future.result()
+    except KeyboardInterrupt:
+        raise
+    except BaseException as exc:  # KilledWorker, a cancelled task, an unpicklable result
+        return exc
+
+
+class _Batch:
+    """The state of one run: the jobs' contents and records, what is left to plan, the
+    counters; writes the manifest after every change."""
+
+    def __init__(self, contents: list[JobContent], out: Path, prior: dict[str, JobRecord],
+                 force: bool, progress: Callable[[BatchProgress], None] | None) -> None:
+        self.t0 = time.perf_counter()
+        self.contents, self.out, self.progress = contents, out, progress
+        self.code = code_identity()
+        self.records: list[JobRecord] = []
+        self.todo: deque[int] = deque()
+        self.attempts = [0] * len(contents)
+        self.kept = self.done = self.failed = 0
+        self.threads: int | None = None
+        for i, c in enumerate(contents):
+            e, old = c.entry, prior.get(c.entry.name)
+            if not force and resumable(old, c.digest, out):
+                self.records.append(old)  # type: ignore[arg-type]
+                self.kept += 1
+            elif c.error is not None:  # found without planning: unreadable, not TOML
+                self.records.append(JobRecord(e.name, e.label, "bad_input", c.digest, c.error,
+                                              planned_at=now(), code=self.code.id))  # fmt: skip
+                self.done += 1
+                self.failed += 1
+            else:
+                self.records.append(pending(e.name, e.label, c.digest, self.code.id))
+                self.todo.append(i)
+        self.to_plan = len(self.todo) + self.done
+        names = {r.name for r in self.records}
+        self.earlier = [r for n, r in prior.items() if n not in names]
+        self.run: dict[str, Any] = {"started": now(), "finished": None, "interrupted": False,
+                                    "error": None, "engine": None, "code": self.code.as_dict(),
+                                    "jobs": len(self.records), "kept": self.kept,
+                                    "planned": self.done}  # fmt: skip
+        self.write()
+
+    def write(self) -> None:
+        self.run["planned"] = self.done
+        write_manifest(self.out, self.records, self.earlier, self.run)
+
+    def say(self, running: int, last: JobRecord | None = None) -> None:
+        if self.progress is not None:
+            self.progress(BatchProgress(len(self.records), self.kept, self.to_plan, self.done,
+                                        self.failed, running, time.perf_counter() - self.t0,
+                                        last, self.threads))  # fmt: skip
+
+    def task(self, i: int) -> JobTask:
+        self.attempts[i] += 1
+        return _task(self.contents[i], self.code.id)
+
+    def finish(self, i: int, outcome: TaskResult | BaseException, wall_s: float,
+               retries: int) -> JobRecord | None:  # fmt: skip
+        """Record job ``i``'s outcome (None: dispatched again after its worker died)."""
+        c = self.contents[i]
+        if isinstance(outcome, TaskResult):
+            rec = _record(c, outcome, self.out, self.code.id, wall_s, self.attempts[i])
+        elif type(outcome).__name__ == "KilledWorker" and self.attempts[i] <= retries:
+            self.todo.appendleft(i)  # again, when a worker is free
+            return None
+        else:
+            rec = _crashed(c, outcome, self.code.id, wall_s, self.attempts[i])
+        self.records[i] = rec
+        self.done += 1
+        self.failed += rec.failed
+        self.write()
+        return rec
+
+
+def _dispatch(b: _Batch, eng: Engine) -> str | None:
+    """Plan ``b``'s jobs on ``eng``, at most one per worker thread in flight, each result
+    recorded as it comes; returns why it stopped early (None: every job has a result).
+    KeyboardInterrupt cancels the jobs in flight and goes on up."""
+    inflight: dict[Any, tuple[int, float]] = {}
+    ac = eng.as_completed()
+    refill_at, staffed = 0.0, time.perf_counter()
+    try:
+        while b.todo or inflight:
+            if time.perf_counter() >= refill_at:  # workers come and go: look again
+                b.threads = threads = eng.threads()
+                if threads:
+                    staffed = time.perf_counter()
+                elif eng.cluster is not None and time.perf_counter() - staffed > NO_WORKER_S:
+                    eng.cancel(list(inflight))
+                    return (f"the local cluster has had no worker for {NO_WORKER_S:g} s "
+                            "(workers that cannot start: out of memory?); the jobs not "
+                            "planned are pending")  # fmt: skip
+                eng.heal(threads)
+                while b.todo and len(inflight) < eng.slots(threads):
+                    i = b.todo.popleft()
+                    key = f"ruledrobot-plan-{b.contents[i].entry.name}-{uuid.uuid4().hex[:8]}"
+                    fut = eng.submit(run_task, b.task(i), key)
+                    inflight[fut] = (i, time.perf_counter())
+                    ac.add(fut)
+                refill_at = time.perf_counter() + _REFILL_S
+                b.say(len(inflight))
+            if not ac.has_ready():
+                time.sleep(_POLL_S)
+                continue
+            for fut in ac.next_batch(block=False):
+                i, t_sub = inflight.pop(fut)
+                outcome = _outcome(fut)
+                fut.release()
+                rec = b.finish(i, outcome, time.perf_counter() - t_sub, eng.client_retries)
+                if rec is not None:
+                    b.say(len(inflight), rec)
+            refill_at = 0.0
+    except KeyboardInterrupt:
+        eng.cancel(list(inflight))
+        raise
+    return None
 
 
 def run_batch(
@@ -173,10 +302,10 @@ def run_batch(
     ``scheduler``: the address of a Dask scheduler to use instead; ``force``: replan
     jobs whose results a rerun would keep; ``progress``: called with a
     :class:`BatchProgress` whenever a job starts or ends; ``timeout``: seconds to
-    reach the scheduler.  BatchInputError (and EngineUnavailable) for bad input to the
-    batch itself; everything about a job goes into its record.
+    reach the scheduler; ``quiet``: silence Dask's log.  BatchInputError (and
+    EngineUnavailable) for bad input to the batch itself; everything about a job goes
+    into its record.
     """
-    t0 = time.perf_counter()
     entries = tuple(jobs) if jobs and all(isinstance(j, JobEntry) for j in jobs) else \
         find_jobs([str(j) for j in jobs])  # type: ignore[arg-type]  # fmt: skip
     out = Path(out)
@@ -184,85 +313,19 @@ def run_batch(
         raise BatchInputError(f"--out {out}: exists and is not a folder")
     out.mkdir(parents=True, exist_ok=True)
     prior = load_records(out)
-    code = code_identity()
-    contents = [read_content(e, code.id) for e in entries]  # type: ignore[arg-type]
-    records: list[JobRecord] = []
-    todo: deque[int] = deque()
-    kept = done = failed = 0
-    for i, c in enumerate(contents):
-        e, old = c.entry, prior.get(c.entry.name)
-        if not force and resumable(old, c.digest, out):
-            records.append(old)  # type: ignore[arg-type]
-            kept += 1
-        elif c.error is not None:  # found without planning: unreadable, not TOML
-            records.append(JobRecord(e.name, e.label, "bad_input", c.digest, c.error,
-                                     planned_at=now(), code=code.id))  # fmt: skip
-            done += 1
-            failed += 1
-        else:
-            records.append(pending(e.name, e.label, c.digest, code.id))
-            todo.append(i)
-    names = {r.name for r in records}
-    earlier = [r for n, r in prior.items() if n not in names]
-    run: dict[str, Any] = {"started": now(), "finished": None, "interrupted": False,
-                           "engine": None, "code": code.as_dict(), "jobs": len(records),
-                           "kept": kept, "planned": done}  # fmt: skip
-    write_manifest(out, records, earlier, run)
-    to_plan = len(todo) + done
-
-    def say(running: int, last: JobRecord | None = None) -> None:
-        if progress is not None:
-            progress(BatchProgress(len(records), kept, to_plan, done, failed, running,
-                                   time.perf_counter() - t0, last))  # fmt: skip
-
-    say(0)
-    interrupted = False
-    engine_info = None
-    inflight: dict[Any, tuple[int, float]] = {}
+    code = code_identity().id
+    b = _Batch([read_content(e, code) for e in entries], out, prior, force, progress)  # type: ignore[arg-type]
+    b.say(0)
+    interrupted, error = False, None
     try:
-        if todo:
+        if b.todo:
             with Engine(workers, scheduler, timeout=timeout, quiet=quiet) as eng:
-                engine_info = run["engine"] = eng.describe()
-                write_manifest(out, records, earlier, run)
-                ac = eng.as_completed()
-                try:
-                    refill_at = 0.0
-                    while todo or inflight:
-                        if todo and time.perf_counter() >= refill_at:
-                            slots = eng.slots()
-                            while todo and len(inflight) < slots:
-                                i = todo.popleft()
-                                key = f"ruledrobot-plan-{contents[i].entry.name}-" \
-                                      f"{uuid.uuid4().hex[:8]}"  # fmt: skip
-                                fut = eng.submit(run_task, _task(contents[i], code.id), key)
-                                inflight[fut] = (i, time.perf_counter())
-                                ac.add(fut)
-                            refill_at = time.perf_counter() + _REFILL_S
-                            say(len(inflight))
-                        if not ac.has_ready():
-                            time.sleep(_POLL_S)
-                            continue
-                        for fut in ac.next_batch(block=False):
-                            i, t_sub = inflight.pop(fut)
-                            wall = time.perf_counter() - t_sub
-                            if fut.status == "finished":
-                                rec = _record(contents[i], fut.result(), out, code.id, wall)
-                            else:
-                                rec = _failed_future(contents[i], fut, code.id, wall)
-                            fut.release()
-                            records[i] = rec
-                            done += 1
-                            failed += rec.failed
-                            run["planned"] = done
-                            write_manifest(out, records, earlier, run)
-                            say(len(inflight), rec)
-                        refill_at = 0.0
-                except KeyboardInterrupt:
-                    eng.cancel(list(inflight))
-                    raise
+                b.run["engine"] = eng.describe()
+                b.write()
+                error = _dispatch(b, eng)
     except KeyboardInterrupt:
         interrupted = True
-    run["finished"], run["interrupted"] = now(), interrupted
-    write_manifest(out, records, earlier, run)
-    return BatchResult(out, tuple(records), done, kept, interrupted, time.perf_counter() - t0,
-                       engine_info)  # fmt: skip
+    b.run.update(finished=now(), interrupted=interrupted, error=error)
+    b.write()
+    return BatchResult(out, tuple(b.records), b.done, b.kept, interrupted,
+                       time.perf_counter() - b.t0, b.run["engine"], error)  # fmt: skip

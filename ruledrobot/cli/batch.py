@@ -58,6 +58,8 @@ def batch(
         err.print(f"  {job_line(r)}", highlight=False, markup=False)
     console.print(f"wrote {result.manifest} and {out / 'batch.csv'}", highlight=False,
                   markup=False)  # fmt: skip
+    if result.error:
+        err.print(f"stopped: {result.error}", highlight=False, markup=False)
     if result.interrupted:
         err.print("stopped by Ctrl-C: the jobs not planned are 'pending' in batch.json; run "
                   "the same command again to plan them", highlight=False, markup=False)  # fmt: skip
