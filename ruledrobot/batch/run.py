@@ -175,7 +175,8 @@ def _outcome(future: Any) -> TaskResult | BaseException:
 
 class _Batch:
     """The state of one run: the jobs' contents and records, what is left to plan, the
-    counters; writes the manifest after every change."""
+    counters.  Made without writing anything; :meth:`write` writes the manifest (after
+    every result)."""
 
     def __init__(self, contents: list[JobContent], out: Path, prior: dict[str, JobRecord],
                  force: bool, progress: Callable[[BatchProgress], None] | None) -> None:
@@ -207,7 +208,6 @@ class _Batch:
                                     "error": None, "engine": None, "code": self.code.as_dict(),
                                     "jobs": len(self.records), "kept": self.kept,
                                     "planned": self.done}  # fmt: skip
-        self.write()
 
     def write(self) -> None:
         self.run["planned"] = self.done
@@ -308,24 +308,26 @@ def run_batch(
     """
     entries = tuple(jobs) if jobs and all(isinstance(j, JobEntry) for j in jobs) else \
         find_jobs([str(j) for j in jobs])  # type: ignore[arg-type]  # fmt: skip
+    eng = Engine(workers, scheduler, timeout=timeout, quiet=quiet)  # checks the options
     out = Path(out)
     if out.exists() and not out.is_dir():
         raise BatchInputError(f"--out {out}: exists and is not a folder")
-    out.mkdir(parents=True, exist_ok=True)
-    prior = load_records(out)
+    prior = load_records(out) if out.is_dir() else {}
     code = code_identity().id
     b = _Batch([read_content(e, code) for e in entries], out, prior, force, progress)  # type: ignore[arg-type]
-    b.say(0)
     interrupted, error = False, None
     try:
         if b.todo:
-            with Engine(workers, scheduler, timeout=timeout, quiet=quiet) as eng:
+            with eng:  # started before anything is written: no scheduler is bad input
+                out.mkdir(parents=True, exist_ok=True)
                 b.run["engine"] = eng.describe()
                 b.write()
+                b.say(0)
                 error = _dispatch(b, eng)
     except KeyboardInterrupt:
         interrupted = True
     b.run.update(finished=now(), interrupted=interrupted, error=error)
+    out.mkdir(parents=True, exist_ok=True)
     b.write()
     return BatchResult(out, tuple(b.records), b.done, b.kept, interrupted,
                        time.perf_counter() - b.t0, b.run["engine"], error)  # fmt: skip
