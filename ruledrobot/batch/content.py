@@ -8,8 +8,8 @@ The hash (SHA-256 of a canonical JSON document) covers
 * every input file the job names (``[surface] file``, a G-code, airfoil, DXF or 3DM
   file, ``[robot] calibration``; :func:`ruledrobot.wirecut.job.file_fields`): the
   path as written and the SHA-256 of the bytes (or ``null``: missing);
-* the code: ruledrobot's version and the SHA-256 of its sources (every ``.py`` file of
-  the package: an uncommitted change counts too), and the plan's options.
+* the code: ruledrobot's version and the SHA-256 of the sources that make a plan
+  (:data:`PLANNING_CODE`: an uncommitted change counts too), and the plan's options.
 
 The job's path is *not* hashed: moving the files, or running from another folder,
 does not replan (the reports keep the path they were planned with).
@@ -38,10 +38,10 @@ PLAN_OPTIONS = {"simulate": True, "video": False}
 
 @dataclass(frozen=True)
 class CodeIdentity:
-    """The code that plans: ``version`` of ruledrobot, ``sources`` the SHA-256 of its
-    ``.py`` files (relative path and bytes, sorted), ``commit`` the git commit of the
-    checkout it runs from (None when it is not one).  ``id`` is what jobs are hashed
-    with and what every worker must match."""
+    """The code that plans: ``version`` of ruledrobot, ``sources`` the SHA-256 of the
+    ``.py`` files of :data:`PLANNING_CODE` (relative path and bytes, sorted), ``commit``
+    the git commit of the checkout it runs from (None when it is not one).  ``id`` is
+    what jobs are hashed with and what every worker must match."""
 
     version: str
     sources: str
@@ -66,14 +66,24 @@ def _git_commit(folder: Path) -> str | None:
     return commit if out.returncode == 0 and len(commit) == 40 else None
 
 
+#: the packages a plan is made by (wirecut and the layers below it, docs/architecture.md)
+#: and the batch's own task: a change anywhere else (the CLI, the viewer, the batch's
+#: bookkeeping) does not replan
+PLANNING_CODE = ("algorithms", "geometry", "io", "protocol", "robot", "sim", "subdivision",
+                 "wirecut", "batch/task.py")  # fmt: skip
+
+
 @functools.lru_cache(maxsize=1)
 def code_identity() -> CodeIdentity:
     """The identity of the ruledrobot this process runs (computed once, about 10 ms)."""
     from .. import __version__
 
     root = Path(__file__).resolve().parents[1]
+    files = set(root.glob("*.py"))
+    for part in PLANNING_CODE:
+        files |= {root / part} if part.endswith(".py") else set((root / part).rglob("*.py"))
     h = hashlib.sha256()
-    for p in sorted(root.rglob("*.py")):
+    for p in sorted(files):
         h.update(p.relative_to(root).as_posix().encode() + b"\0")
         h.update(hashlib.sha256(p.read_bytes()).digest())
     return CodeIdentity(__version__, h.hexdigest(), _git_commit(root))

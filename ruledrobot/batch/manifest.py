@@ -65,8 +65,9 @@ class JobRecord:
     it; ``wait_s``: seconds from dispatch to result beyond that (queue, transfer,
     retries); ``worker``: ``host:pid`` of the worker; ``figures``: from the report
     (:data:`FIGURES`, and ``collisions``: their count); ``margins``: per gating check
-    with a numeric limit, the relative margin (limit - value) / |limit| (``<=``
-    checks; value - limit for ``>=``): negative fails; ``files``: the output files,
+    with a numeric, non-zero limit, the relative margin (limit - value) / |limit|
+    (``<=`` checks; value - limit for ``>=``): negative fails (:attr:`worst_check`
+    names the first failing check, else the smallest margin); ``files``: the output files,
     relative to the batch's folder; ``code``: the code identity it was planned with;
     ``attempts``: how often the batch dispatched it (2: its first worker died).
     """
@@ -89,12 +90,15 @@ class JobRecord:
 
     @property
     def worst_check(self) -> str | None:
+        """The first failing check, else the check with the smallest margin."""
+        if self.failed_checks:
+            return self.failed_checks[0]
         return min(self.margins, key=self.margins.__getitem__) if self.margins else None
 
     @property
     def worst_margin(self) -> float | None:
-        name = self.worst_check
-        return None if name is None else self.margins[name]
+        """Its margin (None: a check without a relative margin, e.g. collisions <= 0)."""
+        return self.margins.get(self.worst_check) if self.worst_check else None
 
     @property
     def failed(self) -> bool:

@@ -183,8 +183,13 @@ def test_margins_are_relative_to_the_limit_and_name_the_worst_check():
     figures, margins = figures_of(_report(True))
     assert figures == {"duration_s": 10.0, "cut_duration_s": 6.0, "collisions": 0}
     assert margins == pytest.approx({"joint_speed": 0.5, "feed_min": -0.5 / 9.5})
-    r = JobRecord("a", "a.toml", "infeasible", "h", margins=margins)
+    r = JobRecord("a", "a.toml", "infeasible", "h", margins=margins, failed_checks=("feed_min",))
     assert r.worst_check == "feed_min" and r.worst_margin < 0
+    # a failing check without a relative margin (collisions <= 0) is still the worst
+    r = JobRecord("a", "a.toml", "infeasible", "h", margins=margins,
+                  failed_checks=("collisions",))  # fmt: skip
+    assert r.worst_check == "collisions" and r.worst_margin is None
+    assert JobRecord("a", "a.toml", "feasible", "h", margins=margins).worst_check == "feed_min"
 
 
 def test_the_manifest_round_trips_and_a_rerun_keeps_only_what_is_there(tmp_path):
