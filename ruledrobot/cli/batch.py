@@ -62,5 +62,6 @@ def batch(
         err.print(f"stopped: {result.error}", highlight=False, markup=False)
     if result.interrupted:
         err.print("stopped by Ctrl-C: the jobs not planned are 'pending' in batch.json; run "
-                  "the same command again to plan them", highlight=False, markup=False)  # fmt: skip
+                  "the same command again (without --force) to plan them", highlight=False,
+                  markup=False)  # fmt: skip
     raise typer.Exit(code=result.exit_code)
