@@ -110,7 +110,7 @@ class BatchResult:
 def _task(content: JobContent, code: str) -> JobTask:
     inputs = tuple((str(f.path), f.data) for f in content.inputs if f.data is not None)
     return JobTask(content.entry.name, content.entry.label, str(content.job_path),
-                   content.text or b"", inputs, code)  # fmt: skip
+                   str(content.entry.path), content.text or b"", inputs, code)  # fmt: skip
 
 
 def _write_folder(out: Path, res: TaskResult) -> tuple[str, ...]:

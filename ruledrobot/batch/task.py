@@ -8,8 +8,9 @@ path>``), points the job's file fields there, plans with
 :func:`ruledrobot.wirecut.planner.plan` (MuJoCo verification on, no video) into
 ``<tmp>/out``, and returns every file of the folder (its ``manifest.json`` is
 rebuilt where the files land).  The job keeps the path the client names it by
-(reports, ``trajectory.json``), so the files equal those of ``ruledrobot plan``
-on that path.  Nothing is left in the temporary folder.
+(reports, ``trajectory.json``) and the input files keep the names ``plan`` would
+give them (a calibration's source, error messages), so the files equal those of
+``ruledrobot plan`` on that path.  Nothing is left in the temporary folder.
 
 A task never raises for a job's sake: bad input (``ValueError`` from the job's
 parser or the planner) and any other exception (with its traceback) come back as a
@@ -39,7 +40,7 @@ from pathlib import Path
 from typing import Any
 
 from ..io.outdir import MANIFEST, read_manifest
-from ..wirecut.job import file_fields, job_document, parse_job
+from ..wirecut.job import Job, file_fields, job_document, parse_job
 from .content import code_identity, resolve_input
 
 __all__ = ["KILL_HOOK", "KILL_LOG", "JobTask", "TaskResult", "run_task"]
@@ -52,12 +53,14 @@ KILL_LOG = "RULEDROBOT_BATCH_TEST_KILL_LOG"
 class JobTask:
     """What a worker needs to plan one job: ``label`` the path the reports name,
     ``job_path`` the job file's absolute path on the client (its folder resolves
-    relative paths), ``text`` the effective job's bytes, ``inputs`` ``(absolute client
-    path, bytes)`` of every input file that exists, ``code`` the client's code id."""
+    relative paths) and ``named_path`` that path as the client names it, ``text`` the
+    effective job's bytes, ``inputs`` ``(absolute client path, bytes)`` of every input
+    file that exists, ``code`` the client's code id."""
 
     name: str
     label: str
     job_path: str
+    named_path: str
     text: bytes = field(repr=False)
     inputs: tuple[tuple[str, bytes], ...] = field(default=(), repr=False)
     code: str = ""
@@ -114,6 +117,16 @@ def _folder_files(folder: Path) -> tuple[tuple[tuple[str, bytes], ...], dict[str
     return files, info
 
 
+def _as_named(job: Job, named: dict[str, str]) -> Job:
+    """``job`` with the paths it carries into its files named as on the client: a
+    calibration file without a ``source`` is known by its path (``trajectory.json``)."""
+    cal = job.robot.calibration
+    if cal is None or cal.source not in named:
+        return job
+    cal = dataclasses.replace(cal, source=named[cal.source])
+    return dataclasses.replace(job, robot=dataclasses.replace(job.robot, calibration=cal))
+
+
 def _plan(task: JobTask, tmp: Path, t0: float) -> TaskResult:
     from ..wirecut.planner import plan
 
@@ -123,8 +136,11 @@ def _plan(task: JobTask, tmp: Path, t0: float) -> TaskResult:
         dst.parent.mkdir(parents=True, exist_ok=True)
         dst.write_bytes(data)
     job_path = Path(task.job_path)
+    named: dict[str, str] = {}  # a path in the mirror -> the path ``plan`` would use
 
     def unmirror(msg: str) -> str:
+        for mine in sorted(named, key=len, reverse=True):
+            msg = msg.replace(mine, named[mine])
         return msg.replace(str(root), "")
 
     def result(status: str, message: str, **kw) -> TaskResult:
@@ -133,13 +149,17 @@ def _plan(task: JobTask, tmp: Path, t0: float) -> TaskResult:
 
     try:
         doc = job_document(task.text.decode("utf-8"), task.label)
-        for loc, named in file_fields(doc):
+        for loc, value in file_fields(doc):
             table = doc
             for key in loc[:-1]:
                 table = table[key]
-            table[loc[-1]] = str(_mirror(root, resolve_input(named, job_path)))
+            mine = str(_mirror(root, resolve_input(value, job_path)))
+            table[loc[-1]] = mine
+            v = Path(value)
+            named[mine] = value if v.is_absolute() else str(Path(task.named_path).parent / v)
         job = parse_job(doc, task.label, base_dir=_mirror(root, job_path.parent))
-        job = dataclasses.replace(job, source=Path(task.label), source_bytes=task.text)
+        job = dataclasses.replace(_as_named(job, named), source=Path(task.label),
+                                  source_bytes=task.text)  # fmt: skip
         out = tmp / "out" / task.name
         res = plan(job, out, progress=_test_hook(task.name), simulate=True, video=False)
     except UnicodeDecodeError as exc:

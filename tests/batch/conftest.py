@@ -36,9 +36,30 @@ pose = [0.5, 0.0, 0.3, 0.0, 0.0, 0.0]   # surface frame in the robot base frame
 assert _SURFACE in FAST_JOB
 
 
-def file_job(lines_path: str) -> str:
-    """``FAST_JOB`` with its rulings read from a lines file (the same surface)."""
-    return FAST_JOB.replace(_SURFACE, f'file = "{lines_path}"\n')
+def file_job(lines_path: str, calibration: str | None = None) -> str:
+    """``FAST_JOB`` with its rulings read from a lines file (the same surface), and on a
+    calibrated robot when ``calibration`` names a calibration file."""
+    text = FAST_JOB.replace(_SURFACE, f'file = "{lines_path}"\n')
+    if calibration:
+        text = text.replace("speed_scale = 1.0",
+                            f'speed_scale = 1.0\ncalibration = "{calibration}"')  # fmt: skip
+    return text
+
+
+def write_calibration(path: Path) -> Path:
+    """A factory calibration of the job's UR5e without a ``source`` field (it is then
+    known by its path, which goes into ``trajectory.json``)."""
+    import json
+
+    from ruledrobot.io.calibration import save_calibration
+    from ruledrobot.robot import random_calibration
+
+    path.parent.mkdir(parents=True, exist_ok=True)
+    save_calibration(path, random_calibration("ur5e", seed=3))
+    doc = json.loads(path.read_text())
+    doc.pop("source", None)
+    path.write_text(json.dumps(doc))
+    return path
 
 
 def write_rulings(path: Path) -> Path:

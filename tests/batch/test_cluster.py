@@ -2,9 +2,10 @@
 stopped by the test, bounded in time.
 
 The jobs mix every outcome: feasible (a built-in surface; the same through a lines
-file one folder up, which the worker receives as bytes; one changed by a job list's
-overrides), infeasible (out of reach), bad input (a negative feed, found on the
-worker), and one whose worker is killed mid-plan, twice (the test hook of
+file one folder up on a robot with a calibration file, both of which the worker
+receives as bytes; one changed by a job list's overrides), infeasible (out of
+reach), bad input (a negative feed, found on the worker), and one whose worker is
+killed mid-plan, twice (the test hook of
 :mod:`ruledrobot.batch.task`).  The manifest must say the truth about each; the
 files must equal those of ``plan`` on the same job; a rerun must keep every result
 but the crash.
@@ -24,7 +25,15 @@ from ruledrobot.io.outdir import read_manifest
 from ruledrobot.wirecut.job import load_job
 from ruledrobot.wirecut.planner import plan
 
-from .conftest import BROKEN_JOB, FAR_JOB, FAST_JOB, deadline, file_job, write_rulings
+from .conftest import (
+    BROKEN_JOB,
+    FAR_JOB,
+    FAST_JOB,
+    deadline,
+    file_job,
+    write_calibration,
+    write_rulings,
+)
 
 pytest.importorskip("distributed")
 
@@ -59,9 +68,11 @@ def cluster(tmp_path_factory):
 def jobs(tmp_path_factory) -> Path:
     root = tmp_path_factory.mktemp("batch-jobs")
     write_rulings(root / "shapes" / "hp.json")
+    write_calibration(root / "robot" / "robot.calib.json")
     folder = root / "jobs"
     folder.mkdir()
-    for name, text in {"fast": FAST_JOB, "from_file": file_job("../shapes/hp.json"),
+    from_file = file_job("../shapes/hp.json", calibration="../robot/robot.calib.json")
+    for name, text in {"fast": FAST_JOB, "from_file": from_file,
                        "far": FAR_JOB, "broken": BROKEN_JOB}.items():  # fmt: skip
         (folder / f"{name}.toml").write_text(text)
     (root / "batch.toml").write_text("""
@@ -155,13 +166,15 @@ def test_results_equal_those_of_plan_on_each_job_alone(first_run, jobs, tmp_path
     """Every file of ``plan`` on the job, byte for byte; in report.json,
     simulation/report.json and manifest.json only the timing fields may differ."""
     _, out, _ = first_run
-    job = jobs / "jobs" / "from_file.toml"  # its input file travelled as bytes
+    job = jobs / "jobs" / "from_file.toml"  # its input files travelled as bytes
     with deadline(120):
         alone = plan(load_job(job), tmp_path / "alone")
     assert alone.feasible
     assert _folder(out / "from_file") == _folder(tmp_path / "alone")
     report = json.loads((out / "from_file" / "report.json").read_text())
     assert report["job"]["path"] == str(job)
+    meta = json.loads((out / "from_file" / "trajectory.json").read_text())
+    assert str(jobs / "jobs" / ".." / "robot" / "robot.calib.json") in json.dumps(meta)
 
 
 def test_a_rerun_keeps_the_results_and_plans_only_the_crash(first_run, cluster, jobs):
