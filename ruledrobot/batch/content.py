@@ -76,8 +76,12 @@ PLANNING_CODE = ("algorithms", "geometry", "io", "protocol", "robot", "sim", "su
 @functools.lru_cache(maxsize=1)
 def code_identity() -> CodeIdentity:
     """The identity of the ruledrobot this process runs (computed once, about 10 ms)."""
-    from .. import __version__
+    from importlib.metadata import PackageNotFoundError, version
 
+    try:  # the installed distribution's version (the package root is above this layer)
+        release = version("ruledrobot")
+    except PackageNotFoundError:  # run from a source tree that is not installed
+        release = "unknown"
     root = Path(__file__).resolve().parents[1]
     files = set(root.glob("*.py"))
     for part in PLANNING_CODE:
@@ -86,7 +90,7 @@ def code_identity() -> CodeIdentity:
     for p in sorted(files):
         h.update(p.relative_to(root).as_posix().encode() + b"\0")
         h.update(hashlib.sha256(p.read_bytes()).digest())
-    return CodeIdentity(__version__, h.hexdigest(), _git_commit(root))
+    return CodeIdentity(release, h.hexdigest(), _git_commit(root))
 
 
 @dataclass(frozen=True)
