@@ -22,7 +22,7 @@ import hashlib
 import json
 import os
 import subprocess
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..wirecut.job import file_fields, job_document
@@ -96,15 +96,13 @@ def code_identity() -> CodeIdentity:
 @dataclass(frozen=True)
 class InputFile:
     """An input file a job names: ``named`` as written in the job, ``path`` where it is
-    on this machine (absolute, normalised), ``data`` its bytes (None: cannot be read)."""
+    on this machine (absolute, normalised), ``sha256`` of its bytes (None: cannot be
+    read), ``data`` the bytes when they were kept (:func:`read_content`)."""
 
     named: str
     path: Path
-    data: bytes | None
-
-    @property
-    def sha256(self) -> str | None:
-        return None if self.data is None else hashlib.sha256(self.data).hexdigest()
+    sha256: str | None
+    data: bytes | None = field(default=None, repr=False)
 
 
 @dataclass(frozen=True)
@@ -152,9 +150,11 @@ def _read(path: Path) -> bytes | None:
         return None
 
 
-def read_content(entry: JobEntry, code: str | None = None) -> JobContent:
+def read_content(entry: JobEntry, code: str | None = None, keep: bool = False) -> JobContent:
     """Read ``entry``'s job file and every input file it names, apply its overrides, and
-    hash them with ``code`` (default: this process's :func:`code_identity`)."""
+    hash them with ``code`` (default: this process's :func:`code_identity`).  ``keep``:
+    keep the input files' bytes (to send them; a batch reads them again at dispatch
+    rather than holding every job's inputs from the start)."""
     code = code_identity().id if code is None else code
     path = entry.path
     job_path = Path(os.path.abspath(path))
@@ -173,7 +173,6 @@ def read_content(entry: JobEntry, code: str | None = None) -> JobContent:
         except ImportError:
             raise BatchInputError(f"{entry.origin}: overrides need tomli-w (pip install "
                                   "'ruledrobot[batch]')") from None  # fmt: skip
-
         doc = merge_overrides(doc, entry.overrides)
         try:
             raw = tomli_w.dumps(doc).encode("utf-8")
@@ -184,7 +183,9 @@ def read_content(entry: JobEntry, code: str | None = None) -> JobContent:
     for _, named in file_fields(doc):
         where = resolve_input(named, job_path)
         if named not in seen:
-            seen[named] = InputFile(named, where, _read(where) if where.is_file() else None)
+            data = _read(where) if where.is_file() else None
+            sha = None if data is None else hashlib.sha256(data).hexdigest()
+            seen[named] = InputFile(named, where, sha, data if keep else None)
     inputs = tuple(seen[k] for k in sorted(seen))
     return JobContent(entry, raw, inputs, _digest(raw, None, inputs, code))
 

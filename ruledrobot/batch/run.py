@@ -9,6 +9,7 @@ the jobs not planned are ``pending`` and a rerun of the same command plans them.
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import time
 import traceback
@@ -108,6 +109,7 @@ class BatchResult:
 
 
 def _task(content: JobContent, code: str) -> JobTask:
+    """The task of a job whose content was read with its input files' bytes."""
     inputs = tuple((str(f.path), f.data) for f in content.inputs if f.data is not None)
     return JobTask(content.entry.name, content.entry.label, str(content.job_path),
                    str(content.entry.path), content.text or b"", inputs, code)  # fmt: skip
@@ -219,9 +221,29 @@ class _Batch:
                                         self.failed, running, time.perf_counter() - self.t0,
                                         last, self.threads))  # fmt: skip
 
-    def task(self, i: int) -> JobTask:
+    def task(self, i: int) -> JobTask | None:
+        """Job ``i``'s task, its files read now: a job or input file changed since the run
+        started is planned as it is now, under its new hash; None: the job file is gone
+        or broken now (recorded as bad input)."""
         self.attempts[i] += 1
-        return _task(self.contents[i], self.code.id)
+        c = read_content(self.contents[i].entry, self.code.id, keep=True)
+        self.contents[i] = dataclasses.replace(c, inputs=tuple(
+            dataclasses.replace(f, data=None) for f in c.inputs))  # fmt: skip
+        if c.digest != self.records[i].hash:
+            self.records[i] = pending(c.entry.name, c.entry.label, c.digest, self.code.id)
+        if c.error is None:
+            return _task(c, self.code.id)
+        e = c.entry
+        self.add(i, JobRecord(e.name, e.label, "bad_input", c.digest, c.error,
+                              planned_at=now(), code=self.code.id))  # fmt: skip
+        return None
+
+    def add(self, i: int, rec: JobRecord) -> None:
+        """Job ``i``'s result: recorded, counted, written."""
+        self.records[i] = rec
+        self.done += 1
+        self.failed += rec.failed
+        self.write()
 
     def finish(self, i: int, outcome: TaskResult | BaseException, wall_s: float,
                retries: int) -> JobRecord | None:  # fmt: skip
@@ -234,10 +256,7 @@ class _Batch:
             return None
         else:
             rec = _crashed(c, outcome, self.code.id, wall_s, self.attempts[i])
-        self.records[i] = rec
-        self.done += 1
-        self.failed += rec.failed
-        self.write()
+        self.add(i, rec)
         return rec
 
 
@@ -262,8 +281,12 @@ def _dispatch(b: _Batch, eng: Engine) -> str | None:
                 eng.heal(threads)
                 while b.todo and len(inflight) < eng.slots(threads):
                     i = b.todo.popleft()
-                    key = f"ruledrobot-plan-{b.contents[i].entry.name}-{uuid.uuid4().hex[:8]}"
-                    fut = eng.submit(run_task, b.task(i), key)
+                    task = b.task(i)
+                    if task is None:
+                        b.say(len(inflight), b.records[i])
+                        continue
+                    key = f"ruledrobot-plan-{task.name}-{uuid.uuid4().hex[:8]}"
+                    fut = eng.submit(run_task, task, key)
                     inflight[fut] = (i, time.perf_counter())
                     ac.add(fut)
                 refill_at = time.perf_counter() + _REFILL_S

@@ -222,3 +222,27 @@ def test_a_batch_json_that_is_not_ours_is_not_overwritten(tmp_path):
     (tmp_path / "batch.json").write_text('{"my": "data"}')
     with pytest.raises(BatchInputError, match=r"batch\.json: not a batch manifest"):
         load_records(tmp_path)
+
+
+def test_a_job_is_read_again_when_it_is_dispatched(tmp_path):
+    """The inputs' bytes are read at dispatch (not held for every job from the start): a
+    job changed meanwhile is planned as it is then, under its new hash; one deleted
+    meanwhile is bad input."""
+    from ruledrobot.batch.run import _Batch
+
+    write_rulings(tmp_path / "shapes" / "hp.json")
+    a, b = _jobs(tmp_path / "jobs", "a", "b", text=file_job("../shapes/hp.json"))
+    contents = [read_content(JobEntry(p.stem, p)) for p in (a, b)]
+    assert all(f.data is None for c in contents for f in c.inputs)  # hashed, not held
+    before = contents[0].digest
+    batch = _Batch(contents, tmp_path / "out", {}, False, None)
+    assert [r.status for r in batch.records] == ["pending", "pending"]
+    a.write_text(a.read_text().replace("feed_speed = 0.04 ", "feed_speed = 0.03 "))
+    task = batch.task(0)
+    assert b"feed_speed = 0.03" in task.text and len(task.inputs) == 1
+    assert task.inputs[0][1] == (tmp_path / "shapes" / "hp.json").read_bytes()
+    assert batch.records[0].hash == read_content(JobEntry("a", a)).digest != before
+    b.unlink()
+    (tmp_path / "out").mkdir()
+    assert batch.task(1) is None
+    assert batch.records[1].status == "bad_input" and "no such job file" in batch.records[1].message
