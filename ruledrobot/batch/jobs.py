@@ -106,11 +106,16 @@ def _check_name(name: object, where: str) -> str:
     return name
 
 
-def _expand(pattern: str, where: str) -> list[Path]:
-    """The files a glob matches (sorted); BatchInputError when it matches none."""
+def _expand(pattern: str, where: str, exclude: Path | None = None) -> list[Path]:
+    """The files a glob matches (sorted), but none under ``exclude`` (the batch's output
+    folder: its ``job.toml`` copies); BatchInputError when it matches none."""
     found = sorted(Path(p) for p in glob.glob(pattern, recursive=True) if Path(p).is_file())
+    if exclude is not None:
+        root = exclude.resolve()
+        found = [p for p in found if not p.resolve().is_relative_to(root)]
     if not found:
-        raise BatchInputError(f"{where}: pattern {pattern!r} matches no file")
+        raise BatchInputError(f"{where}: pattern {pattern!r} matches no file"
+                              + (f" outside {exclude}" if exclude is not None else ""))  # fmt: skip
     return found
 
 
@@ -205,16 +210,17 @@ def _from_path(path: Path, where: str) -> list[JobEntry]:
     return [JobEntry(_check_name(path.stem, f"{where}: {path}"), path, {}, where)]
 
 
-def find_jobs(args: Sequence[str | Path]) -> tuple[JobEntry, ...]:
+def find_jobs(args: Sequence[str | Path], exclude: Path | None = None) -> tuple[JobEntry, ...]:
     """The jobs named by ``args`` (job files, globs, job lists), in order; see the module
-    doc.  BatchInputError when an argument names nothing, a list is unreadable, no job
-    is found, or two jobs would share an output folder."""
+    doc.  Globs on the command line match nothing under ``exclude`` (the batch's output
+    folder).  BatchInputError when an argument names nothing, a list is unreadable, no
+    job is found, or two jobs would share an output folder."""
     entries: list[JobEntry] = []
     for arg in args:
         text = str(arg)
         where = "command line"
         if _MAGIC & set(text) and not Path(text).exists():
-            for p in _expand(text, where):
+            for p in _expand(text, where, exclude):
                 entries += _from_path(p, where)
         else:
             entries += _from_path(Path(text), where)

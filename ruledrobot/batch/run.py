@@ -329,10 +329,10 @@ def run_batch(
     EngineUnavailable) for bad input to the batch itself; everything about a job goes
     into its record.
     """
-    entries = tuple(jobs) if jobs and all(isinstance(j, JobEntry) for j in jobs) else \
-        find_jobs([str(j) for j in jobs])  # type: ignore[arg-type]  # fmt: skip
-    eng = Engine(workers, scheduler, timeout=timeout, quiet=quiet)  # checks the options
     out = Path(out)
+    entries = tuple(jobs) if jobs and all(isinstance(j, JobEntry) for j in jobs) else \
+        find_jobs([str(j) for j in jobs], exclude=out)  # type: ignore[arg-type]  # fmt: skip
+    eng = Engine(workers, scheduler, timeout=timeout, quiet=quiet)  # checks the options
     if out.exists() and not out.is_dir():
         raise BatchInputError(f"--out {out}: exists and is not a folder")
     prior = load_records(out) if out.is_dir() else {}

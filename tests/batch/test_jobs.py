@@ -37,6 +37,10 @@ def test_files_and_globs_name_jobs_by_their_stems(tmp_path):
                        str(tmp_path / "**" / "c.toml")])  # fmt: skip
     assert [(e.name, e.path) for e in found] == [("a", a), ("b", b), ("c", c)]
     assert all(e.label == str(e.path) and not e.overrides for e in found)
+    # a glob does not pick up the job.toml copies in the batch's own output folder
+    _jobs(tmp_path / "out" / "a", "job")
+    found = find_jobs([str(tmp_path / "**" / "*.toml")], exclude=tmp_path / "out")
+    assert [e.name for e in found] == ["c", "a", "b"]
 
 
 def test_a_job_list_names_jobs_with_folder_names_and_overrides(tmp_path):
