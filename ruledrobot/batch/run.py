@@ -190,12 +190,14 @@ class _Batch:
         self.attempts = [0] * len(contents)
         self.kept = self.done = self.failed = 0
         self.threads: int | None = None
+        self.found: list[int] = []  # jobs found to be bad input without planning
         for i, c in enumerate(contents):
             e, old = c.entry, prior.get(c.entry.name)
             if not force and resumable(old, c.digest, out):
                 self.records.append(old)  # type: ignore[arg-type]
                 self.kept += 1
             elif c.error is not None:  # found without planning: unreadable, not TOML
+                self.found.append(i)
                 self.records.append(JobRecord(e.name, e.label, "bad_input", c.digest, c.error,
                                               planned_at=now(), code=self.code.id))  # fmt: skip
                 self.done += 1
@@ -346,6 +348,8 @@ def run_batch(
                 b.run["engine"] = eng.describe()
                 b.write()
                 b.say(0)
+                for i in b.found:  # bad input found without planning: shown with the others
+                    b.say(0, b.records[i])
                 error = _dispatch(b, eng)
     except KeyboardInterrupt:
         interrupted = True
