@@ -37,7 +37,8 @@ from typing import Any
 
 __all__ = ["WORKER_MEMORY", "Engine", "EngineUnavailable", "default_workers", "local_cluster"]
 
-#: memory [bytes] a planning worker is given; a plan of the demo job peaks near 200 MB
+#: memory [bytes] each local worker should have (sizes the cluster; the nanny's limit is
+#: the machine's memory shared out): a plan of the demo job peaks near 200 MB
 WORKER_MEMORY = 1 << 30
 
 
