@@ -74,7 +74,14 @@ from pathlib import Path
 import numpy as np
 
 from ..io.text import read_user_text
-from .job_sections import Section, parse_heat, parse_robot, parse_stock, parse_surface
+from .job_sections import (
+    FOREIGN_KINDS,
+    Section,
+    parse_heat,
+    parse_robot,
+    parse_stock,
+    parse_surface,
+)
 from .spec import CutSpec, HeatSpec, Job, RobotSpec, SurfaceSpec, ToolSpec
 
 if sys.version_info >= (3, 11):
@@ -89,6 +96,8 @@ __all__ = [
     "RobotSpec",
     "SurfaceSpec",
     "ToolSpec",
+    "file_fields",
+    "job_document",
     "load_job",
     "parse_job",
 ]
@@ -199,12 +208,50 @@ def parse_job(doc: dict, where: str = "job", base_dir: Path | None = None) -> Jo
     return Job(cuts, stock, robot, tool)
 
 
+def job_document(text: str, where: str) -> dict:
+    """The TOML document of a job file's text; ValueError naming ``where`` when it is not
+    valid TOML (the fields are checked by :func:`parse_job`)."""
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ValueError(f"{where}: not valid TOML ({exc})") from None
+
+
+#: the fields of a ``[surface]`` table that name a file: ``kind -> keys`` of its option
+#: table (a plain string is the first key's path)
+_SURFACE_FILES = {"file": ()} | {k: ("root", "tip") if k == "airfoil" else ("file",)
+                                 for k in FOREIGN_KINDS}  # fmt: skip
+
+
+def file_fields(doc: dict) -> list[tuple[tuple[str | int, ...], str]]:
+    """Every field of a job document that names an input file, as ``(location, path)``:
+    ``location`` the keys from the document's root (``("cut", 0, "surface", "file")``),
+    ``path`` as written (relative paths are taken from the job file's folder).  Fields
+    of the wrong type are left out (:func:`parse_job` reports them)."""
+    found: list[tuple[tuple[str | int, ...], str]] = []
+    surfaces: list[tuple[tuple[str | int, ...], object]] = [(("surface",), doc.get("surface"))]
+    if isinstance(doc.get("cut"), list):
+        surfaces += [(("cut", i, "surface"), c.get("surface"))
+                     for i, c in enumerate(doc["cut"]) if isinstance(c, dict)]  # fmt: skip
+    for where, table in surfaces:
+        if not isinstance(table, dict):
+            continue
+        for kind, keys in _SURFACE_FILES.items():
+            value = table.get(kind)
+            if isinstance(value, str):
+                found.append(((*where, kind), value))
+            elif isinstance(value, dict):
+                found += [((*where, kind, k), value[k]) for k in keys
+                          if isinstance(value.get(k), str)]  # fmt: skip
+    robot = doc.get("robot")
+    if isinstance(robot, dict) and isinstance(robot.get("calibration"), str):
+        found.append((("robot", "calibration"), robot["calibration"]))
+    return found
+
+
 def load_job(path: str | os.PathLike[str]) -> Job:
     """Read and validate a TOML job file; ValueError names the file, section and field."""
     p, text = read_user_text(path, "job file")
-    try:
-        doc = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise ValueError(f"{p}: not valid TOML ({exc})") from None
+    doc = job_document(text, str(p))
     job = parse_job(doc, str(p), base_dir=p.parent)
     return Job(job.cuts, job.stock, job.robot, job.tool, source=p)

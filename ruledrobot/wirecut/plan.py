@@ -75,7 +75,7 @@ def job_reference(job: Job) -> dict[str, str] | None:
     """``{"path", "sha256"}`` of the job file (None for a job built in memory)."""
     if job.source is None:
         return None
-    data = Path(job.source).read_bytes()
+    data = job.source_bytes if job.source_bytes is not None else Path(job.source).read_bytes()
     return {"path": str(job.source), "sha256": hashlib.sha256(data).hexdigest()}
 
 

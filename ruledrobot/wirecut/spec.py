@@ -147,13 +147,19 @@ class CutSpec:
 @dataclass(frozen=True)
 class Job:
     """A validated cut job (see the module doc for the file format): one stock, robot and
-    tool, and the cuts in the order they are made."""
+    tool, and the cuts in the order they are made.
+
+    ``source``: the job file, as the reports name it; ``source_bytes``: its bytes as
+    planned, when the job was read from a copy (a batch worker on another machine):
+    the reports hash them and ``job.toml`` is written from them instead of reading
+    ``source`` again (None: read ``source``)."""
 
     cuts: tuple[CutSpec, ...]
     stock: Box
     robot: RobotSpec
     tool: ToolSpec
     source: Path | None = None
+    source_bytes: bytes | None = field(default=None, repr=False)
 
     @property
     def cut(self) -> CutSpec:

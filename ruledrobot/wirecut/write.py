@@ -106,5 +106,6 @@ def write_plan(
                                         json.dumps(report, indent=1) + "\n")  # fmt: skip
     job = plan.job
     if job.source is not None:
-        files["job"] = atomic_write_bytes(folder / "job.toml", Path(job.source).read_bytes())
+        data = job.source_bytes if job.source_bytes is not None else Path(job.source).read_bytes()
+        files["job"] = atomic_write_bytes(folder / "job.toml", data)
     return files
