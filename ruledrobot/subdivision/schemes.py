@@ -15,6 +15,7 @@ motion sampled at equal steps (helical surfaces).
 ===================  =====  ==============  ============  =====================
 name                 arity  interpolatory   smoothness    approximation order
 ===================  =====  ==============  ============  =====================
+linear               2      yes             C^0           2
 chaikin              2      no              C^1           2
 bspline3             2      no              C^2           2
 four_point (w)       2      yes             C^1 (w<.154)  4 at w = 1/16
@@ -130,6 +131,21 @@ def _make_four_point(w: float) -> Callable[[Space, FloatArray, int, bool], Float
     return rule
 
 
+def _linear(space: Space, E: FloatArray, n: int, closed: bool) -> FloatArray:
+    """Geodesic midpoints: ``new = mid(p_i, p_{i+1})`` (four_point at ``w = 0``).
+
+    The refined sequence lies on the geodesic polygon of the data: corners stay
+    corners.  For data that already is a densely sampled path with intended
+    corners (a foam cutter's moves), where a smoothing scheme would round or
+    overshoot them."""
+    if closed:  # E = p_{-1} .. p_n (one periodic ghost each side)
+        old, nxt = E[1 : n + 1], E[2 : n + 2]
+    else:  # open data come without ghosts (phantom degree 0)
+        old, nxt = E[: n - 1], E[1:n]
+    new = space.geodesic_many(old, nxt, [0.5])[0]
+    return interleave(E[1 : n + 1] if closed else E, new)
+
+
 _DD6 = np.array([3.0, -25.0, 150.0, 150.0, -25.0, 3.0]) / 256.0
 
 
@@ -178,7 +194,7 @@ def _make_ternary(mu: float) -> Callable[[Space, FloatArray, int, bool], FloatAr
     return rule
 
 
-SCHEME_NAMES = ("chaikin", "bspline3", "four_point", "six_point", "ternary_four_point")
+SCHEME_NAMES = ("linear", "chaikin", "bspline3", "four_point", "six_point", "ternary_four_point")
 
 _DLG_C1_LIMIT = (np.sqrt(5.0) - 1.0) / 8.0
 
@@ -200,6 +216,8 @@ def get_scheme(name: str, **params: float) -> Scheme:
     if extra:
         ok = ", ".join(sorted(allowed.get(name, set()))) or "none"
         raise ValueError(f"scheme {name!r}: unknown parameter(s) {sorted(extra)}; accepted: {ok}")
+    if name == "linear":
+        return Scheme(name, 2, True, 1, 0, 2, _linear)
     if name == "chaikin":
         return Scheme(name, 2, False, 1, 0, 3, _chaikin)
     if name == "bspline3":

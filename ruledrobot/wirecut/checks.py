@@ -11,7 +11,10 @@ Gating (the plan is feasible only when all hold; ``docs/verdict.md``):
   ``[cut] wire_tolerance`` of the target rulings inside the stock;
   ``planned_wire_deviation`` — the same for the planned joints;
 * ``feed_max`` / ``feed_min`` — the feed of the wire inside the stock within
-  ``[cut] feed_tolerance`` of the set feed (above and below);
+  ``[cut] feed_tolerance`` of the set feed (above and below); the lowest feed leaves
+  out the slow-down and speed-up where the wire stops at a corner of its path
+  (:mod:`.corners`: a turn of more than 30 degrees, which no machine passes at the
+  feed), counted in ``corner_stops``;
 * ``kept_surface`` (kerf compensated cuts) — the kept part's surface within
   ``[cut] wire_tolerance`` of the target, from the kerf offsets (:mod:`.kerf`)
   (these four are per cut, named ``wire_deviation:NAME`` ... when a job has several);
@@ -20,7 +23,7 @@ Gating (the plan is feasible only when all hold; ``docs/verdict.md``):
   — the simulated joint torques (MuJoCo, with the bow's mass) at most the limits;
 * ``singularity`` — the singularity measure during the cut at least the margin.
 
-Information only: TCP tracking error, feed within 1 %, kerf, duration.
+Information only: TCP tracking error, feed within 1 %, kerf, corner stops, duration.
 """
 
 from __future__ import annotations
@@ -51,6 +54,7 @@ class CutMeasurements:
     kept_surface_error_mm: float | None
     wire_tolerance_mm: float
     feed_tolerance: float
+    corner_stops: int = 0
 
 
 @dataclass(frozen=True)
@@ -106,11 +110,16 @@ def _cut_info(c: CutMeasurements, single: bool) -> list[Check]:
     key = "" if single else f":{c.name}"
     of = "" if single else f" ({c.name})"
     kerf = "kerf (compensated)" if c.compensated else "kerf (not compensated)"
-    return [
+    info = [
         Check.info("feed_within_1pct" + key, "share of the cut within 1 % of the feed" + of,
                    c.feed_within_1pct),
         Check.info("kerf" + key, kerf + of, c.kerf_mm, "mm"),
     ]  # fmt: skip
+    if c.corner_stops:
+        info.append(Check.info(
+            "corner_stops" + key, "corners where the wire stops (not in the lowest feed)" + of,
+            c.corner_stops, "", "the kerf is wider where the wire stops"))  # fmt: skip
+    return info
 
 
 def plan_verdict(m: Measurements, *, singularity_margin: float) -> Verdict:

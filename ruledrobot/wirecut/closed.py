@@ -31,7 +31,7 @@ from .cutpath import CutPath, RefinedCut
 from .kerf import KerfOffsets
 from .redundancy import solve_redundancy
 from .spec import CutSpec, Job
-from .toolpath import chords
+from .toolpath import chords, world_referenced
 
 __all__ = ["loop_paths", "slit_direction"]
 
@@ -39,24 +39,6 @@ __all__ = ["loop_paths", "slit_direction"]
 CANDIDATES = 6
 #: spacing of the slit's frames [m]
 SLIT_STEP = 0.002
-
-
-def world_referenced(F: FloatArray) -> FloatArray:
-    """The frames turned about their z axes so that x points, as nearly as it can, along
-    one world axis — the one the rulings are most nearly normal to.  A constant roll
-    relative to these frames keeps the bow's attitude in the world as the wire goes
-    round: relative to the DH frames, which turn once with the loop, it would turn the
-    bow a full turn about the wire, through the stock and the table."""
-    z = F[:, :3, 2]
-    axis = int(np.argmin(np.abs(z).mean(axis=0)))
-    v = np.zeros(3)
-    v[axis] = 1.0
-    x = v - (z @ v)[:, None] * z
-    x /= np.linalg.norm(x, axis=1, keepdims=True)
-    out = F.copy()
-    out[:, :3, 0] = x
-    out[:, :3, 1] = np.cross(z, x)
-    return out
 
 
 def _flipped(F: FloatArray) -> FloatArray:

@@ -193,6 +193,10 @@ def parse_surface(s: Section, base_dir: Path | None) -> SurfaceSpec:
     closed = s.get("closed")
     if closed is not None and not isinstance(closed, bool):
         raise s.fail("closed", f"expected true or false, got {closed!r}")
+    # a foam cutter's moves: the projection algorithm by default, whose geodesic
+    # midpoints keep the towers' straight moves (the dh frames swing round a corner
+    # of parallel rulings); refined between its corners (docs/formats.md)
+    polyline = bool(foreign) and foreign[0] == "gcode"
     surface = SurfaceSpec(
         builtin=builtin,
         file=path,
@@ -200,7 +204,7 @@ def parse_surface(s: Section, base_dir: Path | None) -> SurfaceSpec:
         u=u,
         rulings=int(rulings),
         pose=pose(s, "pose"),
-        algorithm=s.choice("algorithm", ALGORITHMS, "dh"),
+        algorithm=s.choice("algorithm", ALGORITHMS, "projection" if polyline else "dh"),
         scheme=s.choice("scheme", SCHEME_NAMES, "four_point"),
         steps=steps,
         spacing=spacing,

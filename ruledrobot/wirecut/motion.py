@@ -2,7 +2,8 @@
 transits between them, the retract — one timed joint trajectory with a label per sample.
 
 Each pass (:class:`~.path.CutPath`) is timed at its cut's feed speed
-(:func:`~.timing.time_path`).  It is entered from a pose ``LIFT`` beyond its first
+(:func:`~.timing.time_path`), in pieces from rest to rest between the corners of its
+path (:mod:`.corners`).  It is entered from a pose ``LIFT`` beyond its first
 ruling (away from the stock centre) and left to a pose ``LIFT`` beyond its last.
 Between passes the arm moves in joint space from one lifted pose to the next
 (:mod:`.transit` checks that the bow and the arm stay clear of the whole stock —
@@ -25,10 +26,11 @@ import numpy as np
 from ..geometry.angles import wrap_near
 from ..geometry.checks import FloatArray
 from ..geometry.interp import interp_linear
+from .corners import corner_nodes, corner_stop_mask, time_between_corners
 from .densify import densified, pass_deviation, pass_feed_error, uneven_intervals
 from .path import CutPath, chord_ends_in_flange
 from .spec import Job
-from .timing import TimedPath, concatenate, dwell, joint_move, time_path
+from .timing import TimedPath, concatenate, dwell, joint_move
 from .toolpath import speed_factor, wire_frame
 from .transit import TransitPlanner
 
@@ -55,7 +57,8 @@ class Motion:
     ``passes``: the passes as timed (with the rulings :mod:`.densify` added).
     ``surface`` (M,): the wire cuts the target surface (in the stock, phase ``cut``; not
     the slits of a closed cut, which cut waste): where the feed and the wire's deviation
-    are checked.
+    are checked.  ``corner_stop`` (M,): the wire slows to a stop at a corner of its path
+    (:mod:`.corners`); the lowest feed is measured outside these samples.
     """
 
     timed: TimedPath = field(repr=False)
@@ -68,6 +71,7 @@ class Motion:
     notes: tuple[str, ...] = ()
     passes: tuple[CutPath, ...] = field(default=(), repr=False)
     surface: np.ndarray | None = field(default=None, repr=False)
+    corner_stop: np.ndarray | None = field(default=None, repr=False)
 
 
 def _fill_nearest(values: FloatArray, valid: np.ndarray) -> FloatArray:
@@ -131,8 +135,9 @@ class _Builder:
 
 
 def _wire_arclength(cp: CutPath) -> FloatArray:
-    """(M,) the distance [m] travelled along the pass by its fastest chord end (the wire's
-    midpoint where no chord exists), from 0: the path parameter the feed is held in.
+    """(M,) the distance [m] travelled along the pass by its fastest chord end across the
+    wire (the frame origin where no chord exists), from 0: the path parameter the feed
+    is held in.
 
     With it the speed factor is about 1 everywhere in the stock; the time law bounds the
     feed with the largest speed factor around each node, so uneven ruling spacing — a
@@ -141,10 +146,22 @@ def _wire_arclength(cp: CutPath) -> FloatArray:
     m = cp.motion
     F = cp.frames
     c = np.nan_to_num(m.chord)
-    ends = F[:, None, :3, 3] + c[:, :, None] * F[:, None, :3, 2]
-    step_ends = np.linalg.norm(np.diff(ends, axis=0), axis=-1).max(axis=1)
-    mid = F[:, :3, 3] + (0.5 * c.sum(axis=1))[:, None] * F[:, :3, 2]
-    step_mid = np.linalg.norm(np.diff(mid, axis=0), axis=-1)
+    o, z = F[:, :3, 3], F[:, :3, 2]
+    ends = o[:, None] + c[:, :, None] * z[:, None]
+
+    def across(p: FloatArray, o: FloatArray, z: FloatArray) -> FloatArray:
+        """Distance (K, 2) of points p (K, 2, 3) from the lines (o, z) (K, 3): the wire's
+        travel across itself.  Not the chord end's own travel: where the wire leaves
+        the stock at a grazing angle that end runs along the wire, many times faster
+        than the wire moves, and would stretch the parameter there."""
+        d = p - o[:, None]
+        return np.linalg.norm(d - (d * z[:, None]).sum(-1, keepdims=True) * z[:, None], axis=-1)
+
+    step_ends = np.maximum(across(ends[:-1], o[1:], z[1:]), across(ends[1:], o[:-1], z[:-1]))
+    step_ends = step_ends.max(axis=1)
+    # out of the stock: the frame origins (anchored nearest the stock centre), across
+    step_mid = np.maximum(across(o[:-1, None], o[1:], z[1:]), across(o[1:, None], o[:-1], z[:-1]))
+    step_mid = step_mid[:, 0]
     both = m.hit[:-1] & m.hit[1:]
     step = np.where(both, step_ends, step_mid)
     step = np.maximum(step, 1e-9)  # strictly increasing, also where the wire holds still
@@ -163,7 +180,8 @@ def _pass_timing(
         s = cp.s
         ends = chord_ends_in_flange(cp)
         sf = speed_factor(m.flange, s, ends, m.hit)
-        timed = time_path(s, m.q, sf, cut.feed_speed, vel, acc, dt)
+        corners = corner_nodes(cp.frames, 0.5 * job.tool.wire_length)
+        timed = time_between_corners(s, m.q, sf, cut.feed_speed, vel, acc, dt, corners)
         if attempt == DENSIFY_ROUNDS:
             break
         dev = pass_deviation(cp, timed, model, ends)
@@ -236,6 +254,7 @@ def _label(job, whole: TimedPath, b: _Builder, passes, timed_passes, notes) -> M
     in_stock = np.zeros(M, dtype=bool)
     ends = np.zeros((M, 2, 3))
     seg = whole.segment
+    stop = np.zeros(M, dtype=bool)
     for i, (label, k) in enumerate(b.kinds):
         rows = seg == i
         if not rows.any():
@@ -245,7 +264,7 @@ def _label(job, whole: TimedPath, b: _Builder, passes, timed_passes, notes) -> M
             if label == "preheat":
                 pass_of[rows] = k
             continue
-        cp, (_, cp_ends) = passes[k], timed_passes[k]
+        cp, (timed_k, cp_ends) = passes[k], timed_passes[k]
         idx = np.flatnonzero(rows)
         # the pass's own parameter: its s_of_t starts at cp.s[0] (the part drops no first
         # sample when it is the first part; otherwise the dropped one is its start)
@@ -269,9 +288,13 @@ def _label(job, whole: TimedPath, b: _Builder, passes, timed_passes, notes) -> M
             lab[s_k < cp.s[a]] = "lead_in"
             lab[s_k > cp.s[len(cp.s) - 1 - z]] = "lead_out"
         labels[idx] = lab
+        s_corner = cp.s[corner_nodes(cp.frames, 0.5 * job.tool.wire_length)]
+        if s_corner.size:  # the pass's own samples: its first may be dropped in the whole
+            own = corner_stop_mask(timed_k, s_corner)
+            stop[idx] = own[timed_k.t.size - idx.size :]
     surface = in_stock & (labels == "cut")
     heat = np.zeros(M, dtype=bool)
     if job.tool.heat is not None:
         heat = np.isin(labels.astype(str), ("preheat", "lead_in", "cut", "lead_out"))
     return Motion(whole, labels, pass_of, s, in_stock, ends, heat, tuple(notes), tuple(passes),
-                  surface)
+                  surface, stop & surface)

@@ -40,7 +40,10 @@ def _cut_sections(plan: Plan, ver: Verification | None) -> tuple[list[dict], lis
         rows = np.isin(mo.pass_of, ks) & mo.surface
         interior = rows & ~mo.timed.feed_limited
         slits = np.isin(mo.pass_of, ks) & mo.in_stock & ~mo.surface
+        stops = rows & mo.corner_stop if mo.corner_stop is not None else rows & False
         feed = me.feed[rows]
+        held = me.feed[rows & ~stops]  # the lowest feed: not where the wire stops at a corner
+        n_stops = int(np.count_nonzero(stops & ~np.r_[False, stops[:-1]]))
         dev_p = float(me.deviation[rows].max()) if rows.any() else 0.0
         dev_s = None if ver is None else (float(ver.deviation[rows].max()) if rows.any() else 0.0)
         err = max((float(np.max(cp.kerf_error)) for cp in passes
@@ -52,7 +55,8 @@ def _cut_sections(plan: Plan, ver: Verification | None) -> tuple[list[dict], lis
         cm = CutMeasurements(
             name=cut.name, feed_set_mm_s=cut.feed_speed * 1e3,
             feed_max_mm_s=float(feed.max() * 1e3) if feed.size else None,
-            feed_min_mm_s=float(feed.min() * 1e3) if feed.size else None,
+            feed_min_mm_s=float(held.min() * 1e3) if held.size else None,
+            corner_stops=n_stops,
             feed_within_1pct=float(np.mean(np.abs(me.feed[interior] / cut.feed_speed - 1.0)
                                            <= 0.01)) if interior.any() else None,
             wire_deviation_mm=_mm(dev_s), planned_wire_deviation_mm=_mm(dev_p),
@@ -73,6 +77,7 @@ def _cut_sections(plan: Plan, ver: Verification | None) -> tuple[list[dict], lis
             "feed_speed_mm_s": cm.feed_set_mm_s,
             "max_feed_speed_mm_s": cm.feed_max_mm_s,
             "min_feed_speed_mm_s": cm.feed_min_mm_s,
+            "corner_stops": n_stops,
             "feed_within_1pct_fraction": cm.feed_within_1pct,
             "max_planned_wire_deviation_mm": cm.planned_wire_deviation_mm,
             "max_wire_deviation_mm": cm.wire_deviation_mm,

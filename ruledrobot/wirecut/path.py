@@ -18,6 +18,8 @@
 
 from __future__ import annotations
 
+from itertools import pairwise
+
 import numpy as np
 
 from ..algorithms import check_distinct_neighbours, refine
@@ -27,11 +29,12 @@ from ..geometry.checks import FloatArray
 from ..geometry.ruled import RuledSurface
 from ..subdivision import check_size, get_scheme, refined_count
 from .closed import loop_paths
+from .corners import polygon_corners
 from .cutpath import CutPath, RefinedCut
 from .kerf import kerf_offsets
 from .redundancy import solve_redundancy
 from .spec import CutSpec, Job
-from .toolpath import chords
+from .toolpath import anchored_frames, chords, world_referenced
 
 __all__ = [
     "CutPath",
@@ -68,18 +71,42 @@ def _gaps(frames: FloatArray, stock: Box) -> float:
     return float(np.max(gaps, axis=0)[both].max())
 
 
-def _frames(lines, closed: bool, cut: CutSpec, steps: int) -> tuple[FloatArray, bool]:
+def _frames(
+    lines, closed: bool, cut: CutSpec, steps: int, stock: Box, half: float
+) -> tuple[FloatArray, bool]:
+    """Refined frames (anchored at the rulings' points nearest the stock centre where
+    their origins stray).  A foam cutter's open polygon of moves is refined piece by
+    piece between its corners (:func:`.corners.polygon_corners`), which stay corners;
+    ``half`` [m]: half the wire."""
     s = cut.surface
-    res = refine(RuledSurface(lines, closed=closed), s.algorithm, s.scheme, steps)
-    frames = res.frames
-    if frames is None:
-        frames = RuledSurface(res.lines, closed=closed).dh_frames("continuous")
-    return frames, bool(res.flip)
+    pieces = [lines]
+    if s.kind == "gcode" and not closed:
+        cuts = [0, *polygon_corners(lines.plucker, stock.centre, half).tolist(), len(lines) - 1]
+        pieces = [lines[a : b + 1] for a, b in pairwise(cuts)]
+    frames, flip = [], False
+    for k, piece in enumerate(pieces):
+        scheme = s.scheme if len(piece) >= get_scheme(s.scheme).min_points else "linear"
+        res = refine(RuledSurface(piece, closed=closed), s.algorithm, scheme, steps)
+        F = res.frames
+        if F is None:
+            F = RuledSurface(res.lines, closed=closed).dh_frames("continuous")
+        frames.append(F if k == 0 else F[1:])  # a piece starts where the last one ends
+        flip = bool(res.flip)
+    F = np.concatenate(frames)
+    # the striction points of nearly parallel rulings run off to metres away: then every
+    # frame is anchored nearest the stock centre (a slide means the same on each)
+    reach = float(np.linalg.norm(stock.size)) + 2.0 * half
+    if (np.linalg.norm(F[:, :3, 3] - stock.centre, axis=1) > reach).any():
+        F = anchored_frames(F, stock.centre)
+    return F, flip
 
 
-def refine_cut(cut: CutSpec, stock: Box, where: str = "job") -> RefinedCut:
+def refine_cut(
+    cut: CutSpec, stock: Box, where: str = "job", wire_length: float = 0.4
+) -> RefinedCut:
     """Refined frames of ``cut`` (see the module doc): ``spacing`` takes the fewest
-    steps whose largest gap inside the stock meets it."""
+    steps whose largest gap inside the stock meets it.  ``wire_length`` [m] (the
+    tool's) places the wire points whose turns are a polygon's corners."""
     s = cut.surface
     label = f"{where}: [surface]" if cut.name == "cut" else f"{where}: [cut '{cut.name}'.surface]"
     doc = s.document()
@@ -87,9 +114,10 @@ def refine_cut(cut: CutSpec, stock: Box, where: str = "job") -> RefinedCut:
     check_distinct_neighbours(lines.plucker, closed, f"{label} {s.label}")
     n = len(lines)
     sch = get_scheme(s.scheme)
+    half = 0.5 * wire_length
     if s.steps is not None:
         check_size(sch, n, s.steps, closed, f"{label} steps", MAX_PATH_RULINGS, None)
-        F, flip = _frames(lines, closed, cut, s.steps)
+        F, flip = _frames(lines, closed, cut, s.steps, stock, half)
         return RefinedCut(F, s.steps, closed, flip, n)
     gap = np.inf
     for steps in range(MAX_STEPS + 1):
@@ -99,7 +127,7 @@ def refine_cut(cut: CutSpec, stock: Box, where: str = "job") -> RefinedCut:
                 f"{MAX_PATH_RULINGS:,} rulings (the limit of a cut); {steps - 1} steps give a "
                 f"largest gap of {gap:.3g} m: ask for a larger spacing"
             )
-        F, flip = _frames(lines, closed, cut, steps)
+        F, flip = _frames(lines, closed, cut, steps, stock, half)
         gap = _gaps(F, stock)
         if gap <= s.spacing:
             return RefinedCut(F, steps, closed, flip, n)
@@ -114,8 +142,32 @@ def refine_cut(cut: CutSpec, stock: Box, where: str = "job") -> RefinedCut:
 
 def refine_for_job(job: Job) -> tuple[FloatArray, int]:
     """Refined frames (M, 4, 4) of the job's first cut and the number of steps used."""
-    rc = refine_cut(job.cut, job.stock, str(job.source or "job"))
+    rc = refine_cut(job.cut, job.stock, str(job.source or "job"), job.tool.wire_length)
     return rc.frames, rc.steps
+
+
+def _x_jumps(F: FloatArray, angle: float = np.radians(30.0)) -> bool:
+    """Whether the frames' x axes turn by more than ``angle`` [rad] between neighbours
+    (the common normals of a polygon reverse at its corners); smooth DH frames are kept
+    as the roll's reference, the others are world referenced
+    (:func:`.toolpath.world_referenced`)."""
+    x = F[:, :3, 0]
+    return bool(((x[1:] * x[:-1]).sum(axis=1) < np.cos(angle)).any())
+
+
+def _untwisted(a: FloatArray, b: FloatArray) -> FloatArray:
+    """Frame ``a`` (4, 4) turned about its z axis so that its x axis is ``b``'s projected
+    (the least rotation from ``a`` to ``b``): the rulings' motion without the turn of
+    the frames about them, which a screw extrapolation would swing out to metres where
+    the frames' x axes jump (the corner of a polygon, the end of a foam cutter's file)."""
+    x = b[:3, 0] - (b[:3, 0] @ a[:3, 2]) * a[:3, 2]
+    size = np.linalg.norm(x)
+    if size < 1e-6:  # b's x along a's z: leave a as it is
+        return a
+    out = a.copy()
+    out[:3, 0] = x / size
+    out[:3, 1] = np.cross(a[:3, 2], out[:3, 0])
+    return out
 
 
 def _extend(F: FloatArray, grown: Box, limit: int = 400) -> tuple[FloatArray, int, int]:
@@ -124,6 +176,7 @@ def _extend(F: FloatArray, grown: Box, limit: int = 400) -> tuple[FloatArray, in
     parts = [F]
     for side in (0, 1):
         a, b = (F[1], F[0]) if side == 0 else (F[-2], F[-1])
+        a = _untwisted(a, b)
         new = []
         k = 1
         last = b
@@ -158,7 +211,7 @@ def cut_paths(
     cut = job.cut if cut is None else cut
     if model is None:
         model = job.robot_model()
-    rc = refine_cut(cut, job.stock, str(job.source or "job"))
+    rc = refine_cut(cut, job.stock, str(job.source or "job"), job.tool.wire_length)
     kerf = kerf_offsets(rc.frames, job.stock, cut.kerf, cut.keep, rc.closed)
     wire = _translated(rc.frames, kerf.offset)
     if job.robot.home is not None:
@@ -174,6 +227,8 @@ def cut_paths(
     first, last = np.flatnonzero(near)[[0, -1]]
     keep = slice(max(first - 1, 0), last + 2)
     F, before, after = _extend(wire[keep], grown)
+    if _x_jumps(F):  # a corner turned the frames about the rulings: roll = bow attitude
+        F = world_referenced(F)
     off = kerf.offset[keep]
     off = np.concatenate([np.repeat(off[:1], before, 0), off, np.repeat(off[-1:], after, 0)])
     S = _translated(F, -off)  # the target rulings (the lead-in/out ones lie outside the stock)

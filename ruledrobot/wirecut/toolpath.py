@@ -32,12 +32,14 @@ from ..robot.tool import BowTool
 from .spec import ToolSpec
 
 __all__ = [
+    "anchored_frames",
     "chords",
     "flange_poses",
     "slide_bounds",
     "speed_factor",
     "wire_frame",
     "wire_poses",
+    "world_referenced",
 ]
 
 
@@ -53,6 +55,55 @@ def chords(frames: ArrayLike, stock: Box) -> tuple[FloatArray, FloatArray, np.nd
     z coordinate of its frame (m); NaN where the ruling misses the stock."""
     F = np.asarray(frames, dtype=np.float64)
     return stock.clip_lines(F[:, :3, 3], F[:, :3, 2])
+
+
+def anchored_frames(frames: ArrayLike, point: ArrayLike) -> FloatArray:
+    """Frames (M, 4, 4) moved along their own z axis so that each origin is the point
+    of its ruling nearest ``point`` (3,) (m, robot base frame); orientation unchanged.
+
+    The DH frames of nearly parallel rulings sit where consecutive rulings' common
+    normals meet them, which can be metres away along the rulings and jump from one
+    ruling to the next; a slide (the wire's position along its ruling, measured
+    from the origin) means the same thing on every ruling only once the origins are
+    anchored.  Foot of the perpendicular: ``o + ((point - o) . z) z``.
+    """
+    F = np.array(frames, dtype=np.float64)
+    o, z = F[:, :3, 3], F[:, :3, 2]
+    t = ((np.asarray(point, dtype=np.float64) - o) * z).sum(axis=1)
+    F[:, :3, 3] = o + t[:, None] * z
+    return F
+
+
+#: Smallest |x| of the projected world axis for which :func:`world_referenced`
+#: turns the frames (a ruling within ~6 deg of that axis leaves them as they are).
+WORLD_REFERENCE_MIN = 0.1
+
+
+def world_referenced(F: FloatArray) -> FloatArray:
+    """The frames (M, 4, 4) turned about their z axes so that x points, as nearly as it
+    can, along one world axis — the one the rulings are most nearly normal to.
+
+    A roll relative to these frames is the bow's attitude in the world.  Relative to
+    the DH frames it is not: their x axes (common normals) turn once with a closed
+    loop, and jump at the corners and cusps of a path (a foam cutter's entry move, an
+    airfoil's trailing edge, where the common normal reverses), so a constant bow
+    attitude would need a jump in roll.  ``x = (v - (z.v) z) / |..|``; where a ruling
+    comes within about 6 degrees of the axis (``|v - (z.v) z| <
+    WORLD_REFERENCE_MIN``) the frames are returned unchanged.
+    """
+    z = F[:, :3, 2]
+    axis = int(np.argmin(np.abs(z).mean(axis=0)))
+    v = np.zeros(3)
+    v[axis] = 1.0
+    x = v - (z @ v)[:, None] * z
+    size = np.linalg.norm(x, axis=1)
+    if size.min() < WORLD_REFERENCE_MIN:
+        return F.copy()
+    x /= size[:, None]
+    out = F.copy()
+    out[:, :3, 0] = x
+    out[:, :3, 1] = np.cross(z, x)
+    return out
 
 
 def slide_bounds(
