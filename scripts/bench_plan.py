@@ -143,6 +143,45 @@ def bench_place() -> None:
     print("each candidate: every sampled ruling x roll x wire direction x 8 IK branches through "
           "the batched IK and the kinematic margins; the planner's clearance rules on the "
           "columns (direction, roll, branch) that can still be the best (branch and bound)")
+    _place_on_workers()
+
+
+def _place_on_workers() -> None:
+    """The symmetric-bow case scored in this process and on a local Dask cluster of 2
+    workers (``ruledrobot place --workers 2``; issue 16), scores compared."""
+    try:
+        from ruledrobot.batch.engine import Engine
+        from ruledrobot.batch.place import DistributedEvaluator
+    except ImportError:
+        print("dask not installed: the cluster comparison is skipped (the batch extra)")
+        return
+    from ruledrobot.wirecut.place import job_passes
+    from ruledrobot.wirecut.place_eval import Evaluator
+    from ruledrobot.wirecut.placement import Region, transforms
+
+    with tempfile.TemporaryDirectory() as tmp:
+        p = Path(tmp) / "job.toml"
+        p.write_text(DEMO_JOB.replace("steps = 4", "steps = 8"))
+        job = load_job(p)
+        ev = Evaluator(job, job_passes(job))
+        region = Region((0.2, 1.1), (-0.5, 0.5), (-np.pi / 2, np.pi / 2))
+        T = transforms(job, region.grid((9, 9, 9)), "stock")
+        t0 = time.perf_counter()
+        here = ev(T)
+        t_here = time.perf_counter() - t0
+        t0 = time.perf_counter()
+        with Engine(2) as eng:
+            t_start = time.perf_counter() - t0
+            d = DistributedEvaluator(ev, eng)
+            t1 = time.perf_counter()
+            there = d(T)
+            t_there = time.perf_counter() - t1
+    same = all(np.array_equal(getattr(here, f), getattr(there, f))
+               for f in ("margin", "score", "pass_margin", "column", "exact"))  # fmt: skip
+    print(f"\n{len(T)} candidates, symmetric bow: in this process {t_here:.1f} s "
+          f"({60 * len(T) / t_here:.0f} per minute); on 2 local Dask workers {t_there:.1f} s "
+          f"({60 * len(T) / t_there:.0f} per minute, speed-up {t_here / t_there:.2f} x; "
+          f"cluster start {t_start:.1f} s more); the same scores: {same}")
 
 
 if __name__ == "__main__":

@@ -7,6 +7,7 @@ when the work outgrows one machine (``docs/batch.md``).
 * :mod:`.task` — the worker's task: plan one job from its bytes, return its files;
 * :mod:`.engine` — Dask: the local cluster or a scheduler, one job per worker thread;
 * :mod:`.run` — :func:`run_batch`, the whole batch.
+* :mod:`.place` — the placement search's candidates scored on the same workers.
 
 Planning itself is :func:`ruledrobot.wirecut.planner.plan`; this package only
 distributes it.  Dask (the ``batch`` extra) is imported when a batch starts.

@@ -82,14 +82,22 @@ def place(
     tries: int = typer.Option(3, min=1, help="Candidates verified by the planner at most."),
     verify: bool = typer.Option(True, "--verify/--no-verify",
                                 help="Plan the best with MuJoCo verification."),
+    workers: int | None = typer.Option(None, "--workers", min=1, help="Score the candidates "
+                                       "on a local Dask cluster of this many processes (the "
+                                       "batch extra; default: in this process)."),
+    scheduler: str | None = typer.Option(None, "--scheduler", help="Score the candidates on "
+                                         "the workers of this Dask scheduler "
+                                         "(tcp://HOST:8786; docs/batch.md)."),
 ) -> None:
     """Search where to put the block (or the robot) so that the arm reaches every ruling of
     every cut with the largest worst margin; verify the best with the planner and MuJoCo;
     when no single placement serves a job of several cuts, split it into setups and say
     what to do between them.  Writes job.toml (the placement filled in), plan/, margin.png,
     place.json (and setupN/, setups.txt).  Exits 1 when nothing found passes."""
+    import contextlib
     import math
 
+    from ..batch.engine import EngineUnavailable  # Dask itself is imported when used
     from ..wirecut.job import load_job
     from ..wirecut.place_run import run_place
     from ..wirecut.placement import Region, parse_range, parse_turns
@@ -115,12 +123,22 @@ def place(
         region = Region(parse_range(x, "--x") if x is not None else default.x,
                         parse_range(y, "--y") if y is not None else default.y,
                         parse_range(yaw, "--yaw", math.pi / 180.0), move)  # fmt: skip
-        with console.status("placing") as status:
+        with contextlib.ExitStack() as stack:
+            scorer = None
+            if workers is not None or scheduler is not None:
+                from ..batch.engine import Engine
+                from ..batch.place import DistributedEvaluator
+
+                eng = stack.enter_context(Engine(workers, scheduler))
+                scorer = lambda ev: DistributedEvaluator(ev, eng)  # noqa: E731
+            status = stack.enter_context(console.status("placing"))
             res = run_place(spec, region, out, grid=_grid(grid), refine=refine,
                             turns=parse_turns(turns), tries=tries, rulings=rulings, rolls=rolls,
                             verify=verify, progress=lambda msg: status.update(msg),
-                            program=program)  # fmt: skip
+                            program=program, scorer=scorer)  # fmt: skip
     except ValueError as exc:
+        raise fail(str(exc)) from None
+    except EngineUnavailable as exc:  # no Dask, or no scheduler there
         raise fail(str(exc)) from None
     _print_place(res)
     if not res.ok:

@@ -78,6 +78,12 @@ class Scores:
     column: np.ndarray
     exact: np.ndarray
 
+    @classmethod
+    def concat(cls, parts: list[Scores]) -> Scores:
+        """The scores of consecutive batches of candidates, in order."""
+        return cls(*(np.concatenate([getattr(p, f.name) for p in parts])
+                     for f in dataclasses.fields(cls)))  # fmt: skip
+
 
 class Evaluator:
     """Scores placements of ``job`` (see the module doc).
@@ -137,9 +143,7 @@ class Evaluator:
         """Scores of candidate placements T (C, 4, 4) (rigid motions of the base frame)."""
         T = np.asarray(T, dtype=np.float64).reshape(-1, 4, 4)
         per = max(1, CHUNK_POSES // max(s.P0[..., 0, 0].size for s in self.samples))
-        parts = [self._chunk(T[i:i + per]) for i in range(0, len(T), per)]
-        return Scores(*(np.concatenate([getattr(p, f.name) for p in parts])
-                        for f in dataclasses.fields(Scores)))  # fmt: skip
+        return Scores.concat([self._chunk(T[i:i + per]) for i in range(0, len(T), per)])
 
     def _chunk(self, T: FloatArray) -> Scores:
         C, n = len(T), len(self.samples)

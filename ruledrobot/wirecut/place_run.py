@@ -86,18 +86,24 @@ def run_place(
     verify: bool = True,
     progress: Callable[[str], None] | None = None,
     program: Callable[[object, Path], Path] | None = None,
+    scorer: Callable[[Evaluator], Evaluator] | None = None,
 ) -> PlaceOutcome:
     """Search ``region`` for the block of ``job`` (:func:`~.place.search`), verify the
     best with the planner and MuJoCo, and, when no single placement serves, split the
     cuts into setups over the allowed ``turns`` (:mod:`.setups`); write the files
     (module doc) into ``out``.  ``program(trajectory, folder)`` writes the robot program
-    of every plan that passes into its folder (``cut.script`` from the command line)."""
+    of every plan that passes into its folder (``cut.script`` from the command line).
+    ``scorer(evaluator)`` returns what scores the candidates: the evaluator itself by
+    default, one that scores them on Dask workers from the command line
+    (:class:`ruledrobot.batch.place.DistributedEvaluator`)."""
     say = progress or (lambda msg: None)
     out = Path(out)
     model = job.robot_model()
     with StagedFolder(out) as stage:
         passes = job_passes(job, model, say)
         ev = Evaluator(job, passes, model, rulings=rulings, rolls=rolls, rules=Rules())
+        if scorer is not None:
+            ev = scorer(ev)
         res = search(job, region, ev, grid, refine, progress=say)
         lines = [f"scored {len(res.margins)} placements in {res.seconds:.1f} s "
                  f"({res.rate:.0f} per minute; each checks {res.rulings} rulings x "
@@ -162,6 +168,7 @@ def run_place(
             sweep = (yaws, ev(transforms(job, xyz, region.move, b.turn)).margin)
         plot_place(stage.path / "margin.png", res,
                    [s.candidate for s in setups.setups] if setups else None, sweep)  # fmt: skip
+        lines += list(getattr(ev, "notes", ()))  # a scorer's notes (chunks scored here)
         doc = _document(job, res, verified, setups, checks, steps, ev, lines, ok)
         atomic_write_text(stage.path / "place.json", json.dumps(doc, indent=1) + "\n")
         target = stage.commit({"kind": "place", "ok": ok})
@@ -196,7 +203,9 @@ def _document(job: Job, res: PlaceResult, verified: Verified | None, setups: Set
         "search": {"evaluated": len(res.margins), "seconds": res.seconds,
                    "per_minute": res.rate, "rulings_per_candidate": res.rulings,
                    "rolls": res.rolls, "wire_directions": res.directions,
-                   "ik_branches": 8, "exact": bool(all(c.exact for c in res.ranked))},
+                   "ik_branches": 8, "exact": bool(all(c.exact for c in res.ranked)),
+                   "engine": ev.engine_info() if hasattr(ev, "engine_info")
+                   else {"kind": "in-process"}},
         "as_placed": res.current.as_dict(names),
         "ranked": [c.as_dict(names) for c in res.ranked],
         "verified": None if verified is None else {
