@@ -302,10 +302,10 @@ class Session:
         # the last of the minima (equal to a micro-radian): through a hold longer than
         # the window (the wire heating) the plan repeats one sample, up to rounding of
         # the resampling, and the match must reach its end
-        j = int(np.flatnonzero(d <= d.min() + 1e-6)[-1])
+        dev = float(d.min())  # the distance to the plan: its nearest sample
+        j = int(np.flatnonzero(d <= dev + 1e-6)[-1])
         self.k_match = lo + j
         self.k_high = max(self.k_high, self.k_match)
-        dev = float(d[j])
         self.max_dev = max(self.max_dev, dev)
         if dev > self.deviation_limit:
             raise Stop(
