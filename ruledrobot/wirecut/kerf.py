@@ -34,6 +34,8 @@ __all__ = ["KerfOffsets", "kept_surface_error", "kerf_offsets", "ruling_normals"
 
 #: points per chord at which the normals are sampled
 SAMPLES = 9
+#: a ``keep`` point nearer the surface than this [m] does not say which side is the part
+KEEP_CLEARANCE = 1e-4
 
 
 @dataclass(frozen=True)
@@ -99,9 +101,12 @@ def waste_sign(
         P = np.asarray(keep, dtype=np.float64)
         flat, nflat = pts[hit].reshape(-1, 3), n[hit].reshape(-1, 3)
         k = int(np.argmin(np.linalg.norm(flat - P, axis=1)))
-        side = float((P - flat[k]) @ nflat[k])
-        if abs(side) < 1e-9:
-            raise ValueError("keep: the point lies on the surface; give a point inside the part")
+        side = float((P - flat[k]) @ nflat[k]) / max(float(np.linalg.norm(nflat[k])), 1e-300)
+        if abs(side) < KEEP_CLEARANCE:
+            raise ValueError(
+                f"keep: the point lies on the surface ({abs(side) * 1e3:.3g} mm from it, "
+                f"less than {KEEP_CLEARANCE * 1e3:g} mm): which side is the part is "
+                "ambiguous; give a point well inside the part")
         part_along_normal = side > 0.0
     return -1.0 if part_along_normal else 1.0
 

@@ -212,7 +212,11 @@ def cut_paths(
     if model is None:
         model = job.robot_model()
     rc = refine_cut(cut, job.stock, str(job.source or "job"), job.tool.wire_length)
-    kerf = kerf_offsets(rc.frames, job.stock, cut.kerf, cut.keep, rc.closed)
+    try:
+        kerf = kerf_offsets(rc.frames, job.stock, cut.kerf, cut.keep, rc.closed)
+    except ValueError as exc:  # name the job file and the cut's section
+        where = "[cut]" if cut.name == "cut" else f"[cut '{cut.name}']"
+        raise ValueError(f"{job.source or 'job'}: {where} {exc}") from None
     wire = _translated(rc.frames, kerf.offset)
     if job.robot.home is not None:
         search.setdefault("q_start", job.robot.home)

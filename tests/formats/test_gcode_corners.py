@@ -1,5 +1,7 @@
-"""A foam cutter's program with sharp corners (entry, trailing edge, exit) planned as a UR
-job: the refined path keeps the file's straight moves, the wire stops at the corners."""
+"""A foam cutter's program with sharp corners planned as a UR job (a NACA 0015 cut from
+the front: in to the leading edge, along the upper surface, round the trailing edge,
+back along the lower one, out): the refined path keeps the file's straight moves, the
+wire stops at the corners, the kerf goes to the waste side."""
 
 from __future__ import annotations
 
@@ -81,14 +83,29 @@ def test_the_refined_path_keeps_the_files_straight_moves_and_corners(tmp_path):
 
 
 def test_a_profile_with_sharp_corners_plans_and_the_wire_stops_at_them(tmp_path):
+    """Kerf compensated, the part inside the profile."""
+    job = _job(tmp_path)
+    job.write_text(PROFILE_JOB.replace("kerf = 0.0008", "kerf = 0.0008\nkeep = [0.5, 0.0, 0.44]"))
     out = tmp_path / "out"
-    res = runner.invoke(app, ["plan", str(_job(tmp_path)), "--out", str(out)])
+    res = runner.invoke(app, ["plan", str(job), "--out", str(out)])
     assert res.exit_code == 0, res.output
     report = json.loads((out / "report.json").read_text())
     assert report["verdict"]["ok"] is True
-    # entry onto the chord line, the trailing edge twice, back towards the work zero
+    # onto the leading edge, round the trailing edge, off the leading edge; moved half a
+    # kerf outwards, the trailing edge's turn of 170 degrees becomes two of about 90
     assert report["cuts"][0]["corner_stops"] == 4
+    assert report["cuts"][0]["kerf_compensated"] is True
     assert report["max_wire_deviation_mm"] < 0.1
     assert 7.6 <= report["min_feed_speed_mm_s"] and report["max_feed_speed_mm_s"] <= 8.4
     info = {c["name"]: c for c in report["verdict"]["checks"]}["corner_stops"]
     assert info["gating"] is False and info["value"] == 4
+
+
+def test_a_keep_point_on_the_surface_is_refused_naming_the_field(tmp_path):
+    """(0, 40) mm of the file is on the lead-in move: which side is the part?"""
+    job = _job(tmp_path)
+    job.write_text(PROFILE_JOB.replace("kerf = 0.0008", "kerf = 0.0008\nkeep = [0.4, 0.0, 0.44]"))
+    res = runner.invoke(app, ["plan", str(job), "--out", str(tmp_path / "out")])
+    assert res.exit_code == 2
+    assert "job.toml: [cut] keep: the point lies on the surface" in " ".join(res.output.split())
+    assert not (tmp_path / "out").exists()
