@@ -14,8 +14,8 @@ metres, radians, seconds)::
     u = [-0.12, 0.12]          # its parameter range
     rulings = 9                # input rulings sampled over u
     pose = [0.5, 0.0, 0.3, 0.0, 0.0, 0.0]   # surface frame in the base frame (UR pose vector)
-    algorithm = "dh"           # projection | combined | dh
-    scheme = "four_point"
+    algorithm = "dh"           # projection | combined | dh (G-code: projection by default)
+    scheme = "four_point"      # linear | chaikin | bspline3 | four_point | six_point | ...
     steps = 4                  # or: spacing = 0.002 (m, largest gap between refined rulings)
     # closed = true            # a closed sequence of rulings (a column, a band)
 
