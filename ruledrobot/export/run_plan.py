@@ -100,6 +100,17 @@ def entry_sample(traj: Trajectory, a: int) -> int:
     return max(a - 1, 0)
 
 
+def _nearest_stretch(idx: np.ndarray, dist: np.ndarray, requested: int) -> int:
+    """Of the sorted sample indices ``idx``, cut into runs of consecutive samples, the run
+    nearest ``requested`` (in samples); in it, the sample of least ``dist``."""
+    breaks = np.flatnonzero(np.diff(idx) > 1) + 1
+    runs = np.split(idx, breaks)
+    gap = [0 if r[0] <= requested <= r[-1] else min(abs(r[0] - requested),
+                                                    abs(r[-1] - requested)) for r in runs]
+    run = runs[int(np.argmin(gap))]
+    return int(run[np.argmin(dist[run])])
+
+
 def plan_entry(
     traj: Trajectory,
     q_actual: np.ndarray,
@@ -120,6 +131,13 @@ def plan_entry(
     hi = int(np.searchsorted(t, t[requested] + window, side="right"))
     hi = min(hi, n - 1)  # the last sample cannot start a run
     near = lo + int(np.argmin(dist[lo:hi])) if hi > lo else requested
+    close = lo + np.flatnonzero(dist[lo:hi] <= tolerance)
+    if close.size:  # the nearest sample of the stretch of samples the arm is at that lies
+        # nearest the requested one: a path that comes back through its own poses (there
+        # and back, a pass turning round in its kerf) has a later stretch as near, and
+        # continuing there would skip everything in between (found: a stop at 207 of a
+        # there-and-back resumed at 393)
+        near = int(_nearest_stretch(close, dist, requested))
 
     def move_to(k: int) -> tuple[float, int, float]:
         d = np.abs(q[k] - qa)
@@ -147,7 +165,7 @@ def plan_entry(
     if inside.any():
         at = np.flatnonzero(inside & (dist <= tolerance))
         if at.size:
-            m = int(at[np.argmin(dist[at])])
+            m = int(_nearest_stretch(at, dist, requested))  # as above
             detail = (
                 f"the arm is at the planned pose of sample {m}, where the wire is inside "
                 f"the stock, not near sample {requested}: a move from there would drag the "

@@ -55,6 +55,25 @@ def test_continue_when_the_arm_is_at_a_sample_near_the_requested_one() -> None:
     assert e.kind == "continue" and e.sample == 0 and e.distance == 0.0
 
 
+def test_a_path_that_comes_back_through_its_poses_continues_where_the_arm_stopped() -> None:
+    """There and back (q0 + A sin^2(pi t / T)): sample 207's pose is sample 393's too.
+    The arm came to rest a little past 207: continue there, never on the way back (that
+    would skip 186 samples: a stretch of kerf never cut)."""
+    t = np.arange(601) * 0.002
+    q = np.asarray(DEFAULT_Q) + np.array([0.09, -0.07, 0.09, 0.07, 0.09, -0.09]) * (
+        np.sin(np.pi * t / t[-1])[:, None] ** 2)  # fmt: skip
+    for rest in (207, 209, 212):
+        back = 600 - rest  # the same pose on the way back
+        np.testing.assert_allclose(q[back], q[rest], atol=1e-12)
+        # the arm 0.1 mrad off sample `rest`, and the way back passing exactly there
+        arm = q[rest] + 1e-4
+        qq = q.copy()
+        qq[back] = arm
+        traj = Trajectory.from_joints(t, qq, load("ur5e"), source="there and back")
+        e = plan_entry(traj, arm, 207)
+        assert e.kind == "continue" and e.sample == rest, (rest, e.sample)
+
+
 def test_replay_from_the_lead_in_when_the_arm_is_elsewhere_and_the_sample_in_the_stock() -> None:
     traj = cut_trajectory()
     elsewhere = traj.q[0] - 0.2

@@ -195,7 +195,8 @@ def test_dropped_connection_during_run(emulator: Emulator) -> None:
 
     res, traj, fired = _run_with_fault(emulator, inject)
     elapsed = time.monotonic() - t_fault[0]
-    assert res.status in ("connection_lost", "client_died"), res
+    # ur_rtde may also hang on the dropped socket: the runner kills it after 1 s
+    assert res.status in ("connection_lost", "client_died", "client_hung"), res
     assert elapsed < 4.5  # the runner's bound for any stop (docs/rtde.md)
     # the client cannot stop the arm: the RTDE watchdog (2 Hz) stops the program,
     # after the servo target of the last sample sent: the stop sample is the last
