@@ -89,7 +89,6 @@ class DistributedEvaluator:
                 self.notes.append(f"{len(chunk)} candidates (chunk {i + 1} of {k}) scored "
                                   f"in this process: the worker failed ({type(exc).__name__})")
                 parts.append(self._ev(chunk))
-        dealt = Scores.concat(parts)
         back = np.empty_like(order)
         back[order] = np.arange(len(order))
-        return Scores(*(getattr(dealt, f)[back] for f in Scores.__dataclass_fields__))
+        return Scores.concat(parts).take(back)

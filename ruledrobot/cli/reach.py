@@ -95,6 +95,7 @@ def place(
     what to do between them.  Writes job.toml (the placement filled in), plan/, margin.png,
     place.json (and setupN/, setups.txt).  Exits 1 when nothing found passes."""
     import contextlib
+    import functools
     import math
 
     from ..batch.engine import EngineUnavailable  # Dask itself is imported when used
@@ -130,7 +131,7 @@ def place(
                 from ..batch.place import DistributedEvaluator
 
                 eng = stack.enter_context(Engine(workers, scheduler))
-                scorer = lambda ev: DistributedEvaluator(ev, eng)  # noqa: E731
+                scorer = functools.partial(DistributedEvaluator, engine=eng)
             status = stack.enter_context(console.status("placing"))
             res = run_place(spec, region, out, grid=_grid(grid), refine=refine,
                             turns=parse_turns(turns), tries=tries, rulings=rulings, rolls=rolls,

@@ -31,15 +31,22 @@ from .toolpath import chords, flange_poses, wire_poses
 __all__ = ["densified", "pass_deviation", "pass_feed_error", "uneven_intervals"]
 
 
+def _samples_in_intervals(
+    cp: CutPath, timed: TimedPath
+) -> tuple[np.ndarray, FloatArray, np.ndarray, FloatArray]:
+    """For every sample the interval between rulings it lies in and its fraction there,
+    whether the wire crosses the stock at both ends, and zeros (M - 1,) per interval."""
+    i0, frac = cp.locate(timed.s_of_t)
+    inside = cp.motion.hit[i0] & cp.motion.hit[i0 + 1]
+    return i0, frac, inside, np.zeros(len(cp.frames) - 1)
+
+
 def pass_deviation(cp: CutPath, timed: TimedPath, model, ends: FloatArray) -> FloatArray:
     """Per interval between rulings (M - 1,) the largest distance [m] of the timed
     wire's chord ends from the target rulings (the screw geodesic between the frames at
     the same path parameter), inside the stock; ``ends`` (M, 2, 3) the chord ends in the
     flange frame at the rulings."""
-    n = len(cp.frames)
-    i0, frac = cp.locate(timed.s_of_t)
-    inside = cp.motion.hit[i0] & cp.motion.hit[i0 + 1]
-    out = np.zeros(n - 1)
+    i0, frac, inside, out = _samples_in_intervals(cp, timed)
     if not inside.any():
         return out
     k = np.flatnonzero(inside)
@@ -64,10 +71,7 @@ def pass_feed_error(
     the joint path bends within an interval, the real feed strays from it."""
     from .measure import feed_speeds
 
-    n = len(cp.frames)
-    i0, frac = cp.locate(timed.s_of_t)
-    inside = cp.motion.hit[i0] & cp.motion.hit[i0 + 1]
-    out = np.zeros(n - 1)
+    i0, frac, inside, out = _samples_in_intervals(cp, timed)
     if not inside.any():
         return out
     e = np.nan_to_num(ends)

@@ -170,9 +170,10 @@ def _wire_arclength(cp: CutPath) -> FloatArray:
 
 def _pass_timing(
     job: Job, model, cp: CutPath, vel, acc, dt
-) -> tuple[CutPath, TimedPath, FloatArray]:
+) -> tuple[CutPath, TimedPath, FloatArray, np.ndarray]:
     """The pass timed at its feed, with rulings added where the timed wire leaves the
-    surface between them (:mod:`.densify`); returns the (denser) pass too."""
+    surface between them (:mod:`.densify`); returns the (denser) pass too, its chord
+    ends and the samples where the wire stops at a corner (:mod:`.corners`)."""
     cut = next(c for c in job.cuts if c.name == cp.name)
     cp = dataclasses.replace(cp, param=_wire_arclength(cp))
     for attempt in range(DENSIFY_ROUNDS + 1):
@@ -192,7 +193,7 @@ def _pass_timing(
         if not bad.size:
             break
         cp = densified(cp, bad, model, job.tool, job.stock)
-    return cp, timed, ends
+    return cp, timed, ends, corner_stop_mask(timed, s[corners])
 
 
 def assemble_motion(job: Job, model, passes: list[CutPath]) -> Motion:
@@ -208,12 +209,12 @@ def assemble_motion(job: Job, model, passes: list[CutPath]) -> Motion:
     notes: list[str] = []
     timed_passes = []
     for k, cp in enumerate(passes):
-        passes[k], timed, ends = _pass_timing(job, model, cp, vel, acc, dt)
-        timed_passes.append((timed, ends))
+        passes[k], *timing = _pass_timing(job, model, cp, vel, acc, dt)
+        timed_passes.append(tuple(timing))
     here: FloatArray | None = None
     if job.robot.home is not None:
         here = np.asarray(job.robot.home, dtype=np.float64)
-    for k, (cp, (timed, _)) in enumerate(zip(passes, timed_passes, strict=True)):
+    for k, (cp, (timed, *_)) in enumerate(zip(passes, timed_passes, strict=True)):
         cut = next(c for c in job.cuts if c.name == cp.name)
         slow = cut.approach_speed
         m = cp.motion
@@ -264,7 +265,7 @@ def _label(job, whole: TimedPath, b: _Builder, passes, timed_passes, notes) -> M
             if label == "preheat":
                 pass_of[rows] = k
             continue
-        cp, (timed_k, cp_ends) = passes[k], timed_passes[k]
+        cp, (timed_k, cp_ends, stop_k) = passes[k], timed_passes[k]
         idx = np.flatnonzero(rows)
         # the pass's own parameter: its s_of_t starts at cp.s[0] (the part drops no first
         # sample when it is the first part; otherwise the dropped one is its start)
@@ -288,10 +289,7 @@ def _label(job, whole: TimedPath, b: _Builder, passes, timed_passes, notes) -> M
             lab[s_k < cp.s[a]] = "lead_in"
             lab[s_k > cp.s[len(cp.s) - 1 - z]] = "lead_out"
         labels[idx] = lab
-        s_corner = cp.s[corner_nodes(cp.frames, 0.5 * job.tool.wire_length)]
-        if s_corner.size:  # the pass's own samples: its first may be dropped in the whole
-            own = corner_stop_mask(timed_k, s_corner)
-            stop[idx] = own[timed_k.t.size - idx.size :]
+        stop[idx] = stop_k[timed_k.t.size - idx.size :]  # its first may be dropped
     surface = in_stock & (labels == "cut")
     heat = np.zeros(M, dtype=bool)
     if job.tool.heat is not None:

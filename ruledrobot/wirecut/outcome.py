@@ -40,7 +40,7 @@ def _cut_sections(plan: Plan, ver: Verification | None) -> tuple[list[dict], lis
         rows = np.isin(mo.pass_of, ks) & mo.surface
         interior = rows & ~mo.timed.feed_limited
         slits = np.isin(mo.pass_of, ks) & mo.in_stock & ~mo.surface
-        stops = rows & mo.corner_stop if mo.corner_stop is not None else rows & False
+        stops = rows & (False if mo.corner_stop is None else mo.corner_stop)
         feed = me.feed[rows]
         held = me.feed[rows & ~stops]  # the lowest feed: not where the wire stops at a corner
         n_stops = int(np.count_nonzero(stops & ~np.r_[False, stops[:-1]]))

@@ -29,7 +29,7 @@ from ..geometry.checks import FloatArray
 from ..geometry.ruled import RuledSurface
 from ..subdivision import check_size, get_scheme, refined_count
 from .closed import loop_paths
-from .corners import polygon_corners
+from .corners import CORNER_ANGLE, polygon_corners
 from .cutpath import CutPath, RefinedCut
 from .kerf import kerf_offsets
 from .redundancy import solve_redundancy
@@ -146,7 +146,7 @@ def refine_for_job(job: Job) -> tuple[FloatArray, int]:
     return rc.frames, rc.steps
 
 
-def _x_jumps(F: FloatArray, angle: float = np.radians(30.0)) -> bool:
+def _x_jumps(F: FloatArray, angle: float = CORNER_ANGLE) -> bool:
     """Whether the frames' x axes turn by more than ``angle`` [rad] between neighbours
     (the common normals of a polygon reverse at its corners); smooth DH frames are kept
     as the roll's reference, the others are world referenced

@@ -78,6 +78,10 @@ class Scores:
     column: np.ndarray
     exact: np.ndarray
 
+    def take(self, idx: np.ndarray) -> Scores:
+        """The scores of candidates ``idx`` (K,), in that order."""
+        return Scores(*(getattr(self, f.name)[idx] for f in dataclasses.fields(self)))
+
     @classmethod
     def concat(cls, parts: list[Scores]) -> Scores:
         """The scores of consecutive batches of candidates, in order."""
@@ -126,6 +130,13 @@ class Evaluator:
         out = copy.copy(self)
         out.samples = [s for s in self.samples if s.cut in cuts]
         return out
+
+    #: what went wrong while scoring (a distributed scorer's chunks scored here instead)
+    notes: tuple[str, ...] | list[str] = ()
+
+    def engine_info(self) -> dict[str, object]:
+        """Where the candidates are scored (``place.json``): in this process."""
+        return {"kind": "in-process"}
 
     @property
     def rulings_checked(self) -> int:

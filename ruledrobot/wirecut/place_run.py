@@ -168,7 +168,7 @@ def run_place(
             sweep = (yaws, ev(transforms(job, xyz, region.move, b.turn)).margin)
         plot_place(stage.path / "margin.png", res,
                    [s.candidate for s in setups.setups] if setups else None, sweep)  # fmt: skip
-        lines += list(getattr(ev, "notes", ()))  # a scorer's notes (chunks scored here)
+        lines += list(ev.notes)  # a scorer's notes (chunks scored here)
         doc = _document(job, res, verified, setups, checks, steps, ev, lines, ok)
         atomic_write_text(stage.path / "place.json", json.dumps(doc, indent=1) + "\n")
         target = stage.commit({"kind": "place", "ok": ok})
@@ -204,8 +204,7 @@ def _document(job: Job, res: PlaceResult, verified: Verified | None, setups: Set
                    "per_minute": res.rate, "rulings_per_candidate": res.rulings,
                    "rolls": res.rolls, "wire_directions": res.directions,
                    "ik_branches": 8, "exact": bool(all(c.exact for c in res.ranked)),
-                   "engine": ev.engine_info() if hasattr(ev, "engine_info")
-                   else {"kind": "in-process"}},
+                   "engine": ev.engine_info()},
         "as_placed": res.current.as_dict(names),
         "ranked": [c.as_dict(names) for c in res.ranked],
         "verified": None if verified is None else {
