@@ -19,6 +19,10 @@ line, then one row per controller period, and nothing else (``csv.reader`` and
      "max_acceleration_rad_s2": [2.5, 2.5, 2.5, 2.5, 2.5, 2.5],   # or null: the default
      "heat": {"output": "standard:0", "value": 1.0, "preheat_s": 2.0,
               "windows": [[1100, 9900]]},                # or null
+     "cut": {"stock": {"centre": [...], "size": [...], "rotvec": [...]},   # or null
+             "wire_length_m": 0.4,
+             "feeds": [{"name": "cut", "start": 1858, "stop": 13406, "speed_m_s": 0.01,
+                        "tolerance": 0.05, "held": [[2200, 12500]]}]},
      "job": {"path": "job.toml", "sha256": "..."}, "source": "ruledrobot plan",
      "csv": "trajectory.csv", "csv_sha256": "...", "samples": 12925}
 
@@ -40,7 +44,10 @@ from typing import Any
 
 import numpy as np
 
+from ..geometry.box import Box
+from ..geometry.se3 import pose_from_rotvec, rotvec_from_matrix
 from ..robot.trajectory import Heat, KinematicsRef, Payload, Phase, Trajectory, TrajectoryMeta
+from ..robot.wire_cut import FeedWindow, WireCut
 from .atomic import atomic_write_bytes, atomic_write_text
 from .text import read_user_text
 
@@ -105,9 +112,22 @@ def meta_to_dict(meta: TrajectoryMeta) -> dict[str, Any]:
         },
         "max_acceleration_rad_s2": None if meta.max_acceleration is None
         else meta.max_acceleration.tolist(),
+        "cut": None if meta.cut is None else _cut_to_dict(meta.cut),
         "job": meta.job,
         "source": meta.source,
     }
+
+
+def _cut_to_dict(cut: WireCut) -> dict[str, Any]:
+    st = cut.stock
+    return {
+        "stock": {"centre": st.centre.tolist(), "size": st.size.tolist(),
+                  "rotvec": rotvec_from_matrix(st.rotation).tolist()},
+        "wire_length_m": cut.wire_length,
+        "feeds": [{"name": w.name, "start": w.start, "stop": w.stop, "speed_m_s": w.speed,
+                   "tolerance": w.tolerance, "held": [list(r) for r in w.held]}
+                  for w in cut.feeds],
+    }  # fmt: skip
 
 
 class _Doc:
@@ -159,6 +179,39 @@ def _heat(d: _Doc) -> Heat | None:
                     float(h.get("preheat_s", 0.0)))
     except (TypeError, ValueError) as exc:
         raise d.fail("heat", str(exc)) from None
+
+
+def _cut(d: _Doc) -> WireCut | None:
+    c = d.get("cut")
+    if c is None:
+        return None
+    if not isinstance(c, dict) or not isinstance(c.get("stock"), dict):
+        raise d.fail("cut", 'expected {"stock": {...}, "wire_length_m": L, "feeds": [...]} or '
+                     f"null, got {c!r}")  # fmt: skip
+    st = c["stock"]
+    try:
+        stock = Box(d.numbers("cut.stock.centre", st.get("centre"), 3),
+                    d.numbers("cut.stock.size", st.get("size"), 3),
+                    pose_from_rotvec(d.numbers("cut.stock.rotvec", st.get("rotvec", [0, 0, 0]),
+                                               3))[:3, :3])  # fmt: skip
+    except ValueError as exc:
+        raise d.fail("cut.stock", str(exc)) from None
+    length = c.get("wire_length_m")
+    if not isinstance(length, (int, float)) or isinstance(length, bool):
+        raise d.fail("cut.wire_length_m", f"expected a length in metres, got {length!r}")
+    feeds = []
+    for i, w in enumerate(c.get("feeds") or []):
+        try:
+            feeds.append(FeedWindow(str(w["name"]), int(w["start"]), int(w["stop"]),
+                                    float(w["speed_m_s"]), float(w["tolerance"]),
+                                    tuple(tuple(r) for r in w.get("held", []))))  # fmt: skip
+        except (KeyError, TypeError, ValueError, AttributeError) as exc:
+            raise d.fail(f"cut.feeds[{i}]", "expected {name, start, stop, speed_m_s, tolerance, "
+                         f"held}}: {exc}") from None  # fmt: skip
+    try:
+        return WireCut(stock, float(length), tuple(feeds))
+    except ValueError as exc:
+        raise d.fail("cut", str(exc)) from None
 
 
 def meta_from_dict(doc: Any, where: str = "trajectory metadata") -> TrajectoryMeta:
@@ -230,6 +283,7 @@ def meta_from_dict(doc: Any, where: str = "trajectory metadata") -> TrajectoryMe
             payload=Payload(mass, cog), kinematics=kinematics, base=base,
             phases=tuple(phases), in_stock=tuple(stock), job=job,
             source=str(d.get("source", default="")), heat=heat, max_acceleration=max_acc,
+            cut=_cut(d),
         )  # fmt: skip
     except ValueError as exc:
         raise ValueError(f"{where}: {exc}") from None

@@ -38,6 +38,8 @@ from ..geometry.se3 import pose_from_ur_vector, ur_vector_from_pose
 from ._checks import FloatArray, as_array, as_pose_or_vector, readonly
 from .model import DEFAULT_ACCELERATION, RobotModel
 from .rates import finite_difference_rates
+from .wire_cut import WireCut
+from .wire_in_stock import WireInStock, runs_of
 
 __all__ = [
     "PHASE_NAMES",
@@ -215,6 +217,9 @@ class TrajectoryMeta:
     #: the joint acceleration limits (J,) [rad/s^2] the trajectory was planned within, when
     #: they are not the catalogue's default (a job's ``[robot] acceleration``)
     max_acceleration: FloatArray | None = None
+    #: what it cuts — the block, the wire, the passes' feeds — for measuring any motion
+    #: of it with the one model of the wire against the block (:mod:`.wire_cut`)
+    cut: WireCut | None = None
 
     def __post_init__(self) -> None:
         put = object.__setattr__
@@ -365,6 +370,13 @@ class Trajectory:
             mask[a:b] = True
         return mask
 
+    def wire_in_stock(self) -> WireInStock | None:
+        """The wire against the block along these samples (the one model,
+        :mod:`.wire_in_stock`); None when the metadata names no cut."""
+        if self.meta.cut is None:
+            return None
+        return self.meta.cut.measure(self.t, self.tcp_poses())
+
     def phase_at(self, k: int) -> str:
         """The name of the phase sample ``k`` belongs to (``"move"`` if none is named)."""
         for p in self.meta.phases:
@@ -403,7 +415,8 @@ class Trajectory:
             Phase(p.name, *c) for p in self.meta.phases if (c := clip(p.start, p.stop))
         )
         stock = tuple(c for a, b in self.meta.in_stock if (c := clip(a, b)))
-        meta = self.meta.replace(phases=phases, in_stock=stock)
+        cut = None if self.meta.cut is None else self.meta.cut.sliced(start, stop)
+        meta = self.meta.replace(phases=phases, in_stock=stock, cut=cut)
         return Trajectory(self.t[start:stop] - self.t[start], self.q[start:stop],
                           self.tcp[start:stop], meta)  # fmt: skip
 
@@ -421,7 +434,4 @@ def phases_from_labels(labels: ArrayLike) -> tuple[Phase, ...]:
 
 def runs(mask: ArrayLike) -> tuple[tuple[int, int], ...]:
     """Half-open ranges ``(start, stop)`` of the True runs of a boolean mask (M,)."""
-    m = np.asarray(mask, dtype=bool).astype(np.int8)
-    d = np.diff(np.r_[0, m, 0])
-    return tuple(zip(np.flatnonzero(d == 1).tolist(), np.flatnonzero(d == -1).tolist(),
-                     strict=True))  # fmt: skip
+    return runs_of(mask)

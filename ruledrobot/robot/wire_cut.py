@@ -1,0 +1,156 @@
+"""What a trajectory cuts: the block, the wire, the feed each pass must hold — and the
+feed and wire checks measured on any motion by the one model (:mod:`.wire_in_stock`).
+
+A trajectory's sidecar carries a :class:`WireCut` (``"cut"``), so that whoever holds
+the trajectory alone — an exported program's verification, the runner on its
+recording, resume, the viewer — measures the wire against the same block and judges
+the feed by the same rule as the planner:
+
+* ``feed_max``: over every sample of a pass's window with the wire in the stock, the
+  cutting speed at most ``speed · (1 + tolerance)``;
+* ``feed_min``: over the samples of the window's ``held`` ranges (the pass's cut phase
+  less the corners where the wire stops and the slits of a closed cut) with the wire
+  in the stock, at least ``speed · (1 - tolerance)``.
+
+Units: m, m/s; the block in the robot base frame.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from ..geometry.box import Box
+from .wire_in_stock import WireInStock, wire_ends, wire_in_stock
+
+__all__ = ["FeedMeasure", "FeedWindow", "WireCut", "feed_measures"]
+
+
+def _ranges(value: object, what: str) -> tuple[tuple[int, int], ...]:
+    out = []
+    for i, r in enumerate(value or ()):  # type: ignore[attr-defined]
+        a, b = (int(x) for x in r)
+        if not 0 <= a < b:
+            raise ValueError(f"{what}[{i}]: expected sample indices 0 <= start < stop, got {r!r}")
+        out.append((a, b))
+    return tuple(out)
+
+
+@dataclass(frozen=True)
+class FeedWindow:
+    """One pass's feed: samples ``[start, stop)`` of the pass (lead-in to lead-out), the
+    cut's name, its set ``speed`` (m/s) and relative ``tolerance``, and the ``held``
+    ranges where the lowest feed is checked (module doc)."""
+
+    name: str
+    start: int
+    stop: int
+    speed: float
+    tolerance: float
+    held: tuple[tuple[int, int], ...] = ()
+
+    def __post_init__(self) -> None:
+        if not 0 <= int(self.start) < int(self.stop):
+            raise ValueError(f"feed window {self.name!r}: expected 0 <= start < stop, got "
+                             f"[{self.start}, {self.stop}]")  # fmt: skip
+        if not (np.isfinite(self.speed) and self.speed > 0):
+            raise ValueError(f"feed window {self.name!r}: speed must be > 0 m/s, got {self.speed}")
+        if not 0 <= self.tolerance < 1:
+            raise ValueError(f"feed window {self.name!r}: tolerance must be in [0, 1), got "
+                             f"{self.tolerance}")  # fmt: skip
+        object.__setattr__(self, "start", int(self.start))
+        object.__setattr__(self, "stop", int(self.stop))
+        object.__setattr__(self, "held", _ranges(self.held, f"feed window {self.name!r} held"))
+
+    def mask(self, n: int) -> np.ndarray:
+        m = np.zeros(n, dtype=bool)
+        m[self.start : self.stop] = True
+        return m
+
+    def held_mask(self, n: int) -> np.ndarray:
+        m = np.zeros(n, dtype=bool)
+        for a, b in self.held:
+            m[a:b] = True
+        return m
+
+    def shifted(self, start: int, stop: int) -> FeedWindow | None:
+        """The window on samples ``start:stop`` renumbered from 0 (None when outside)."""
+        a, b = max(self.start, start) - start, min(self.stop, stop) - start
+        if a >= b:
+            return None
+        held = tuple((max(x, start) - start, min(y, stop) - start) for x, y in self.held
+                     if min(y, stop) > max(x, start))  # fmt: skip
+        return FeedWindow(self.name, a, b, self.speed, self.tolerance, held)
+
+
+@dataclass(frozen=True, eq=False)
+class WireCut:
+    """The block (robot base frame), the wire's length (m) and the passes' feeds: what
+    a trajectory cuts, so that any motion of it can be measured (module doc).  The
+    trajectory's TCP is the wire's midpoint with z along the wire."""
+
+    stock: Box
+    wire_length: float
+    feeds: tuple[FeedWindow, ...] = field(default=())
+
+    def __post_init__(self) -> None:
+        if not (np.isfinite(self.wire_length) and self.wire_length > 0):
+            raise ValueError(f"cut.wire_length: expected a length > 0 m, got {self.wire_length}")
+        object.__setattr__(self, "wire_length", float(self.wire_length))
+        object.__setattr__(self, "feeds", tuple(self.feeds))
+
+    def measure(self, t: ArrayLike, tcp: ArrayLike) -> WireInStock:
+        """The wire against the block along TCP poses ``tcp`` (M, 4, 4) at times ``t`` (M,)."""
+        return wire_in_stock(t, wire_ends(tcp, self.wire_length), self.stock)
+
+    def sliced(self, start: int, stop: int) -> WireCut:
+        """The same cut for samples ``start:stop`` numbered from 0."""
+        feeds = tuple(w for f in self.feeds if (w := f.shifted(start, stop)) is not None)
+        return WireCut(self.stock, self.wire_length, feeds)
+
+
+@dataclass(frozen=True)
+class FeedMeasure:
+    """The feed of one cut (all its windows) on a measured motion: the highest feed in
+    the stock and the lowest where it is held (m/s, NaN when never in the stock there),
+    the samples where they are, and the set speed and tolerance."""
+
+    name: str
+    speed: float
+    tolerance: float
+    highest: float
+    lowest: float
+    at_highest: int
+    at_lowest: int
+
+    @property
+    def max_ok(self) -> bool:
+        return not self.highest > self.speed * (1.0 + self.tolerance)
+
+    @property
+    def min_ok(self) -> bool:
+        return not self.lowest < self.speed * (1.0 - self.tolerance)
+
+
+def feed_measures(wis: WireInStock, cut: WireCut) -> tuple[FeedMeasure, ...]:
+    """Per cut name (in the order of ``cut.feeds``) the feed checks' figures (module
+    doc) of the measured motion ``wis``."""
+    n = wis.n
+    names: list[str] = []
+    for w in cut.feeds:
+        if w.name not in names:
+            names.append(w.name)
+    out = []
+    for name in names:
+        ws = [w for w in cut.feeds if w.name == name]
+        inwin = np.zeros(n, dtype=bool)
+        held = np.zeros(n, dtype=bool)
+        for w in ws:
+            inwin |= w.mask(n)
+            held |= w.held_mask(n)
+        _, hi, _, k_hi = wis.feed_extremes(inwin)
+        lo, _, k_lo, _ = wis.feed_extremes(held)
+        out.append(FeedMeasure(name, ws[0].speed, ws[0].tolerance, hi, lo, k_hi, k_lo))
+    return tuple(out)
