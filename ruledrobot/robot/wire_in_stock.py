@@ -64,7 +64,9 @@ def wire_ends(tcp: ArrayLike, wire_length: float) -> FloatArray:
     return np.stack([p - half, p + half], axis=-2)
 
 
-def chord_fractions(ends: ArrayLike, stock: Box, margin: float = 0.0) -> tuple[FloatArray, FloatArray]:
+def chord_fractions(
+    ends: ArrayLike, stock: Box, margin: float = 0.0
+) -> tuple[FloatArray, FloatArray]:
     """The chord of each wire in the block grown by ``margin``: ``(lo, hi)`` (M,) as
     fractions of the wire from its start, NaN where the chord is shorter than
     :data:`TOUCH` (the wire misses or only touches the block)."""
