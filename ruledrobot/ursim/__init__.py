@@ -11,10 +11,12 @@ Modules, one job each: ``rtde_types`` (variable/type table), ``protocol``
 (RTDE packets and recipes), ``rtde_server``, ``dashboard``, ``script_port``,
 ``primary_port`` (the servers), ``program`` (URScript parsing), ``handshake`` (ur_rtde's
 control-script register protocol), ``script_runner`` (standalone programs),
-``controller`` (state machine), ``motion`` (trajectory generator),
-``backend`` (the arm), ``kinematics``, ``server`` (:class:`ThreadedEmulator`,
+``controller`` (state machine), ``backend`` (the arm), ``server`` (:class:`ThreadedEmulator`,
 :func:`serve`), ``process`` (:class:`Emulator`: the emulator in a child
-process, so that a ur_rtde client in this process does not deadlock it).
+process, so that a ur_rtde client in this process does not deadlock it).  The
+trajectory generator (moveJ/moveL/movep with blends, stops) and the per-tick kinematics
+are the robot layer's :mod:`ruledrobot.robot.ur_motion` and
+:mod:`ruledrobot.robot.arm_kinematics`, shared with the verification of exported programs.
 """
 
 from __future__ import annotations

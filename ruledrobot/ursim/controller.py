@@ -45,12 +45,19 @@ from numpy.typing import ArrayLike
 
 from ..protocol.modes import JointMode, RobotMode, RuntimeState, SafetyMode, SafetyStatusBit
 from ..robot import RobotModel
+from ..robot.arm_kinematics import ArmKinematics
+from ..robot.ur_motion import (
+    MotionError,
+    PathMotion,
+    Segment,
+    StopMotion,
+    joint_segment,
+    linear_segment,
+)
 from .backend import ArmBackend, ArmState, KinematicBackend
 from .controller_io import IN_DOUBLE, IN_INT, OUT_DOUBLE, OUT_INT, IOMixin
 from .controller_safety import SafetyMixin
 from .handshake import ControlScript
-from .kinematics import ArmKinematics
-from .motion import MotionError, PathMotion, Segment, StopMotion, joint_segment, linear_segment
 from .program import CompileError, PathWaypoint, Program, parse_program
 from .script_functions import compile_program
 from .script_runner import ScriptRunner, run_io_statement

@@ -38,8 +38,8 @@ from enum import IntEnum
 import numpy as np
 
 from ..geometry.se3 import pose_from_ur_vector, ur_vector_from_pose
+from ..robot.ur_motion import MotionError, PathMotion, StopMotion, joint_segment, linear_segment
 from .host import ProgramHost
-from .motion import MotionError, PathMotion, StopMotion, joint_segment, linear_segment
 from .program import Program
 
 __all__ = ["NOT_EMULATED", "RT_COMMANDS", "Command", "ControlScript", "NotEmulatedError"]

@@ -18,9 +18,9 @@ from typing import Protocol
 
 from numpy.typing import ArrayLike
 
+from ..robot.arm_kinematics import ArmKinematics
+from ..robot.ur_motion import PathMotion, StopMotion
 from .backend import ArmState
-from .kinematics import ArmKinematics
-from .motion import PathMotion, StopMotion
 from .program import PathWaypoint
 
 __all__ = ["ProgramHost"]

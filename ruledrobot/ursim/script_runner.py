@@ -31,8 +31,15 @@ import math
 
 import numpy as np
 
+from ..robot.ur_motion import (
+    MotionError,
+    PathMotion,
+    Segment,
+    StopMotion,
+    joint_segment,
+    linear_segment,
+)
 from .host import ProgramHost
-from .motion import MotionError, PathMotion, Segment, StopMotion, joint_segment, linear_segment
 from .program import Pose, Program, Statement
 
 __all__ = ["ScriptRunner", "run_io_statement"]

@@ -19,16 +19,16 @@ from ruledrobot.protocol.rtde import (
 )
 from ruledrobot.protocol.rtde_types import TYPE_SIZES, input_type, output_type
 from ruledrobot.robot import load
-from ruledrobot.ursim import DEFAULT_Q, KinematicBackend
-from ruledrobot.ursim.controller import Controller
-from ruledrobot.ursim.kinematics import ArmKinematics
-from ruledrobot.ursim.motion import (
+from ruledrobot.robot.arm_kinematics import ArmKinematics
+from ruledrobot.robot.ur_motion import (
     PathMotion,
     Profile,
     StopMotion,
     joint_segment,
     linear_segment,
 )
+from ruledrobot.ursim import DEFAULT_Q, KinematicBackend
+from ruledrobot.ursim.controller import Controller
 from ruledrobot.ursim.program import ProgramSplitter, parse_call, parse_program
 from tests.support.rawclient import UR_RTDE_RECEIVE_RECIPE
 

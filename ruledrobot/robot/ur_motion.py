@@ -36,7 +36,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..geometry.se3 import pose_from_ur_vector, ur_vector_from_pose
-from .kinematics import ArmKinematics
+from .arm_kinematics import ArmKinematics
 
 __all__ = [
     "MotionError",

@@ -26,7 +26,7 @@ from numpy.typing import ArrayLike
 
 from ..geometry.angles import wrap_angle, wrap_near
 from ..geometry.se3 import pose_from_ur_vector, ur_vector_from_pose
-from ..robot import RobotModel
+from .model import RobotModel
 
 __all__ = ["ArmKinematics", "rotvec_from_rows"]
 
