@@ -25,7 +25,7 @@ import numpy as np
 from ruledrobot.robot import load
 from ruledrobot.wirecut.demo import DEMO_JOB, PART_JOB
 from ruledrobot.wirecut.job import load_job
-from ruledrobot.wirecut.path import chord_ends_in_flange, cut_path, refine_for_job
+from ruledrobot.wirecut.path import cut_path, refine_for_job
 from ruledrobot.wirecut.planner import plan
 from ruledrobot.wirecut.timing import time_path
 from ruledrobot.wirecut.toolpath import speed_factor
@@ -54,7 +54,7 @@ def main() -> None:
             m = cp.motion
             s = np.arange(len(cp.frames), dtype=float)
             t0 = time.perf_counter()
-            sf = speed_factor(m.flange, s, chord_ends_in_flange(cp), m.hit)
+            sf = speed_factor(m.flange, s, job.tool, job.stock, 0.002)
             time_path(
                 s,
                 m.q,

@@ -152,7 +152,8 @@ class WireInStock:
     ``t`` (M,) s; ``ends`` (M, 2, 3) the wire's start and end (m); ``lo``, ``hi``
     (M,) the chord as fractions of the wire from its start (NaN outside); ``inside``
     (M,) the wire is in the stock; ``depth`` (M,) m (0 outside); ``feed`` (M,) m/s,
-    the cutting speed: the fastest speed across the wire of a chord point (0 outside).
+    the cutting speed: the fastest speed across the wire of a chord point (NaN outside:
+    the wire cuts nothing there).
     """
 
     t: FloatArray = field(repr=False)
@@ -217,8 +218,8 @@ def wire_in_stock(t: ArrayLike, ends: ArrayLike, stock: Box) -> WireInStock:
         raise ValueError(f"ends: expected ({ta.size}, 2, 3) wire end points, got {e.shape}")
     lo, hi = chord_fractions(e, stock)
     inside = ~np.isnan(lo)
-    feed = np.zeros(ta.size)
-    if inside.any() and ta.size >= 2:
+    feed = np.full(ta.size, np.nan)
+    if inside.any():
         feed[inside] = across_speeds(ta, e, np.stack([lo, hi], axis=1))[inside].max(axis=1)
     return WireInStock(ta, e, lo, hi, inside, _depth(e, lo, hi, stock), feed)
 

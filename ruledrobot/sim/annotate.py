@@ -10,7 +10,7 @@ motion with:
 * the **trail** of the wire's middle (the TCP), a line that stays, coloured by
   phase;
 * a **caption**: time, phase and feed (the speed of the fastest wire point in
-  the stock, :func:`ruledrobot.sim.cutting.feed_speeds`);
+  the stock, :mod:`ruledrobot.robot.wire_in_stock`, the one model);
 * while the wire cuts (phases lead-in, cut, lead-out, or in the stock when the
   phases are not given) a **close-up** of the wire inset in the lower right
   corner, seen from the side of the cut surface facing the main camera.
@@ -31,7 +31,7 @@ import numpy as np
 from ..geometry._arrays import FloatArray
 from ..geometry.box import Box
 from ..geometry.interp import interp_linear
-from .cutting import chords, feed_speeds
+from ..robot.wire_in_stock import chord_fractions, wire_in_stock
 
 __all__ = ["CUTTING_PHASES", "CutAnnotator", "phase_labels"]
 
@@ -93,7 +93,8 @@ class CutAnnotator:
             mj.mj_kinematics(model, data)
             ends[k, 0], ends[k, 1] = data.site_xpos[s0], data.site_xpos[s1]
         self.ends = ends
-        lo, hi, inside = chords(ends, self.stock)
+        lo, hi = chord_fractions(ends, self.stock)
+        inside = ~np.isnan(lo)
         a, b = ends[:, 0], ends[:, 1]
         self.chord = np.stack([a + np.nan_to_num(lo)[:, None] * (b - a),
                                a + np.nan_to_num(hi)[:, None] * (b - a)], axis=1)  # fmt: skip
@@ -113,7 +114,7 @@ class CutAnnotator:
         flange = dataclasses.replace(scene.robot, tool=np.eye(4)).fk(q)
         w = np.stack([scene.tool.wire_start, scene.tool.wire_end])
         all_ends = np.einsum("mij,kj->mki", flange[:, :3, :3], w) + flange[:, None, :3, 3]
-        feed = feed_speeds(t, all_ends, self.stock)
+        feed = wire_in_stock(t, all_ends, self.stock).feed
         k = np.clip(np.searchsorted(t, times - 1e-9), 0, t.size - 1)
         self.feed = feed[k]
         labels = phase_labels(phases, t.size)

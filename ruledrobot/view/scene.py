@@ -35,7 +35,7 @@ from ..robot.rates import finite_difference_rates
 from ..robot.trajectory import KinematicsRef, model_for
 from ..robot.verdict import Check
 from ..sim._mujoco import mujoco
-from ..sim.cutting import chords, feed_speeds
+from ..robot.wire_in_stock import chord_fractions, wire_in_stock
 from ..sim.scene import Scene, default_camera
 from .clearance import Event, contacts_along, locate, near_misses
 from .folder import PlanFolder, read_plan_folder
@@ -238,7 +238,8 @@ def build_scene(
         labels = _phase_labels(folder)
         pos, quat = geom_poses(mj, model, traj.q[k], ids)
         wire = _wire_sites(mj, model, traj.q[k])
-        lo, hi, inside = chords(wire, stock)
+        lo, hi = chord_fractions(wire, stock)
+        inside = ~np.isnan(lo)
         chord = np.where(inside[:, None, None], wire[:, :1] + np.stack([lo, hi], 1)[:, :, None]
                          * (wire[:, 1:] - wire[:, :1]), np.nan)  # fmt: skip
         flange = dataclasses.replace(robot, tool=np.eye(4)).fk(traj.q)
@@ -246,7 +247,7 @@ def build_scene(
         assert tool is not None
         ends = np.stack([tool.wire_start, tool.wire_end])
         all_wire = np.einsum("mij,kj->mki", flange[:, :3, :3], ends) + flange[:, None, :3, 3]
-        feed = feed_speeds(traj.t, all_wire, stock)[k]
+        feed = wire_in_stock(traj.t, all_wire, stock).feed[k]
         qd, _ = finite_difference_rates(traj.t, traj.q)
         vmax = np.asarray(robot.max_velocity, dtype=np.float64)
         speed = np.abs(qd[np.minimum(k, qd.shape[0] - 1)]) / vmax

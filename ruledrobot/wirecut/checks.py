@@ -55,6 +55,8 @@ class CutMeasurements:
     wire_tolerance_mm: float
     feed_tolerance: float
     corner_stops: int = 0
+    #: what holds the wire below the feed where it is slowest, measured (None: it is not)
+    feed_min_limit: str | None = None
 
 
 @dataclass(frozen=True)
@@ -95,8 +97,8 @@ def _cut_checks(c: CutMeasurements, single: bool) -> list[Check]:
                       f"the wire moves faster than {F:g} mm/s + {100 * tol:g} %"),
         Check.at_least("feed_min" + key, "lowest feed inside the stock" + of, c.feed_min_mm_s,
                        F * (1 - tol), "mm/s",
-                       f"the joints cannot hold {F:g} mm/s - {100 * tol:g} %: the "
-                       "wire slows down inside the stock (a wider kerf there)"),
+                       f"the wire slows below {F:g} mm/s - {100 * tol:g} % inside the stock "
+                       f"(a wider kerf there): {c.feed_min_limit or 'see the plots'}"),
     ]  # fmt: skip
     if c.compensated:
         checks.append(Check.at_most(

@@ -23,65 +23,51 @@ from ..geometry.angles import wrap_near
 from ..geometry.box import Box
 from ..geometry.checks import FloatArray
 from ..robot.tool import BowTool
+from ..robot.wire_in_stock import WireInStock
 from .cutpath import CutPath
-from .measure import wire_points
 from .timing import TimedPath
-from .toolpath import chords, flange_poses, wire_poses
+from .toolpath import chords, distance_from_rulings, flange_poses, wire_poses
 
-__all__ = ["densified", "pass_deviation", "pass_feed_error", "uneven_intervals"]
-
-
-def _samples_in_intervals(
-    cp: CutPath, timed: TimedPath
-) -> tuple[np.ndarray, FloatArray, np.ndarray, FloatArray]:
-    """For every sample the interval between rulings it lies in and its fraction there,
-    whether the wire crosses the stock at both ends, and zeros (M - 1,) per interval."""
-    i0, frac = cp.locate(timed.s_of_t)
-    inside = cp.motion.hit[i0] & cp.motion.hit[i0 + 1]
-    return i0, frac, inside, np.zeros(len(cp.frames) - 1)
+__all__ = [
+    "densified", "pass_deviation", "pass_feed_error", "target_frames", "uneven_intervals",
+]
 
 
-def pass_deviation(cp: CutPath, timed: TimedPath, model, ends: FloatArray) -> FloatArray:
+def target_frames(cp: CutPath, s: FloatArray) -> tuple[np.ndarray, FloatArray]:
+    """The interval between rulings (K,) each path parameter ``s`` (K,) lies in, and the
+    target ruling's frame (K, 4, 4) there: the screw geodesic between the interval's
+    frames at the same fraction."""
+    i0, frac = cp.locate(s)
+    return i0, se3.geodesic(cp.frames[i0], cp.frames[i0 + 1], frac)
+
+
+def pass_deviation(cp: CutPath, timed: TimedPath, wire: WireInStock) -> FloatArray:
     """Per interval between rulings (M - 1,) the largest distance [m] of the timed
-    wire's chord ends from the target rulings (the screw geodesic between the frames at
-    the same path parameter), inside the stock; ``ends`` (M, 2, 3) the chord ends in the
-    flange frame at the rulings."""
-    i0, frac, inside, out = _samples_in_intervals(cp, timed)
-    if not inside.any():
+    wire's chord ends from the target rulings at the same path parameter, where the wire
+    is in the stock; ``wire`` the one model measured on ``timed``."""
+    out = np.zeros(len(cp.frames) - 1)
+    k = np.flatnonzero(wire.inside)
+    if not k.size:
         return out
-    k = np.flatnonzero(inside)
-    f = frac[k, None, None]
-    e = np.nan_to_num(ends)
-    e_t = (1.0 - f) * e[i0[k]] + f * e[i0[k] + 1]
-    target = se3.geodesic(cp.frames[i0[k]], cp.frames[i0[k] + 1], frac[k])
-    off = wire_points(model.fk(timed.q[k]), e_t) - target[:, None, :3, 3]
-    dist = np.linalg.norm(np.cross(off, target[:, None, :3, 2]), axis=-1).max(axis=1)
-    np.maximum.at(out, i0[k], dist)
+    i0, target = target_frames(cp, timed.s_of_t[k])
+    np.maximum.at(out, i0, distance_from_rulings(wire.chord_points()[k], target))
     return out
 
 
 def pass_feed_error(
-    cp: CutPath, timed: TimedPath, model, ends: FloatArray, feed_speed: float
+    cp: CutPath, timed: TimedPath, wire: WireInStock, feed_speed: float
 ) -> FloatArray:
     """Per interval between rulings (M - 1,) the largest relative error of the timed
-    wire's feed, measured through forward kinematics, against ``feed_speed`` inside the
-    stock, where the time law meant to hold the feed (not where the joints set the pace).
-
-    The time law bounds a feed model interpolated linearly between the rulings; where
-    the joint path bends within an interval, the real feed strays from it."""
-    from .measure import feed_speeds
-
-    i0, frac, inside, out = _samples_in_intervals(cp, timed)
-    if not inside.any():
+    wire's cutting speed (the one model, ``wire``) against ``feed_speed`` where the wire
+    is in the stock and the time law meant to hold the feed (not where the joints set
+    the pace).  The time law bounds a speed factor interpolated linearly between the
+    rulings; where the joint path bends within an interval, the real feed strays."""
+    out = np.zeros(len(cp.frames) - 1)
+    held = wire.inside & ~timed.feed_limited
+    if not held.any():
         return out
-    e = np.nan_to_num(ends)
-    f = frac[:, None, None]
-    e_t = (1.0 - f) * e[i0] + f * e[i0 + 1]
-    feed = feed_speeds(timed.t, model.fk(timed.q), e_t, inside)
-    err = np.abs(feed / feed_speed - 1.0)
-    held = inside & ~timed.feed_limited
-    # the first and last samples of a run in the stock are one-sided differences
-    held[1:-1] &= inside[:-2] & inside[2:]
+    err = np.abs(wire.feed / feed_speed - 1.0)
+    i0, _ = cp.locate(timed.s_of_t)
     np.maximum.at(out, i0[held], err[held])
     return out
 

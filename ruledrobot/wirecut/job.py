@@ -49,6 +49,8 @@ metres, radians, seconds)::
     #                          # surface): the wire runs kerf/2 off the surface, in the waste
     wire_tolerance = 0.0005    # m, largest wire deviation from the rulings (a check)
     feed_tolerance = 0.05      # fraction: feed inside the stock within +-5 % (a check)
+    # extend = true            # an open surface that stops short of the block is cut on
+    #                          # through it along its extrapolation (noted); default: refused
 
 A part with several cuts lists them in order as ``[[cut]]`` tables, each with a
 ``name`` and its own ``[cut.surface]`` table (the fields of ``[surface]``), and
@@ -156,7 +158,11 @@ def _cut(c: Section, name: str, surface: SurfaceSpec) -> CutSpec:
         keep=_keep(c, closed),
         wire_tolerance=c.number("wire_tolerance", 0.0005, lo=0.0, strict_lo=True),
         feed_tolerance=c.number("feed_tolerance", 0.05, lo=0.0, hi=1.0, strict_lo=True),
+        extend=c.flag("extend", False),
     )
+    if cut.extend and closed:
+        raise c.fail("extend", "only for an open surface (a closed one is entered through a "
+                     "slit, never extended)")  # fmt: skip
     c.done()
     return cut
 

@@ -25,10 +25,11 @@ import numpy as np
 
 from ..geometry.angles import wrap_near
 from ..geometry.checks import FloatArray
-from ..geometry.interp import interp_linear
+from ..robot.tool import BowTool
+from ..robot.wire_in_stock import WireInStock, wire_ends, wire_in_stock
 from .corners import corner_nodes, corner_stop_mask, time_between_corners
 from .densify import densified, pass_deviation, pass_feed_error, uneven_intervals
-from .path import CutPath, chord_ends_in_flange
+from .path import CutPath
 from .spec import Job
 from .timing import TimedPath, concatenate, dwell, joint_move
 from .toolpath import speed_factor, wire_frame
@@ -41,6 +42,11 @@ LIFT = 0.1  # m: approach from / retract to this far beyond the lead-in/out pose
 #: and the share of the cut's wire and feed tolerances that triggers it (:mod:`.densify`)
 DENSIFY_ROUNDS = 3
 DENSIFY_SHARE = 0.25
+#: m: the time law bounds the speed of the wire's point nearest the block from this far
+#: out (at least; 1.5 ruling intervals where they are longer), so that its feed bound
+#: meets the chord's without a jump where the wire enters and leaves
+#: (:func:`ruledrobot.robot.wire_in_stock.feed_chord`)
+FEED_NEAR = 0.002
 
 
 @dataclass(frozen=True, eq=False)
@@ -49,9 +55,12 @@ class Motion:
 
     ``timed``: the trajectory.  ``labels`` (M,): the phase (module doc).  ``pass_of``
     (M,): the index of the pass a sample belongs to (-1 outside passes).  ``s`` (M,):
-    the ruling parameter within its pass (NaN outside).  ``in_stock`` (M,): the wire
-    crosses the stock (both neighbouring rulings of its pass do).  ``ends`` (M, 2, 3):
-    the chord ends as points of the wire in the flange frame (0 outside the stock).
+    the ruling parameter within its pass (NaN outside).  ``wire``: the one model of the
+    wire against the block measured on the samples (:mod:`ruledrobot.robot.wire_in_stock`);
+    ``in_stock`` (M,) is its ``inside``: the wire's chord in the block is at least
+    ``TOUCH`` long.  ``ends`` (M, 2, 3): the chord ends as points of the wire in the
+    flange frame (0 outside the stock).  A pass's lead-in ends where its wire first
+    enters the block and its lead-out starts where it last leaves.
     ``heat`` (M,): the wire is hot (pre-heat, lead-in, cut, lead-out) when the tool
     switches heat, else all False.  ``notes``: what the assembly decided (transits).
     ``passes``: the passes as timed (with the rulings :mod:`.densify` added).
@@ -72,17 +81,7 @@ class Motion:
     passes: tuple[CutPath, ...] = field(default=(), repr=False)
     surface: np.ndarray | None = field(default=None, repr=False)
     corner_stop: np.ndarray | None = field(default=None, repr=False)
-
-
-def _fill_nearest(values: FloatArray, valid: np.ndarray) -> FloatArray:
-    """Rows of ``values`` where ``valid`` is False replaced by the nearest valid row."""
-    idx = np.flatnonzero(valid)
-    pos = np.clip(np.searchsorted(idx, np.arange(len(values))), 0, len(idx) - 1)
-    left = idx[np.clip(pos - 1, 0, len(idx) - 1)]
-    right = idx[pos]
-    k = np.arange(len(values))
-    nearest = np.where(np.abs(k - left) <= np.abs(right - k), left, right)
-    return values[nearest]
+    wire: WireInStock | None = field(default=None, repr=False)
 
 
 def _backed_off(model, q: FloatArray, away: FloatArray, dist: float) -> FloatArray | None:
@@ -168,32 +167,49 @@ def _wire_arclength(cp: CutPath) -> FloatArray:
     return np.r_[0.0, np.cumsum(step)]
 
 
+def measure_wire(job: Job, model, t: FloatArray, q: FloatArray) -> WireInStock:
+    """The one model of the wire against the job's block along joints ``q`` (M, 6) at
+    times ``t`` (M,) (``model``: the planner's, flange without tool, base frame)."""
+    bow = BowTool.from_spec(job.tool)
+    ends = wire_ends(model.fk(q) @ bow.wire_frame(), bow.wire_length)
+    return wire_in_stock(t, ends, job.stock)
+
+
+def _chord_in_flange(job: Job, wire: WireInStock) -> FloatArray:
+    """(M, 2, 3) the chord ends as points of the wire in the flange frame (0 outside)."""
+    bow = BowTool.from_spec(job.tool)
+    W = bow.wire_frame()
+    f = np.nan_to_num(wire.fractions()) - 0.5
+    return W[:3, 3] + f[:, :, None] * bow.wire_length * W[:3, 2]
+
+
 def _pass_timing(
     job: Job, model, cp: CutPath, vel, acc, dt
-) -> tuple[CutPath, TimedPath, FloatArray, np.ndarray]:
+) -> tuple[CutPath, TimedPath, np.ndarray]:
     """The pass timed at its feed, with rulings added where the timed wire leaves the
-    surface between them (:mod:`.densify`); returns the (denser) pass too, its chord
-    ends and the samples where the wire stops at a corner (:mod:`.corners`)."""
+    surface between them or its feed strays (:mod:`.densify`); returns the (denser)
+    pass too and the samples where the wire stops at a corner (:mod:`.corners`)."""
     cut = next(c for c in job.cuts if c.name == cp.name)
     cp = dataclasses.replace(cp, param=_wire_arclength(cp))
     for attempt in range(DENSIFY_ROUNDS + 1):
         m = cp.motion
         s = cp.s
-        ends = chord_ends_in_flange(cp)
-        sf = speed_factor(m.flange, s, ends, m.hit)
+        near = max(FEED_NEAR, 1.5 * float(np.diff(s).max()))
+        sf = speed_factor(m.flange, s, job.tool, job.stock, near)
         corners = corner_nodes(cp.frames, 0.5 * job.tool.wire_length)
         timed = time_between_corners(s, m.q, sf, cut.feed_speed, vel, acc, dt, corners)
         if attempt == DENSIFY_ROUNDS:
             break
-        dev = pass_deviation(cp, timed, model, ends)
-        feed = pass_feed_error(cp, timed, model, ends, cut.feed_speed)
+        wire = measure_wire(job, model, timed.t, timed.q)
+        dev = pass_deviation(cp, timed, wire)
+        feed = pass_feed_error(cp, timed, wire, cut.feed_speed)
         bad = np.flatnonzero((dev > DENSIFY_SHARE * cut.wire_tolerance)
                              | (feed > DENSIFY_SHARE * cut.feed_tolerance))  # fmt: skip
         bad = np.union1d(bad, uneven_intervals(cp, DENSIFY_SHARE * cut.feed_tolerance))
         if not bad.size:
             break
         cp = densified(cp, bad, model, job.tool, job.stock)
-    return cp, timed, ends, corner_stop_mask(timed, s[corners])
+    return cp, timed, corner_stop_mask(timed, s[corners])
 
 
 def assemble_motion(job: Job, model, passes: list[CutPath]) -> Motion:
@@ -244,16 +260,16 @@ def assemble_motion(job: Job, model, passes: list[CutPath]) -> Motion:
         for qa, qb in transit.route(here, home, notes, "home"):
             b.add(joint_move(qa, qb, vel, acc, dt, job.cuts[-1].approach_speed), "retract")
     whole = concatenate(b.parts, dt) if len(b.parts) > 1 else b.parts[0]
-    return _label(job, whole, b, passes, timed_passes, notes)
+    return _label(job, model, whole, b, passes, timed_passes, notes)
 
 
-def _label(job, whole: TimedPath, b: _Builder, passes, timed_passes, notes) -> Motion:
+def _label(job, model, whole: TimedPath, b: _Builder, passes, timed_passes, notes) -> Motion:
     M = whole.t.size
     labels = np.full(M, "move", dtype=object)
     pass_of = np.full(M, -1, dtype=np.int64)
     s = np.full(M, np.nan)
-    in_stock = np.zeros(M, dtype=bool)
-    ends = np.zeros((M, 2, 3))
+    wire = measure_wire(job, model, whole.t, whole.q)
+    in_stock = wire.inside
     seg = whole.segment
     stop = np.zeros(M, dtype=bool)
     for i, (label, k) in enumerate(b.kinds):
@@ -265,7 +281,7 @@ def _label(job, whole: TimedPath, b: _Builder, passes, timed_passes, notes) -> M
             if label == "preheat":
                 pass_of[rows] = k
             continue
-        cp, (timed_k, cp_ends, stop_k) = passes[k], timed_passes[k]
+        cp, (timed_k, stop_k) = passes[k], timed_passes[k]
         idx = np.flatnonzero(rows)
         # the pass's own parameter: its s_of_t starts at cp.s[0] (the part drops no first
         # sample when it is the first part; otherwise the dropped one is its start)
@@ -273,13 +289,9 @@ def _label(job, whole: TimedPath, b: _Builder, passes, timed_passes, notes) -> M
         if i > 0:
             s_k = s_k + (b.parts[i].s_of_t[1] - b.parts[i].s_of_t[0])
         s_k = np.clip(s_k, cp.s[0], cp.s[-1])
-        i0, _ = cp.locate(s_k)
-        hit = cp.motion.hit[i0] & cp.motion.hit[i0 + 1]
         pass_of[idx] = k
         s[idx] = s_k
-        in_stock[idx] = hit
-        ends[idx] = interp_linear(s_k, cp.s, _fill_nearest(cp_ends, cp.motion.hit))
-        h = np.flatnonzero(hit)
+        h = np.flatnonzero(in_stock[idx])
         lab = np.full(idx.size, "lead_in", dtype=object)
         if h.size:
             lab[h[0] : h[-1] + 1] = "cut"
@@ -294,5 +306,5 @@ def _label(job, whole: TimedPath, b: _Builder, passes, timed_passes, notes) -> M
     heat = np.zeros(M, dtype=bool)
     if job.tool.heat is not None:
         heat = np.isin(labels.astype(str), ("preheat", "lead_in", "cut", "lead_out"))
-    return Motion(whole, labels, pass_of, s, in_stock, ends, heat, tuple(notes), tuple(passes),
-                  surface, stop & surface)
+    return Motion(whole, labels, pass_of, s, in_stock, _chord_in_flange(job, wire), heat,
+                  tuple(notes), tuple(passes), surface, stop & surface, wire)

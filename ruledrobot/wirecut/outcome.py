@@ -11,7 +11,9 @@ from __future__ import annotations
 import numpy as np
 
 from ..robot.verdict import Check, Verdict
+from ..robot.wire_cut import feed_measures
 from .checks import CutMeasurements, Measurements, plan_verdict
+from .feed_limit import feed_limit_reason
 from .plan import SINGULARITY_MARGIN, Plan, job_reference
 from .reach_explain import reach_reasons
 from .verify import Verification
@@ -34,6 +36,8 @@ def _keep_text(keep) -> str | list[float] | None:
 def _cut_sections(plan: Plan, ver: Verification | None) -> tuple[list[dict], list[CutMeasurements]]:
     mo, me = plan.motion, plan.measured
     sections, measures = [], []
+    cut_meta = plan.trajectory.meta.cut
+    feeds = {f.name: f for f in feed_measures(mo.wire, cut_meta)}
     for cut in plan.job.cuts:
         ks = [k for k, cp in enumerate(plan.passes) if cp.name == cut.name]
         passes = [plan.passes[k] for k in ks]
@@ -41,8 +45,7 @@ def _cut_sections(plan: Plan, ver: Verification | None) -> tuple[list[dict], lis
         interior = rows & ~mo.timed.feed_limited
         slits = np.isin(mo.pass_of, ks) & mo.in_stock & ~mo.surface
         stops = rows & (False if mo.corner_stop is None else mo.corner_stop)
-        feed = me.feed[rows]
-        held = me.feed[rows & ~stops]  # the lowest feed: not where the wire stops at a corner
+        fm = feeds.get(cut.name)
         n_stops = int(np.count_nonzero(stops & ~np.r_[False, stops[:-1]]))
         dev_p = float(me.deviation[rows].max()) if rows.any() else 0.0
         dev_s = None if ver is None else (float(ver.deviation[rows].max()) if rows.any() else 0.0)
@@ -54,8 +57,9 @@ def _cut_sections(plan: Plan, ver: Verification | None) -> tuple[list[dict], lis
         m0 = passes[0].motion
         cm = CutMeasurements(
             name=cut.name, feed_set_mm_s=cut.feed_speed * 1e3,
-            feed_max_mm_s=float(feed.max() * 1e3) if feed.size else None,
-            feed_min_mm_s=float(held.min() * 1e3) if held.size else None,
+            feed_max_mm_s=_mm(None if fm is None or np.isnan(fm.highest) else fm.highest),
+            feed_min_mm_s=_mm(None if fm is None or np.isnan(fm.lowest) else fm.lowest),
+            feed_min_limit=None if fm is None or fm.min_ok else feed_limit_reason(plan, fm),
             corner_stops=n_stops,
             feed_within_1pct=float(np.mean(np.abs(me.feed[interior] / cut.feed_speed - 1.0)
                                            <= 0.01)) if interior.any() else None,

@@ -11,6 +11,11 @@
    meets the stock grown by the lead distance on every side, and extended at
    either end by screw-geodesic extrapolation of the frame motion when the
    surface stops before the wire is clear of the stock by the lead distance.
+   The extrapolation is a lead-in/out: it may not cut the block.  A surface that
+   stops short of the block (an extrapolated target ruling whose chord in the block
+   is longer than :data:`SPAN_TOLERANCE`) is refused, naming where it ends and
+   where the block does, unless the cut says ``extend = true``: then it is cut on
+   along the extrapolation and the pass notes how far.
    Closed surfaces are cut as loops entered through a slit (:mod:`.closed`).
 4. The redundancy search (:mod:`.redundancy`) chooses roll, slide, wire
    direction and IK branch.
@@ -18,6 +23,7 @@
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from itertools import pairwise
 
 import numpy as np
@@ -27,7 +33,7 @@ from ..geometry import se3
 from ..geometry.box import Box
 from ..geometry.checks import FloatArray
 from ..geometry.ruled import RuledSurface
-from ..subdivision import check_size, get_scheme, refined_count
+from ..subdivision import check_length, check_size, get_scheme, refined_count
 from .closed import loop_paths
 from .corners import CORNER_ANGLE, polygon_corners
 from .cutpath import CutPath, RefinedCut
@@ -37,6 +43,7 @@ from .spec import CutSpec, Job
 from .toolpath import anchored_frames, chords, world_referenced
 
 __all__ = [
+    "SPAN_TOLERANCE",
     "CutPath",
     "RefinedCut",
     "chord_ends_in_flange",
@@ -50,6 +57,12 @@ MAX_STEPS = 10
 #: Most refined rulings a cut may have (the redundancy search, the time law and the
 #: simulation scale with them: ~2 min of planning and ~2 GB at this size).
 MAX_PATH_RULINGS = 250_000
+#: An extrapolated target ruling cuts the block when its chord in it is longer than
+#: this [m]; one through an edge or along a face (a surface that ends on the block's
+#: face) does not.
+SPAN_TOLERANCE = 1e-6
+#: Spacing [m] at which the extrapolation is checked within its first gap past an end
+SPAN_STEP = 1e-4
 
 
 def _gaps(frames: FloatArray, stock: Box) -> float:
@@ -114,6 +127,8 @@ def refine_cut(
     check_distinct_neighbours(lines.plucker, closed, f"{label} {s.label}")
     n = len(lines)
     sch = get_scheme(s.scheme)
+    if s.kind != "gcode":  # (a foam cutter's polygon: pieces too short are refined linearly)
+        check_length(sch, n, f"{label} {s.label}")
     half = 0.5 * wire_length
     if s.steps is not None:
         check_size(sch, n, s.steps, closed, f"{label} steps", MAX_PATH_RULINGS, None)
@@ -170,31 +185,153 @@ def _untwisted(a: FloatArray, b: FloatArray) -> FloatArray:
     return out
 
 
-def _extend(F: FloatArray, grown: Box, limit: int = 400) -> tuple[FloatArray, int, int]:
-    """Extrapolate the frame motion at each end until the end frames clear ``grown``."""
-    added = [0, 0]
-    parts = [F]
-    for side in (0, 1):
-        a, b = (F[1], F[0]) if side == 0 else (F[-2], F[-1])
-        a = _untwisted(a, b)
-        new = []
-        k = 1
-        last = b
-        while grown.clip_lines(last[None, :3, 3], last[None, :3, 2])[2][0]:
-            if k > limit:
-                raise ValueError(
-                    "lead-in/out: the frame motion does not leave the stock within "
-                    f"{limit} extrapolated rulings; extend the surface past the stock, or "
-                    "mark it closed (closed = true) if it goes all the way round"
-                )
-            last = se3.geodesic(a, b, 1.0 + k)
-            new.append(last)
-            k += 1
-        added[side] = len(new)
-        if new:
-            ext = np.array(new)
-            parts.insert(0, ext[::-1]) if side == 0 else parts.append(ext)
-    return np.concatenate(parts), added[0], added[1]
+class _Endless(ValueError):
+    """The extrapolation does not clear the grown stock within its limit; ``frames`` the
+    extrapolated frames made so far."""
+
+    def __init__(self, message: str, frames: FloatArray) -> None:
+        super().__init__(message)
+        self.frames = frames
+
+
+def _extrapolated(F: FloatArray, side: int, t: FloatArray | float) -> FloatArray:
+    """The frame motion ``F`` (M, 4, 4) extrapolated ``t`` gaps past its first (``side``
+    0) or last (1) frame: the screw motion of the least rotation between the end frame
+    and its neighbour (:func:`_untwisted`), at ``1 + t``."""
+    a, b = (F[1], F[0]) if side == 0 else (F[-2], F[-1])
+    return se3.geodesic(_untwisted(a, b), b, 1.0 + np.asarray(t, dtype=np.float64))
+
+
+def _extension(F: FloatArray, side: int, grown: Box, limit: int = 400) -> FloatArray:
+    """The extrapolated frames (K, 4, 4) past one end of ``F``, outwards, up to the first
+    that clears ``grown``; :class:`_Endless` after ``limit`` of them."""
+    new: list[FloatArray] = []
+    last = F[0] if side == 0 else F[-1]
+    while grown.clip_lines(last[None, :3, 3], last[None, :3, 2])[2][0]:
+        if len(new) >= limit:
+            raise _Endless(
+                "lead-in/out: the frame motion does not leave the stock within "
+                f"{limit} extrapolated rulings; extend the surface past the stock, or "
+                "mark it closed (closed = true) if it goes all the way round",
+                np.array(new),
+            )
+        last = _extrapolated(F, side, float(len(new) + 1))
+        new.append(last)
+    return np.array(new).reshape(-1, 4, 4)
+
+
+@dataclass(frozen=True)
+class _Overrun:
+    """Where the extrapolation past one end of an open surface cuts the block."""
+
+    end: str  #: "first" or "last"
+    index: int  #: the surface's end ruling, an index of the input rulings (from 0)
+    rulings: int  #: extrapolated rulings whose chord in the block exceeds SPAN_TOLERANCE
+    reach: float  #: [m] farthest chord end in the block of the extrapolation from the end ruling
+    point: FloatArray  #: the end ruling's point nearest the block centre (3,)
+    inside: float  #: [m] from ``point`` to where the block ends, the way the surface runs
+    block_end: FloatArray  #: that end of the block (3,); NaN when ``point`` is outside it
+    more: bool = False  #: the extrapolation went on past its limit (more rulings than counted)
+
+
+def _off_line(p: FloatArray, F: FloatArray) -> FloatArray:
+    """Distances [m] of points (..., 3) from the line of frame ``F`` (4, 4)."""
+    d = p - F[:3, 3]
+    z = F[:3, 2]
+    return np.linalg.norm(d - (d @ z)[..., None] * z, axis=-1)
+
+
+def _in_block(S: FloatArray, stock: Box) -> tuple[np.ndarray, FloatArray]:
+    """Which target rulings (K, 4, 4) cut ``stock`` (a chord longer than
+    :data:`SPAN_TOLERANCE`) and their chord ends (K, 2, 3) (NaN where they miss it)."""
+    c0, c1, hit = chords(S, stock)
+    cuts = hit & (np.nan_to_num(c1 - c0) > SPAN_TOLERANCE)
+    ends = S[:, None, :3, 3] + np.stack([c0, c1], 1)[:, :, None] * S[:, None, :3, 2]
+    return cuts, ends
+
+
+def _first_gap(F: FloatArray, side: int, centre: FloatArray) -> FloatArray:
+    """The extrapolated frames within the first gap past an end of ``F`` (M, 4, 4), at
+    most :data:`SPAN_STEP` apart where the rulings pass nearest ``centre`` (at most 999)."""
+    pair = anchored_frames(F[[0, 1]] if side == 0 else F[[-1, -2]], centre)[:, :3, 3]
+    m = int(np.clip(np.ceil(np.linalg.norm(pair[0] - pair[1]) / SPAN_STEP), 2, 1000))
+    return _extrapolated(F, side, np.arange(1, m) / m)
+
+
+def _overrun(
+    side: int, pair: FloatArray, ext: FloatArray, gap: FloatArray, stock: Box, index: int,
+    more: bool,
+) -> _Overrun | None:
+    """Whether the extrapolation past an end of the target rulings cuts ``stock``: ``pair``
+    (2, 4, 4) the end ruling and its neighbour, ``ext`` (K, 4, 4) the extrapolated rulings
+    at whole gaps past it (``more``: the extrapolation went on), ``gap`` (G, 4, 4) more
+    within its first gap (a surface stopping less than a gap short); None when it does
+    not cut the block."""
+    cuts, ends = _in_block(ext, stock)
+    g_cuts, g_ends = _in_block(gap, stock)
+    if not (cuts.any() or g_cuts.any()):
+        return None
+    e = pair[0]
+    reach = float(_off_line(np.concatenate([ends[cuts], g_ends[g_cuts]]), e).max())
+    near = anchored_frames(pair, stock.centre)[:, :3, 3]
+    point, run = near[0], near[0] - near[1]  # the way the surface runs past its end
+    run = run - (run @ e[:3, 2]) * e[:3, 2]
+    inside, block_end = np.nan, np.full(3, np.nan)
+    size = float(np.linalg.norm(run))
+    if stock.contains(point) and size > 0.0:
+        _, t_out, through = stock.clip_lines(point, run / size)
+        if through:
+            inside = float(t_out)
+            block_end = point + inside * run / size
+    name = "first" if side == 0 else "last"
+    return _Overrun(name, index, int(cuts.sum()), reach, point, inside, block_end, more)
+
+
+def _mm(x: float) -> str:
+    return f"{x * 1e3:.1f} mm"
+
+
+def _xyz(p: FloatArray) -> str:
+    return "[" + ", ".join(f"{round(float(v), 3) + 0.0:.3f}" for v in p) + "]"
+
+
+def _rulings(r: _Overrun) -> str:
+    if r.rulings == 0:
+        return "within the gap to the first extrapolated ruling"
+    return f"on {'more than ' if r.more else ''}{r.rulings} ruling{'s' if r.rulings > 1 else ''}"
+
+
+def _short_of_block(where: str, label: str, n: int, runs: list[_Overrun]) -> str:
+    """The refusal of a surface that stops short of the block (see :func:`cut_paths`)."""
+    parts = []
+    for r in runs:
+        at = (f"inside the block, {_mm(r.inside)} short of the block's end at "
+              f"{_xyz(r.block_end)} the way the surface runs" if np.isfinite(r.inside)
+              else "outside the block")  # fmt: skip
+        parts.append(
+            f"its {r.end} input ruling (index {r.index} of {n}, from 0) passes {_xyz(r.point)} "
+            f"(its point nearest the block centre), {at}; going on would cut the block "
+            f"{_rulings(r)} extrapolated from the surface (screw motion), up to "
+            f"{_mm(r.reach)} past that ruling"
+        )
+    return (
+        f"{where} the surface ({label}) stops short of the block: "
+        + "; ".join(parts)
+        + ". Extend the surface past the block (a built-in surface's u range, a file's "
+        f"rulings) or move the block; or add extend = true to {where} to cut the block "
+        "along the extrapolation"
+    )
+
+
+def _extended_note(where: str, runs: list[_Overrun]) -> str:
+    """The plan's note on a cut extended through the block (``extend = true``)."""
+    parts = [f"{_mm(r.reach)} past its {r.end} input ruling, {_rulings(r)}"
+             for r in runs]  # fmt: skip
+    return (
+        f"{where} extend = true: the surface stops short of the block and is cut on along "
+        f"its extrapolated frame motion (screw motion), {' and '.join(parts)}; the wire "
+        "deviation there is measured against the extrapolated rulings"
+    )
 
 
 def _translated(F: FloatArray, offset: FloatArray) -> FloatArray:
@@ -212,10 +349,10 @@ def cut_paths(
     if model is None:
         model = job.robot_model()
     rc = refine_cut(cut, job.stock, str(job.source or "job"), job.tool.wire_length)
+    where = "[cut]" if cut.name == "cut" else f"[cut '{cut.name}']"
     try:
         kerf = kerf_offsets(rc.frames, job.stock, cut.kerf, cut.keep, rc.closed)
     except ValueError as exc:  # name the job file and the cut's section
-        where = "[cut]" if cut.name == "cut" else f"[cut '{cut.name}']"
         raise ValueError(f"{job.source or 'job'}: {where} {exc}") from None
     wire = _translated(rc.frames, kerf.offset)
     if job.robot.home is not None:
@@ -230,16 +367,42 @@ def cut_paths(
                          "surface's pose")  # fmt: skip
     first, last = np.flatnonzero(near)[[0, -1]]
     keep = slice(max(first - 1, 0), last + 2)
-    F, before, after = _extend(wire[keep], grown)
+    W, off = wire[keep], kerf.offset[keep]
+    ext, runs = [], []
+    for side in (0, 1):
+        end = 0 if side == 0 else len(W) - 1
+        endless = None
+        try:
+            frames = _extension(W, side, grown)
+        except _Endless as exc:
+            frames, endless = exc.frames, exc
+        run = None
+        if len(frames):  # the surface ends within the lead of the stock, or in it
+            # the target rulings past this end (the wire's, moved back by its kerf offset)
+            run = _overrun(side, _translated(W[[end, end + 1 - 2 * side]], -off[end]),
+                           _translated(frames, -off[end]),
+                           _translated(_first_gap(W, side, job.stock.centre), -off[end]),
+                           job.stock, 0 if side == 0 else rc.input_rulings - 1,
+                           endless is not None)  # fmt: skip
+        if endless is not None and (run is None or cut.extend):
+            raise ValueError(f"{job.source or 'job'}: {where} {endless}") from None
+        if run is not None:
+            runs.append(run)
+        ext.append(frames)
+    if runs and not cut.extend:  # the extrapolation is a lead-in/out, never the surface
+        raise ValueError(f"{job.source or 'job'}: " + _short_of_block(
+            where, cut.surface.label, rc.input_rulings, runs))  # fmt: skip
+    before, after = len(ext[0]), len(ext[1])
+    F = np.concatenate([ext[0][::-1], W, ext[1]])
     if _x_jumps(F):  # a corner turned the frames about the rulings: roll = bow attitude
         F = world_referenced(F)
-    off = kerf.offset[keep]
     off = np.concatenate([np.repeat(off[:1], before, 0), off, np.repeat(off[-1:], after, 0)])
     S = _translated(F, -off)  # the target rulings (the lead-in/out ones lie outside the stock)
+    notes = (_extended_note(where, runs),) if runs else ()
     err = np.r_[np.zeros(before), kerf.error[keep], np.zeros(after)]
     motion = solve_redundancy(F, job.stock, job.tool, model, **search)
     return [CutPath(F, motion, rc.steps, (before, after), rc.input_rulings, cut.name,
-                    S, err, kerf.compensated)]  # fmt: skip
+                    S, err, kerf.compensated, notes=notes)]  # fmt: skip
 
 
 def cut_path(job: Job, model=None, **search: float) -> CutPath:

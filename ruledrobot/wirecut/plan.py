@@ -17,18 +17,21 @@ from pathlib import Path
 
 import numpy as np
 
-from ..geometry import se3
 from ..geometry.checks import FloatArray
 from ..robot.rates import trajectory_limits_report
 from ..robot.tool import BowTool
 from ..robot.trajectory import Heat, Trajectory, phases_from_labels, runs
-from .measure import feed_speeds, wire_points
+from ..robot.wire_cut import FeedWindow, WireCut
+from .densify import target_frames
 from .motion import Motion, assemble_motion
 from .order import check_cut_order
 from .path import CutPath, cut_paths
 from .spec import Job
+from .toolpath import distance_from_rulings
 
-__all__ = ["SINGULARITY_MARGIN", "Plan", "PlannedMeasures", "make_plan", "wire_deviation"]
+__all__ = [
+    "SINGULARITY_MARGIN", "Plan", "PlannedMeasures", "make_plan", "wire_cut", "wire_deviation",
+]
 
 SINGULARITY_MARGIN = 0.02  # the redundancy search's own threshold (solve_redundancy)
 
@@ -38,7 +41,7 @@ class PlannedMeasures:
     """Measurements of the planned (sampled) motion, per sample (M,) where arrays."""
 
     flange: FloatArray = field(repr=False)  # (M, 4, 4) flange poses
-    feed: FloatArray = field(repr=False)  # m/s of the wire inside the stock (0 outside)
+    feed: FloatArray = field(repr=False)  # m/s, the cutting speed (NaN outside the stock)
     deviation: FloatArray = field(repr=False)  # m, wire from its target ruling (0 outside)
     ratios: dict = field(repr=False)  # trajectory_limits_report
     position_ratio: float
@@ -83,7 +86,8 @@ def wire_deviation(plan: Plan, q: FloatArray) -> FloatArray:
     """Per sample (M,) the distance [m] of the wire's chord ends, with joints ``q``
     (M, 6), from the target ruling of its pass at the same path parameter — the z axis
     of the wire's frame motion there (the screw geodesic between neighbouring frames);
-    0 outside the stock."""
+    0 outside the stock.  The chord is the planned one (the one model,
+    ``plan.motion.wire``), as points of the wire."""
     mo = plan.motion
     flange = plan.model.fk(q)
     out = np.zeros(len(q))
@@ -91,12 +95,33 @@ def wire_deviation(plan: Plan, q: FloatArray) -> FloatArray:
         rows = np.flatnonzero((mo.pass_of == k) & mo.in_stock)
         if not rows.size:
             continue
-        i0, frac = cp.locate(mo.s[rows])
-        target = se3.geodesic(cp.frames[i0], cp.frames[i0 + 1], frac)
-        off = wire_points(flange[rows], mo.ends[rows]) - target[:, None, :3, 3]
-        dist = np.linalg.norm(np.cross(off, target[:, None, :3, 2]), axis=-1).max(axis=1)
-        out[rows] = dist
+        _, target = target_frames(cp, mo.s[rows])
+        pts = wire_points(flange[rows], mo.ends[rows])
+        out[rows] = distance_from_rulings(pts, target)
     return out
+
+
+def wire_points(flange: FloatArray, points_in_flange: FloatArray) -> FloatArray:
+    """World positions (M, K, 3) of flange-frame points (M, K, 3) under poses (M, 4, 4)."""
+    return np.einsum("mij,mkj->mki", flange[:, :3, :3], points_in_flange) + flange[:, None, :3, 3]
+
+
+def wire_cut(job: Job, motion: Motion) -> WireCut:
+    """What the planned trajectory cuts (the sidecar's ``cut``): the block, the wire and
+    per pass the feed window — the pass's samples, the cut's feed and tolerance, and
+    where the feed is held (its cut phase less the corner stops and slits)."""
+    held_all = motion.surface & ~(False if motion.corner_stop is None else motion.corner_stop)
+    feeds = []
+    for k, cp in enumerate(motion.passes):
+        rows = np.flatnonzero(motion.pass_of == k)
+        if not rows.size:
+            continue
+        cut = next(c for c in job.cuts if c.name == cp.name)
+        mask = np.zeros(len(motion.pass_of), dtype=bool)
+        mask[rows] = True
+        feeds.append(FeedWindow(cut.name, int(rows[0]), int(rows[-1]) + 1, cut.feed_speed,
+                                cut.feed_tolerance, runs(held_all & mask)))  # fmt: skip
+    return WireCut(job.stock, BowTool.from_spec(job.tool).wire_length, tuple(feeds))
 
 
 def _position_ratio(model, q: FloatArray) -> float:
@@ -167,7 +192,7 @@ def make_plan(
     t2 = time.perf_counter()
     timed = motion.timed
     flange = model.fk(timed.q)
-    feed = feed_speeds(timed.t, flange, motion.ends, motion.in_stock)
+    feed = motion.wire.feed
     plan = Plan(job, model, tuple(passes), motion, None, None, reasons,
                 notes + motion.notes, timings)  # fmt: skip
     dev = wire_deviation(plan, timed.q)
@@ -186,8 +211,8 @@ def make_plan(
     robot = dataclasses.replace(robot, tool_mass=job.tool.mass, tool_com=bow.inertia()[0])
     trajectory = Trajectory.from_joints(
         timed.t, timed.q, robot, base=job.robot.base, phases=phases_from_labels(motion.labels),
-        in_stock=runs(motion.in_stock), job=job_reference(job), source="ruledrobot plan",
-        heat=_heat(job, motion),
+        in_stock=motion.wire.runs(), job=job_reference(job), source="ruledrobot plan",
+        heat=_heat(job, motion), cut=wire_cut(job, motion),
     )  # fmt: skip
     timings["measure_s"] = time.perf_counter() - t2
     return dataclasses.replace(plan, trajectory=trajectory, measured=measured)

@@ -129,7 +129,9 @@ class CutSpec:
 
     ``keep``: which side of the surface is the part — a point of the part (3,) in the
     base frame, ``"inside"`` / ``"outside"`` for a closed surface, or None (the wire
-    runs on the surface itself and the kerf is not compensated).
+    runs on the surface itself and the kerf is not compensated).  ``extend``: an open
+    surface that stops short of the block is cut on through it along the extrapolated
+    frame motion (noted) instead of being refused (:func:`.path.cut_paths`).
     """
 
     name: str
@@ -142,6 +144,7 @@ class CutSpec:
     keep: str | np.ndarray | None = field(default=None, repr=False)
     wire_tolerance: float = 0.0005
     feed_tolerance: float = 0.05
+    extend: bool = False
 
 
 @dataclass(frozen=True)

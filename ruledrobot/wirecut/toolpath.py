@@ -29,11 +29,13 @@ from ..geometry import se3
 from ..geometry.box import Box
 from ..geometry.checks import FloatArray
 from ..robot.tool import BowTool
+from ..robot.wire_in_stock import across_speeds, feed_chord, wire_ends
 from .spec import ToolSpec
 
 __all__ = [
     "anchored_frames",
     "chords",
+    "distance_from_rulings",
     "flange_poses",
     "slide_bounds",
     "speed_factor",
@@ -147,30 +149,33 @@ def flange_poses(wire: ArrayLike, W: ArrayLike) -> FloatArray:
 
 
 def speed_factor(
-    flange: ArrayLike, path_s: ArrayLike, ends_in_flange: ArrayLike, hit: ArrayLike
+    flange: ArrayLike, path_s: ArrayLike, tool: ToolSpec, stock: Box, near: float
 ) -> FloatArray:
-    """Metres moved by the fastest wire point inside the stock per unit of path parameter.
+    """Metres moved across the wire by its fastest point in (or, within ``near`` m,
+    nearest) the stock per unit of path parameter: the time law's feed bound.
 
-    ``flange`` (M, 4, 4) flange poses along the path at parameters ``path_s`` (M,),
-    ``ends_in_flange`` (M, 2, 3) the chord end points as material points of the
-    wire (flange coordinates), ``hit`` (M,) where a chord exists.  The velocity
-    of a rigid body is affine along the wire, so its largest value over the chord
-    is at one of the ends.  Central differences (one-sided at the path ends);
-    0 where there is no chord.
+    ``flange`` (M, 4, 4) flange poses along the path at parameters ``path_s`` (M,).
+    The chord and the speed across the wire come from the one model of the wire
+    against the block (:func:`ruledrobot.robot.wire_in_stock.feed_chord`,
+    :func:`~ruledrobot.robot.wire_in_stock.across_speeds`): where the wire is outside
+    but near the block, its point nearest the block, so that the bound meets the
+    chord's without a jump as the wire enters and leaves.  0 further away.
     """
-    P = np.asarray(flange, dtype=np.float64)
-    s = np.asarray(path_s, dtype=np.float64)
-    e = np.asarray(ends_in_flange, dtype=np.float64)
-    hit = np.asarray(hit, dtype=bool)
-    m = P.shape[0]
-    if m < 2:
-        return np.zeros(m)
-    nxt = np.minimum(np.arange(m) + 1, m - 1)
-    prv = np.maximum(np.arange(m) - 1, 0)
-    e_safe = np.where(hit[:, None, None], e, 0.0)
-    # world position of the same material points under the neighbouring poses
-    ahead = np.einsum("mij,mkj->mki", P[nxt, :3, :3], e_safe) + P[nxt, None, :3, 3]
-    behind = np.einsum("mij,mkj->mki", P[prv, :3, :3], e_safe) + P[prv, None, :3, 3]
-    ds = (s[nxt] - s[prv])[:, None]
-    speed = np.linalg.norm(ahead - behind, axis=-1) / ds
-    return np.where(hit, speed.max(axis=1), 0.0)
+    bow = BowTool.from_spec(tool)
+    ends = wire_ends(np.asarray(flange, dtype=np.float64) @ bow.wire_frame(), bow.wire_length)
+    f = feed_chord(ends, stock, near)
+    if len(ends) < 2:
+        return np.zeros(len(ends))
+    return np.nan_to_num(across_speeds(path_s, ends, f), nan=0.0).max(axis=1)
+
+
+def distance_from_rulings(points: ArrayLike, frames: ArrayLike) -> FloatArray:
+    """The largest distance (K,) [m] of points (K, P, 3) from the lines of frames
+    (K, 4, 4) (origin, z axis): ``max_p |(x_p - o) x z|``; NaN points are left out
+    (0 when all are NaN).  The wire's deviation from its target ruling, with the points
+    its chord ends and the frames the target rulings at the same path parameter."""
+    x = np.asarray(points, dtype=np.float64)
+    F = np.asarray(frames, dtype=np.float64)
+    off = x - F[:, None, :3, 3]
+    d = np.linalg.norm(np.cross(off, F[:, None, :3, 2]), axis=-1)
+    return np.nan_to_num(d, nan=0.0).max(axis=1) if d.size else np.zeros(len(F))

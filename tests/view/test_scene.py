@@ -14,7 +14,6 @@ from ruledrobot.io.mesh import read_stl
 from ruledrobot.io.trajectory import read_trajectory
 from ruledrobot.sim import Scene
 from ruledrobot.sim._mujoco import mujoco
-from ruledrobot.sim.cutting import chords, feed_speeds
 from ruledrobot.view import NotAPlanFolder, build_scene, read_plan_folder
 from ruledrobot.view.clearance import contacts_along, near_misses
 from ruledrobot.view.geoms import geom_meshes
@@ -153,29 +152,6 @@ def test_a_moved_plan_folder_still_opens(tmp_path, plan_folder):
     folder = read_plan_folder(copy)
     assert any("gone.json" in n for n in folder.notes)
     assert folder.trajectory is not None and folder.rulings is not None
-
-
-def test_feed_of_a_translating_and_a_turning_wire():
-    stock = Box(centre=[0.0, 0.0, 0.0], size=[0.2, 0.2, 0.2])
-    t = np.linspace(0.0, 2.0, 201)
-    x = -0.3 + 0.3 * t  # the wire along y moves along x at 0.3 m/s
-    ends = np.stack([np.stack([x, -0.5 + 0 * t, 0 * t], 1), np.stack([x, 0.5 + 0 * t, 0 * t], 1)],
-                    axis=1)  # fmt: skip
-    feed = feed_speeds(t, ends, stock)
-    inside = np.abs(x) < 0.1
-    np.testing.assert_allclose(feed[inside], 0.3, rtol=1e-9)
-    assert np.isnan(feed[np.abs(x) > 0.1 + 1e-9]).all()
-    lo, hi, hit = chords(ends, stock)
-    np.testing.assert_allclose(lo[hit], 0.4)
-    np.testing.assert_allclose(hi[hit], 0.6)
-    # turning about its middle (inside the stock) at 1 rad/s: the chord ends are fastest
-    a = t
-    d = np.stack([np.cos(a), np.sin(a), 0 * a], 1)
-    ends = np.stack([-0.5 * d, 0.5 * d], axis=1)
-    lo, hi, hit = chords(ends, stock)
-    half = 0.5 * (hi - lo) * 1.0  # chord half length (wire length 1 m)
-    feed = feed_speeds(t, ends, stock)
-    np.testing.assert_allclose(feed[5:-5], half[5:-5], rtol=2e-3)
 
 
 def test_geom_meshes_lie_on_the_primitive_surfaces(plan_folder):

@@ -76,16 +76,24 @@ def test_wire_covers_its_chord(psi, frac, reverse, seed):
 
 
 def test_speed_factor_known_motions():
+    """The time law's bound: speed across the wire per unit of s, from the one model."""
     s = np.linspace(0.0, 1.0, 11)
+    big = Box([0.0, 0.05, 0.25], [1.0, 1.0, 1.0])
     P = np.broadcast_to(np.eye(4), (11, 4, 4)).copy()
-    P[:, 0, 3] = 0.3 * s  # translation: 0.3 m per unit of s
-    ends = np.broadcast_to([[0.0, 0.1, 0.2], [0.0, -0.1, 0.2]], (11, 2, 3))
-    hit = np.ones(11, bool)
-    hit[3] = False
-    f = tp.speed_factor(P, s, ends, hit)
-    np.testing.assert_allclose(np.delete(f, 3), 0.3)
-    assert f[3] == 0.0
-    # rotation about the flange z axis by 2 rad per unit of s: speed 2 r at radius r
+    P[:, 1, 3] = 0.3 * s  # translation across the wire (along flange y): 0.3 m per unit s
+    np.testing.assert_allclose(tp.speed_factor(P, s, TOOL, big, 0.0), 0.3, rtol=1e-12)
+    P = np.broadcast_to(np.eye(4), (11, 4, 4)).copy()
+    P[:, 0, 3] = 0.3 * s  # sliding along the wire cuts nothing
+    np.testing.assert_allclose(tp.speed_factor(P, s, TOOL, big, 0.0), 0.0, atol=1e-12)
+    # far from a small block: 0; within `near` of it: the speed of the nearest point
+    far = Box([0.0, 2.0, 0.25], [0.1, 0.1, 0.1])
+    P[:, 1, 3] = 0.3 * s
+    P[:, 0, 3] = 0.0
+    assert (tp.speed_factor(P, s, TOOL, far, 0.5) == 0.0).all()
+    np.testing.assert_allclose(tp.speed_factor(P, s, TOOL, far, 2.0), 0.3, rtol=1e-12)
+    # rotation about the flange z axis by 2 rad per unit of s: the wire (at y = 0.05,
+    # z = 0.25, along x) sweeps; its chord ends at x = +-0.2 are fastest across it
     P = se3.pose_from_rotvec(np.c_[0 * s, 0 * s, 2.0 * s])
-    f = tp.speed_factor(P, s, ends, np.ones(11, bool))
-    np.testing.assert_allclose(f[1:-1], 2.0 * 0.1 * np.sinc(2 * 0.1 / np.pi), rtol=1e-12)
+    f = tp.speed_factor(P, s, TOOL, big, 0.0)
+    r = 0.2  # across-wire part of the velocity of the end at radius hypot(0.2, 0.05)
+    np.testing.assert_allclose(f[1:-1], 2.0 * r * np.sinc(2 * 0.1 / np.pi), rtol=1e-9)

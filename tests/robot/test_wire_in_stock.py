@@ -1,0 +1,136 @@
+"""The one model of the wire against the block, against closed forms and an independent
+measure written here (points of the wire tested inside the box, speeds across the wire by
+dense sampling), over random motions (hypothesis)."""
+
+from __future__ import annotations
+
+import numpy as np
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from ruledrobot.geometry import se3
+from ruledrobot.geometry.box import Box
+from ruledrobot.robot.wire_cut import FeedWindow, WireCut, feed_measures
+from ruledrobot.robot.wire_in_stock import (
+    TOUCH,
+    feed_chord,
+    wire_ends,
+    wire_in_stock,
+)
+
+STOCK = Box(centre=[0.0, 0.0, 0.0], size=[0.2, 0.2, 0.2])
+
+
+def test_translating_wire_closed_form():
+    t = np.linspace(0.0, 2.0, 201)
+    x = -0.3 + 0.3 * t  # the wire along y moves along x at 0.3 m/s
+    ends = np.stack([np.stack([x, -0.5 + 0 * t, 0 * t], 1), np.stack([x, 0.5 + 0 * t, 0 * t], 1)],
+                    axis=1)  # fmt: skip
+    w = wire_in_stock(t, ends, STOCK)
+    inside = np.abs(x) <= 0.1
+    np.testing.assert_array_equal(w.inside, inside)
+    np.testing.assert_allclose(w.feed[inside], 0.3, rtol=1e-9)
+    assert np.isnan(w.feed[~inside]).all()
+    np.testing.assert_allclose(w.lo[inside], 0.4)
+    np.testing.assert_allclose(w.hi[inside], 0.6)
+    np.testing.assert_allclose(w.depth[inside], 0.1 - np.abs(x[inside]), atol=1e-12)
+    assert w.runs() == ((int(np.argmax(inside)), int(np.flatnonzero(inside)[-1]) + 1),)
+
+
+def test_turning_wire_and_sliding_wire():
+    t = np.linspace(0.0, 2.0, 2001)
+    d = np.stack([np.cos(t), np.sin(t), 0 * t], 1)  # turning about its middle at 1 rad/s
+    w = wire_in_stock(t, np.stack([-0.5 * d, 0.5 * d], axis=1), STOCK)
+    half = 0.5 * w.chord_length  # the chord ends are fastest: omega * r
+    np.testing.assert_allclose(w.feed[5:-5], half[5:-5], rtol=1e-5)
+    # sliding along itself cuts nothing
+    z = 0.2 * t
+    ends = np.stack([np.stack([0 * t, 0 * t, z - 0.5], 1), np.stack([0 * t, 0 * t, z + 0.5], 1)],
+                    axis=1)  # fmt: skip
+    w = wire_in_stock(t, ends, STOCK)
+    assert w.inside.all()
+    np.testing.assert_allclose(w.feed, 0.0, atol=1e-12)
+
+
+def test_touching_is_not_inside_and_depth_of_a_diagonal():
+    # a wire along an edge of the block only touches it ... (chord on the boundary has
+    # length; a wire crossing a corner point has a chord shorter than TOUCH)
+    a = np.array([[[0.1 + 1e-7, -1.0, 0.0], [0.1 - 1e-7, 1.0, 0.0]]])  # 2e-7 inside at x
+    w = wire_in_stock([0.0], a, STOCK)
+    assert w.chord_length[0] > TOUCH and w.inside[0]
+    corner = np.array([[[0.2, 0.0, 0.0], [0.0, 0.2, 0.0]]])  # touches the edge x=y=0.1
+    assert not wire_in_stock([0.0], corner, STOCK).inside[0]
+    diag = np.array([[[-1.0, -1.0, -1.0], [1.0, 1.0, 1.0]]])  # through the centre
+    np.testing.assert_allclose(wire_in_stock([0.0], diag, STOCK).depth, 0.1, atol=1e-12)
+
+
+def test_feed_chord_meets_the_chord_without_a_jump():
+    t = np.linspace(0.0, 1.0, 1001)
+    x = -0.2 + 0.2 * t  # enters the block's face x = -0.1 at t = 0.5
+    ends = np.stack([np.stack([x, -0.5 + 0 * t, 0.05 + 0 * t], 1),
+                     np.stack([x, 0.5 + 0 * t, 0.05 + 0 * t], 1)], axis=1)  # fmt: skip
+    f = feed_chord(ends, STOCK, near=0.05)
+    far = x < -0.15 - 1e-9
+    assert np.isnan(f[far]).all()
+    near = (x > -0.15 + 1e-9) & (x < -0.1)
+    assert np.isfinite(f[near]).all()
+    # the nearest point lies on the face's extent, within the chord the wire gets
+    assert ((f[near] >= 0.4 - 1e-6) & (f[near] <= 0.6 + 1e-6)).all()
+
+
+def _independent(t: np.ndarray, ends: np.ndarray, box: Box, n: int = 2001):
+    """Points of the wire tested inside the box; speeds across the wire of every point."""
+    lam = np.linspace(0.0, 1.0, n)
+    a, b = ends[:, 0], ends[:, 1]
+    pts = a[:, None] + lam[None, :, None] * (b - a)[:, None]
+    inbox = np.all(np.abs(box.to_box(pts)) <= 0.5 * box.size, axis=-1)
+    v = np.gradient(pts, t, axis=0)
+    d = (b - a) / np.linalg.norm(b - a, axis=1, keepdims=True)
+    across = v - (v * d[:, None]).sum(-1, keepdims=True) * d[:, None]
+    speed = np.where(inbox, np.linalg.norm(across, axis=-1), -np.inf).max(axis=1)
+    length = inbox.sum(axis=1) / (n - 1) * np.linalg.norm(b - a, axis=1)
+    return inbox.sum(axis=1) >= 3, speed, length
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    st.floats(-0.2, 0.2), st.floats(-0.2, 0.2), st.floats(-0.2, 0.2),  # start offset
+    st.floats(-1.0, 1.0), st.floats(-1.0, 1.0), st.floats(-1.0, 1.0),  # rotation vector rate
+    st.floats(-0.3, 0.3), st.floats(-0.3, 0.3), st.floats(-0.3, 0.3),  # velocity
+    st.floats(0.3, 0.8),  # wire length
+    st.floats(0.05, 0.3), st.floats(0.05, 0.3), st.floats(0.05, 0.3),  # block size
+)
+def test_model_equals_an_independent_measure(x0, y0, z0, wx, wy, wz, vx, vy, vz, L, a, b, c):
+    """A rigid wire moving on a screw motion through a block: inside, chord length and
+    cutting speed agree with dense sampling of the wire's points."""
+    box = Box([0.01, -0.02, 0.03], [a, b, c], se3.pose_from_rotvec([0.3, -0.2, 0.5])[:3, :3])
+    t = np.linspace(0.0, 1.0, 401)
+    T = se3.pose_from_rotvec(np.outer(t, [wx, wy, wz]))
+    T[:, :3, 3] = np.array([x0, y0, z0]) + np.outer(t, [vx, vy, vz]) - 0.15 * np.array([vx, vy, vz])
+    ends = wire_ends(T, L)
+    w = wire_in_stock(t, ends, box)
+    inside, speed, length = _independent(t, ends, box)
+    step = L / 2000
+    clear = (w.chord_length > 4 * step) | ~w.inside  # away from grazing touches
+    k = np.arange(2, t.size - 2)
+    k = k[clear[k]]
+    np.testing.assert_array_equal(w.inside[k], inside[k])
+    np.testing.assert_allclose(w.chord_length[k], length[k], atol=2 * step)
+    m = k[w.inside[k]]
+    # the dense measure's points lie within one step inside the chord's ends
+    np.testing.assert_allclose(w.feed[m], speed[m], rtol=5e-3, atol=2e-4)
+
+
+def test_feed_measures_of_windows():
+    t = np.linspace(0.0, 2.0, 201)
+    x = -0.3 + 0.3 * t
+    ends = np.stack([np.stack([x, -0.5 + 0 * t, 0 * t], 1), np.stack([x, 0.5 + 0 * t, 0 * t], 1)],
+                    axis=1)  # fmt: skip
+    w = wire_in_stock(t, ends, STOCK)
+    cut = WireCut(STOCK, 1.0, (FeedWindow("a", 0, 201, 0.3, 0.05, ((80, 120),)),))
+    (fm,) = feed_measures(w, cut)
+    assert fm.max_ok and fm.min_ok and abs(fm.highest - 0.3) < 1e-9
+    (fm,) = feed_measures(w, WireCut(STOCK, 1.0, (FeedWindow("a", 0, 201, 0.25, 0.05),)))
+    assert not fm.max_ok and 67 <= fm.at_highest <= 133
+    sliced = cut.sliced(100, 201)
+    assert sliced.feeds[0].start == 0 and sliced.feeds[0].held == ((0, 20),)
