@@ -94,8 +94,10 @@ def run(
     """Stream a planned trajectory to a UR controller through RTDE (ur_rtde): checks the
     controller (robot model, period, state) and shows the approach move before asking to
     start; monitors the motion, stops safely, says where and how to resume; records the
-    actual trajectory (<name>.run-NNN.csv).  Exit 0 completed, 1 refused or stopped, 2 bad
-    input."""
+    actual trajectory (<name>.run-NNN.csv) and measures it: the run's verdict (the feed and
+    the wire in the block, samples skipped in the foam) is printed and written into the
+    recording's sidecar.  Exit 0 completed and every check holds, 1 refused, stopped or a
+    check of the executed cut failed, 2 bad input."""
     import sys
 
     if not (yes or dry_run or sys.stdin.isatty()):
@@ -107,13 +109,15 @@ def run(
     result = stream(trajectory, host, yes=yes, mode=mode.value, speed_scale=speed_scale,
                      dry_run=dry_run, start_index=resume or 0,
                      force_kinematics=force)  # fmt: skip
-    if not result.completed or (result.verdict is not None and not result.verdict.ok):
+    if not result.ok:
         raise typer.Exit(code=1)
 
 
 def stream(trajectory: Path, host: str | None, *, yes: bool = False, **options):
     """Run ``trajectory`` (the CLI's side of :func:`run_trajectory`): checks table,
-    confirmation, progress bar, where it stopped and the resume command."""
+    confirmation, progress bar, where it stopped and the resume command, the run's
+    verdict.  A run that completed but whose executed cut broke a check exits 1 here
+    (``typer.Exit``), after everything is printed and written."""
     from rich.text import Text
 
     from ..export import ControllerError, run_trajectory
@@ -127,6 +131,7 @@ def stream(trajectory: Path, host: str | None, *, yes: bool = False, **options):
         raise fail(str(exc)) from None
     dry_run = bool(options.get("dry_run"))
     target = host
+    emu = None
     shown: list[bool] = []
 
     def show_plan(plan) -> None:
@@ -150,13 +155,15 @@ def stream(trajectory: Path, host: str | None, *, yes: bool = False, **options):
                 target = EMBEDDED_HOST
                 console.print(f"no --host: starting the embedded MuJoCo-backed controller "
                               f"emulator on {target}")  # fmt: skip
-                stack.enter_context(embedded_emulator(traj.meta.robot, traj.q[0], target))
+                emu = stack.enter_context(embedded_emulator(traj.meta.robot, traj.q[0], target))
             try:
                 result = run_trajectory(trajectory, target, traj.meta.robot,
                                         progress=bar.update, confirm=confirm,
                                         **options)  # fmt: skip
             finally:
                 bar.stop()
+            if emu is not None:
+                say_emulator_clock(emu)
     except (ValueError, ControllerError) as exc:
         raise fail(str(exc)) from None
     if not shown and result.verdict is not None:
@@ -177,6 +184,9 @@ def stream(trajectory: Path, host: str | None, *, yes: bool = False, **options):
                           f"{1e3 * result.max_slip:.0f} ms and skipped "
                           f"{result.samples_skipped} samples to keep the plan's timing",
                           highlight=False)  # fmt: skip
+    if result.moved and not result.realtime and result.priority:
+        err.print(Text(f"  runner: the streaming process ran at {result.priority}: "
+                       "a busy machine may delay its commands"), highlight=False)  # fmt: skip
     if result.stop is not None and result.status != "completed":
         console.print(Text(f"  stopped at {result.stop.describe()}"), highlight=False)
         cmd = resume_command(trajectory, host, options.get("mode", "servoj"),
@@ -184,10 +194,33 @@ def stream(trajectory: Path, host: str | None, *, yes: bool = False, **options):
         console.print(Text(f"  resume with: {cmd}", style="bold"), highlight=False)
     if result.client:
         err.print(Text(f"  ur_rtde client: {result.client}"), highlight=False)
+    if result.run_verdict is not None:
+        print_verdict(result.run_verdict, "the executed cut (measured on the recording)")
     if result.actual_path is not None:
-        console.print(f"wrote {result.actual_path}  (recording of the actual motion)",
-                      highlight=False, markup=False)  # fmt: skip
+        console.print(f"wrote {result.actual_path}  (recording of the actual motion; its "
+                      "measures and verdict in the sidecar's \"run\")", highlight=False,
+                      markup=False)  # fmt: skip
+    if result.status == "completed" and not result.ok:
+        raise typer.Exit(code=1)
     return result
+
+
+def say_emulator_clock(emu) -> None:
+    """After a run on the embedded emulator: say when its clock could not run at real-time
+    priority, or missed periods."""
+    from rich.text import Text
+
+    try:
+        s = emu.stats_summary()
+    except Exception:  # the emulator is gone: nothing to say
+        return
+    if not s.get("realtime_clock", 0.0):
+        err.print(Text("  emulator: its clock thread ran at normal priority (SCHED_FIFO "
+                       "refused: no CAP_SYS_NICE): a busy machine may delay the controller's "
+                       "periods"), highlight=False)  # fmt: skip
+    if s.get("missed", 0.0):
+        err.print(Text(f"  emulator: its clock missed {s['missed']:.0f} periods (longest gap "
+                       f"{s['gap_max_ms']:.1f} ms)"), highlight=False)  # fmt: skip
 
 
 @app.command(epilog="Example:  ruledrobot ursim --host 127.0.0.2 --model ur5e")

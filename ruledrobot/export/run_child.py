@@ -18,6 +18,11 @@ The child ignores SIGINT and runs in its own session (the terminal's Ctrl-C
 goes to the supervisor, which asks for a safe stop), and is killed when the
 supervisor dies (``PR_SET_PDEATHSIG``; the controller's watchdog then stops
 the program).
+
+It raises its scheduling priority first (:func:`raise_priority`, before ur_rtde
+starts its threads, which inherit it): a stream that must send every 2 ms cannot
+wait behind whatever else the machine runs.  The ``state`` message says what it got
+(``"priority"``), and the runner says so when it is not real-time.
 """
 
 from __future__ import annotations
@@ -33,7 +38,35 @@ from ..robot.trajectory import Heat
 from .run_motion import approach, preheat, run_path, stream
 from .run_session import Link, Session, SessionError, Stop
 
-__all__ = ["main"]
+__all__ = ["NICE", "RT_PRIORITY", "main", "raise_priority"]
+
+#: SCHED_RR priority of the streaming process: low (1-99), below the emulator's clock
+#: (10) and servers (5), so that a controller emulated on the same machine goes first
+RT_PRIORITY = 4
+#: the nice value tried when real-time scheduling is refused
+NICE = -10
+
+
+def raise_priority(rt_priority: int = RT_PRIORITY, nice: int = NICE) -> tuple[bool, str]:
+    """Raise the calling thread's scheduling priority (threads it starts later inherit
+    it): ``SCHED_RR`` ``rt_priority`` where the OS allows (Linux, root or CAP_SYS_NICE),
+    else nice ``nice``.  Returns (real-time, what it got in words)."""
+    why = "not supported on this OS"
+    setter = getattr(os, "sched_setscheduler", None)
+    if setter is not None:
+        try:
+            setter(0, os.SCHED_RR, os.sched_param(rt_priority))
+            return True, f"SCHED_RR {rt_priority}"
+        except (OSError, AttributeError) as exc:
+            why = getattr(exc, "strerror", None) or str(exc)
+    try:
+        os.setpriority(os.PRIO_PROCESS, 0, nice)
+        return False, f"nice {nice} (real-time scheduling refused: {why})"
+    except (OSError, AttributeError) as exc:
+        now = os.getpriority(os.PRIO_PROCESS, 0) if hasattr(os, "getpriority") else 0
+        refused = getattr(exc, "strerror", None) or exc
+        return False, (f"normal priority, nice {now} (real-time scheduling refused: {why}; "
+                       f"nice {nice} refused: {refused})")  # fmt: skip
 
 
 def _die_with_parent() -> None:
@@ -110,6 +143,7 @@ def main(fd: int) -> None:  # pragma: no cover - runs in the child
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     _die_with_parent()
     conn = Connection(fd)
+    realtime, priority = raise_priority()
     try:
         cfg = conn.recv()
         link = Link(conn)
@@ -121,6 +155,8 @@ def main(fd: int) -> None:  # pragma: no cover - runs in the child
         except (SessionError, RuntimeError) as exc:
             link.send("error", str(exc))
             return
+        state["priority"] = priority
+        state["realtime"] = realtime
         link.send("state", state)
         msg = conn.recv()
         if msg[0] == "go":

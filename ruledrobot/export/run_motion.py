@@ -13,7 +13,21 @@ import numpy as np
 
 from .run_session import Session, Stop
 
-__all__ = ["approach", "preheat", "run_path", "stream"]
+__all__ = ["approach", "preheat", "run_path", "stream", "wait_until"]
+
+#: s: the end of a wait is spun, not slept (a sleep may wake this much late)
+SPIN = 0.0004
+
+
+def wait_until(deadline: float) -> None:
+    """Return at ``time.monotonic()`` >= ``deadline``: sleep, then spin the last
+    :data:`SPIN` seconds (as ur_rtde's ``waitPeriod`` does)."""
+    while True:
+        left = deadline - time.monotonic()
+        if left <= 0.0:
+            return
+        if left > SPIN:
+            time.sleep(left - SPIN)
 
 
 def approach(
@@ -94,14 +108,16 @@ def stream(
     while k < K:
         if hot is not None and bool(hot[k]) != s.hot:
             s.set_heat(bool(hot[k]))
-        t0 = c.initPeriod()
         if not c.servoJ(rows[k], 0.0, 0.0, dt, lookahead, gain):
             raise s.classify(f"servoJ of grid sample {k}")
         s.sent = k
         qa = s.poll()
         s.check_deviation(q_grid, qa, k)
         s.service()
-        c.waitPeriod(t0)
+        # the next sample's time on the schedule (absolute: a wait of one period after
+        # each send would add this loop's own time every period and drift behind, and
+        # keep_schedule would then skip a sample every ~100 periods on an idle machine)
+        wait_until(start + (k + 1) * dt)
         k = s.keep_schedule(k, time.monotonic() - start, K)
     # hold the final target until the filter has converged
     last = rows[-1]

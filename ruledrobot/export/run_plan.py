@@ -17,7 +17,12 @@ start sample ``N`` (``--resume N``; 0 for a fresh run), one of:
 
 It refuses (a failing check) when the arm is at the planned pose of an
 in-stock sample that is not near ``N``: the wire is in the stock there, and a
-moveJ would drag it through uncut material.
+moveJ would drag it through uncut material; and when the in-stock run of ``N``
+has no sample outside the block before it to enter from.
+
+Whether the wire is in the block at a sample comes from the one model of the wire
+against the block (:func:`inside_mask`: :meth:`Trajectory.wire_in_stock` when the
+metadata names its cut, else the sidecar's ``in_stock``).
 """
 
 from __future__ import annotations
@@ -36,6 +41,7 @@ from ..robot.verdict import Check
 __all__ = [
     "Entry",
     "StopPlace",
+    "inside_mask",
     "moveJ_time",
     "path_waypoints",
     "plan_entry",
@@ -83,21 +89,35 @@ class Entry:
         return self.check.ok
 
 
-def _in_stock_run(traj: Trajectory, k: int) -> tuple[int, int] | None:
-    for a, b in traj.meta.in_stock:
-        if a <= k < b:
-            return a, b
-    return None
+def inside_mask(traj: Trajectory) -> np.ndarray:
+    """(M,) bool: the wire is in the block at sample k — from the one model of the wire
+    against the block (:meth:`Trajectory.wire_in_stock`) when the metadata names its cut
+    (``meta.cut``), else from the sidecar's ``in_stock`` ranges."""
+    wis = traj.wire_in_stock()
+    return traj.inside_stock() if wis is None else np.asarray(wis.inside, dtype=bool)
 
 
-def entry_sample(traj: Trajectory, a: int) -> int:
+def _in_stock_run(inside: np.ndarray, k: int) -> tuple[int, int] | None:
+    if not inside[k]:
+        return None
+    out = np.flatnonzero(~inside)
+    before, after = out[out < k], out[out > k]
+    return (int(before[-1]) + 1 if before.size else 0,
+            int(after[0]) if after.size else inside.size)  # fmt: skip
+
+
+def entry_sample(traj: Trajectory, a: int, inside: np.ndarray | None = None) -> int:
     """The sample a replay of the in-stock run starting at ``a`` starts from: the start
-    of the lead-in phase that ends at ``a``, else ``a - 1`` (the last sample before the
-    wire entered the stock), at least 0."""
+    of the latest lead-in phase that begins before ``a`` with the wire outside the block
+    from there to ``a`` (the model's and the phases' edges need not coincide), else
+    ``a - 1`` (the last sample before the wire entered the block), at least 0.
+    ``inside``: :func:`inside_mask` of ``traj`` (computed when not given)."""
+    inside = inside_mask(traj) if inside is None else inside
+    best = None
     for p in traj.meta.phases:
-        if p.name == "lead_in" and p.start < a <= p.stop:
-            return p.start
-    return max(a - 1, 0)
+        if p.name == "lead_in" and p.start < a and not inside[p.start:a].any():
+            best = p.start if best is None else max(best, p.start)
+    return best if best is not None else max(a - 1, 0)
 
 
 def _nearest_stretch(idx: np.ndarray, dist: np.ndarray, requested: int) -> int:
@@ -161,7 +181,7 @@ def plan_entry(
             note += f" (requested {requested})"
         value = f"continue at {near}"
         return entry("continue", near, note, Check(name, label, value, safe, "", "", True))
-    inside = traj.inside_stock()
+    inside = inside_mask(traj)
     if inside.any():
         at = np.flatnonzero(inside & (dist <= tolerance))
         if at.size:
@@ -183,9 +203,19 @@ def plan_entry(
                 detail,
             )
             return entry("refused", m, detail, chk)
-    run = _in_stock_run(traj, requested)
+    run = _in_stock_run(inside, requested)
+    if run is not None and run[0] == 0:
+        detail = (
+            f"the wire is in the block at sample {requested} and has been since the first "
+            f"sample (in-stock run 0..{run[1] - 1}): there is no sample outside the block to "
+            "re-enter the kerf from, and a move to it would drag the wire through uncut "
+            "stock; move the arm to the first sample by hand and run again"
+        )
+        chk = Check(name, label, f"wire in the stock at {requested}", safe, "", "", False,
+                    True, detail)  # fmt: skip
+        return entry("refused", requested, detail, chk)
     if run is not None:
-        k0 = entry_sample(traj, run[0])
+        k0 = entry_sample(traj, run[0], inside)
         note = (
             f"the arm is not at the cut and sample {requested} is inside the stock (in-stock "
             f"run {run[0]}..{run[1] - 1}): move to sample {k0} before the wire enters the "
@@ -200,7 +230,7 @@ def plan_entry(
             f"the arm is not near sample {requested}, which is outside the stock: moveJ to "
             "it and continue"
         )
-    if not traj.meta.in_stock:
+    if traj.meta.cut is None and not traj.meta.in_stock:
         note += " (the trajectory names no in-stock samples)"
     value = f"approach {requested}"
     return entry("approach", requested, note, Check(name, label, value, safe, "", "", True))
@@ -220,9 +250,12 @@ class StopPlace:
         return f"sample {self.sample} (t = {self.time:.3f} s), phase {self.phase}, wire {where}"
 
 
-def stop_place(traj: Trajectory, k: int) -> StopPlace:
+def stop_place(traj: Trajectory, k: int, inside: np.ndarray | None = None) -> StopPlace:
+    """Where sample ``k`` is; ``inside``: :func:`inside_mask` of ``traj`` (computed when
+    not given)."""
     k = int(min(max(k, 0), traj.n - 1))
-    return StopPlace(k, float(traj.t[k]), traj.phase_at(k), bool(traj.inside_stock()[k]))
+    inside = inside_mask(traj) if inside is None else inside
+    return StopPlace(k, float(traj.t[k]), traj.phase_at(k), bool(inside[k]))
 
 
 _RUN_RE = re.compile(r"\.run-(\d{3,})$")

@@ -7,6 +7,7 @@ from pathlib import Path
 from typing import Any
 
 from ..robot.trajectory import Trajectory
+from .run_plan import inside_mask
 
 __all__ = ["RunProgress", "resume_command"]
 
@@ -20,7 +21,7 @@ class RunProgress:
         self.console = console
         self.progress: Any = None
         self.task: Any = None
-        self._inside = traj.inside_stock()
+        self._inside = inside_mask(traj)
 
     def update(self, k: int, n: int) -> None:
         from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn

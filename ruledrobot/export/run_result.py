@@ -6,10 +6,14 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from enum import Enum
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from ..robot.trajectory import KinematicsRef, Trajectory
 from ..robot.verdict import Check, Verdict
 from .run_plan import Entry, StopPlace
+
+if TYPE_CHECKING:
+    from .run_verdict import RunMeasures
 
 __all__ = ["ControllerError", "RunMode", "RunPlan", "RunResult"]
 
@@ -79,7 +83,12 @@ class RunResult:
     ``entry``: how the run entered; ``actual``/``actual_path``: the recording
     and its file (``<stem>.run-NNN.csv``); ``client``: how the ur_rtde process
     ended and the tail of its output, when it did not end normally;
-    ``timeline``: (``time.monotonic()``, event) of the supervised steps.
+    ``timeline``: (``time.monotonic()``, event) of the supervised steps;
+    ``run_verdict``: after motion, what the robot did to the cut (the motion, the feed
+    and the wire in the block, samples skipped in the stock: :mod:`.run_verdict`), with
+    its figures in ``measures``; ``ok``: the run holds (completed, or a dry run, and
+    every check of both verdicts holds); ``priority``: the scheduling the streaming
+    process got (``realtime``: SCHED_RR).
     """
 
     status: str
@@ -107,10 +116,23 @@ class RunResult:
     #: stream was behind it [s] (``Session.keep_schedule``)
     samples_skipped: int = 0
     max_slip: float = 0.0
+    #: after motion: the run's verdict from the recording, and its figures
+    run_verdict: Verdict | None = None
+    measures: RunMeasures | None = None
+    #: the streaming process's scheduling, in words, and whether it is real-time
+    priority: str = ""
+    realtime: bool = False
 
     @property
     def completed(self) -> bool:
         return self.status in ("completed", "dry_run")
+
+    @property
+    def ok(self) -> bool:
+        """Completed (or a dry run) with every check before motion and of the executed
+        cut holding: what exit code 0 means."""
+        return (self.completed and (self.verdict is None or self.verdict.ok)
+                and (self.run_verdict is None or self.run_verdict.ok))  # fmt: skip
 
     @property
     def moved(self) -> bool:
@@ -133,4 +155,6 @@ class RunResult:
                 f" (samples {self.start_index}..{self.stop_index} of {self.n_samples}, max "
                 f"deviation {self.max_deviation:.4f} rad)"
             )
+        if self.run_verdict is not None and not self.run_verdict.ok:
+            text += f"; the executed cut fails: {self.run_verdict.summary()}"
         return text

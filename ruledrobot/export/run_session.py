@@ -8,9 +8,11 @@ through a :class:`Link`:
 
 * ``("stage", name, timeout)`` before every step: the supervisor kills the
   child when no message follows within ``timeout`` seconds;
-* ``("rec", t, q, tcp, info)`` every ``CHUNK`` seconds while recording: the
-  recording so far (controller time, actual joints, actual TCP), plus the
-  progress (``info``: matched grid sample, samples sent, largest deviation);
+* ``("rec", t, q, tcp, k, info)`` every ``CHUNK`` seconds while recording: the
+  recording so far (controller time, actual joints, actual TCP, and the grid sample
+  the deviation match put each at, -1 where none was made: the settling after a
+  stop), plus the progress (``info``: matched grid sample, samples sent, largest
+  deviation, samples skipped);
   it doubles as the heartbeat; ``("beat", info)`` when not recording;
 * ``("stopping", status, message)`` when the session stops on a fault.
 
@@ -100,11 +102,14 @@ class Session:
         self.k_match = 0
         self.k_high = 0  # the furthest plan sample matched so far
         self.skipped = 0  # samples skipped to keep the schedule (stream)
+        #: the grid samples skipped, as half-open ranges (stream)
+        self.skipped_ranges: list[tuple[int, int]] = []
         self.max_slip = 0.0  # the longest the stream was behind its schedule [s]
         self.sent = 0
         self.window = 10
         self.recording = False
-        self._buf: list[tuple[float, list[float], list[float]]] = []
+        self._buf: list[tuple[float, list[float], list[float], int]] = []
+        self._fresh = False  # the last recorded sample awaits its deviation match
         self._last_ts = -math.inf
         self._ts0: float | None = None
         self._last_flush = 0.0
@@ -182,7 +187,8 @@ class Session:
             if self._ts0 is None:
                 self._ts0 = ts
             self._last_ts = ts
-            self._buf.append((ts - self._ts0, q, tcp))
+            self._buf.append((ts - self._ts0, q, tcp, -1))
+            self._fresh = True
 
     def snapshot(self) -> tuple[float, list[float], list[float]]:
         """(controller time, actual q, actual TCP) of one data package: ur_rtde's getters
@@ -199,6 +205,7 @@ class Session:
     def info(self) -> dict:
         return {"k_match": self.k_match, "sent": self.sent, "max_dev": self.max_dev,
                 "recording_t0": self._ts0, "skipped": self.skipped,
+                "skipped_ranges": list(self.skipped_ranges),
                 "max_slip": self.max_slip}  # fmt: skip
 
     def keep_schedule(self, k: int, elapsed: float, n: int) -> int:
@@ -219,7 +226,9 @@ class Session:
         nxt = k + 1
         if due > nxt and nxt < n:
             nxt = min(due, n - 1)
-            self.skipped += nxt - (k + 1)
+            if nxt > k + 1:
+                self.skipped += nxt - (k + 1)
+                self.skipped_ranges.append((k + 1, nxt))
         return nxt
 
     def flush(self, force: bool = False) -> None:
@@ -232,8 +241,9 @@ class Session:
             t = np.array([b[0] for b in self._buf])
             q = np.array([b[1] for b in self._buf])
             tcp = np.array([b[2] for b in self._buf])
+            k = np.array([b[3] for b in self._buf], dtype=np.int64)
             self._buf = []
-            self.link.send("rec", t, q, tcp, self.info())
+            self.link.send("rec", t, q, tcp, k, self.info())
         else:
             self.link.send("beat", self.info())
 
@@ -306,6 +316,9 @@ class Session:
         j = int(np.flatnonzero(d <= dev + 1e-6)[-1])
         self.k_match = lo + j
         self.k_high = max(self.k_high, self.k_match)
+        if self._fresh and self._buf:  # the sample poll() just recorded: where it is
+            self._buf[-1] = (*self._buf[-1][:3], self.k_match)
+            self._fresh = False
         self.max_dev = max(self.max_dev, dev)
         if dev > self.deviation_limit:
             raise Stop(

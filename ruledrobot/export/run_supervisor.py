@@ -43,8 +43,9 @@ class Outcome:
     ``status``/``message``: the child's (``done``) or the supervisor's
     (``client_died``, ``client_hung``, or the stop the child had reported,
     with what happened after); ``info``: the child's last progress
-    (``k_match``, ``sent``, ``max_dev``); ``chunks``: the recording, (t, q, tcp)
-    arrays in order; ``killed``: the supervisor killed the child;
+    (``k_match``, ``sent``, ``max_dev``); ``chunks``: the recording, (t, q, tcp, k)
+    arrays in order (``k``: the grid sample each was matched to, -1 for none);
+    ``killed``: the supervisor killed the child;
     ``exit``: how the child ended, in words; ``log``: the tail of its output;
     ``timeline``: (``time.monotonic()``, event) of every stage, stop and end.
     """
@@ -52,7 +53,7 @@ class Outcome:
     status: str = ""
     message: str = ""
     info: dict = field(default_factory=lambda: {"k_match": 0, "sent": 0, "max_dev": 0.0})
-    chunks: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = field(default_factory=list)
+    chunks: list[tuple[np.ndarray, ...]] = field(default_factory=list)
     killed: bool = False
     exit: str = ""
     log: str = ""
@@ -211,7 +212,7 @@ class Child:
                         out.timeline.append((last, f"stage {msg[1]}"))
                     elif kind in ("rec", "beat"):
                         if kind == "rec":
-                            out.chunks.append((msg[1], msg[2], msg[3]))
+                            out.chunks.append(tuple(msg[1:-1]))
                         out.info = msg[-1]
                         if on_progress is not None and reported is None and asked is None:
                             on_progress(out.info)

@@ -19,10 +19,16 @@ monitoring, safe stops, resume, recording.
 4. **Result** (:class:`RunResult`): status, where it stopped (sample, time,
    phase, wire in the stock), the resume sample, the recording
    ``<stem>.run-NNN.csv`` (never overwritten).
+5. **The run's verdict** from what the robot did (:mod:`.run_verdict`): the recording
+   measured by the one model of the wire against the block — feed in the block, the
+   actual wire from the planned one, samples skipped with the wire in the foam, the
+   longest slip — in ``RunResult.run_verdict`` / ``measures`` and in the recording's
+   sidecar (``"run"``).
 """
 
 from __future__ import annotations
 
+import json
 import math
 import os
 from collections.abc import Callable
@@ -32,7 +38,8 @@ from typing import Any
 
 import numpy as np
 
-from ..io.trajectory import read_trajectory, write_trajectory
+from ..io.atomic import atomic_write_text
+from ..io.trajectory import read_trajectory, sidecar_path, write_trajectory
 from ..robot import RobotModel, load, model_for
 from ..robot.trajectory import Trajectory
 from ..robot.verdict import Check, Verdict
@@ -50,6 +57,7 @@ from .run_plan import (
 )
 from .run_result import ControllerError, RunMode, RunPlan, RunResult
 from .run_supervisor import Child, ChildGone
+from .run_verdict import WIRE_TOLERANCE, RunMeasures, align_recording, measure_run
 from .urscript import check_servo_options
 
 __all__ = ["ControllerError", "RunMode", "RunPlan", "RunResult", "run_trajectory"]
@@ -115,6 +123,7 @@ def run_trajectory(
     heartbeat: float = 1.0,
     stop_budget: float = 1.0,
     connect_timeout: float = 15.0,
+    wire_tolerance: float = WIRE_TOLERANCE,
 ) -> RunResult:
     """Run a joint trajectory on the UR controller at ``host`` (ur_rtde), checked and monitored.
 
@@ -151,11 +160,15 @@ def run_trajectory(
     heartbeat : the longest the ur_rtde process may stay silent while moving [s].
     stop_budget : the longest the safe stop (servoStop/stopJ, stopScript) may take [s].
     connect_timeout : the longest a connection step may take [s].
+    wire_tolerance : the largest distance of the actual wire from the planned wire in the
+        block [m] in the run's verdict (the job's ``[cut] wire_tolerance``).
 
     Returns
     -------
-    :class:`RunResult`.  Raises ValueError (bad input, limits) and
-    :class:`ControllerError` (the controller cannot be reached) before any motion.
+    :class:`RunResult`; after motion ``run_verdict`` (what the robot did to the cut,
+    :mod:`.run_verdict`) decides with the status whether the run holds (``ok``).
+    Raises ValueError (bad input, limits) and :class:`ControllerError` (the controller
+    cannot be reached) before any motion.
     """
     source: Path | None = None
     if not isinstance(traj, Trajectory):
@@ -257,6 +270,9 @@ def run_trajectory(
                 stop_budget=stop_budget,
                 connect_timeout=connect_timeout,
                 watchdog=watchdog,
+                max_latency=max_latency,
+                deviation_limit=deviation_limit,
+                wire_tolerance=wire_tolerance,
             ),
         )
     finally:
@@ -285,6 +301,8 @@ def _run(
     if msg[0] == "error":
         raise ControllerError(msg[1])
     state = msg[1]
+    result.priority = str(state.get("priority", ""))
+    result.realtime = bool(state.get("realtime", False))
     checks.append(readiness_check(host, state))
     entry = plan_entry(
         traj,
@@ -415,13 +433,57 @@ def _move(
         k_in = k0 + int(grid_to_input[min(kg, grid_to_input.size - 1)])
         result.stop_index, result.stop_time = k_in, float(traj.t[k_in])
         result.stop = stop_place(traj, k_in)
+    to_input = k0 + grid_to_input
+    skips = [(int(to_input[a]), int(to_input[b - 1]) + 1)
+             for a, b in info.get("skipped_ranges", ())]  # fmt: skip
+    if rec is not None:
+        tags = np.concatenate([c[3] for c in out.chunks])
+        kg = align_recording(q_grid, rec.q, tags, window)
+        plan_index = to_input[np.clip(kg, 0, to_input.size - 1)]
+    else:
+        plan_index = np.zeros(0, dtype=np.int64)
+    measures = measure_run(traj, rec, plan_index, status=result.status,
+                           message=result.message, skipped_ranges=skips,
+                           max_slip=result.max_slip, max_latency=o["max_latency"],
+                           max_deviation=result.max_deviation,
+                           deviation_limit=o["deviation_limit"], speed_scale=speed_scale,
+                           wire_tolerance=o["wire_tolerance"])  # fmt: skip
+    result.measures, result.run_verdict = measures, measures.verdict
+    if rec is not None:  # the recording measures itself with the cut carried over to it
+        rec = Trajectory(rec.t, rec.q, rec.tcp,
+                         rec.meta.replace(cut=measures.cut, in_stock=measures.in_stock))
     result.actual = rec
     if rec is not None:
         if o["actual_path"] is not None:
             result.actual_path = write_trajectory(o["actual_path"], rec)
         elif source is not None:
             result.actual_path = write_trajectory(recording_path_for(source), rec)
+        if result.actual_path is not None:
+            _write_run(result.actual_path, result, measures, source, speed_scale)
     return result
+
+
+def _write_run(path: Path, result: RunResult, measures: RunMeasures, source: Path | None,
+               speed_scale: float) -> None:  # fmt: skip
+    """The run's figures and verdict into the recording's sidecar (``"run"``)."""
+    side = sidecar_path(path)
+    doc = json.loads(side.read_text(encoding="utf-8"))
+    doc["run"] = {
+        "plan": None if source is None else str(source),
+        "status": result.status,
+        "message": result.message,
+        "entry": None if result.entry is None else result.entry.kind,
+        "requested_index": result.requested_index,
+        "start_index": result.start_index,
+        "stop_index": result.stop_index,
+        "samples_sent": result.samples_sent,
+        "max_deviation_rad": result.max_deviation,
+        "speed_scale": speed_scale,
+        "priority": result.priority,
+        "ok": result.ok,
+        **measures.as_dict(),
+    }
+    atomic_write_text(side, json.dumps(doc, indent=1) + "\n")
 
 
 def _heat_message(traj: Trajectory, k0: int, grid_to_input: np.ndarray) -> dict | None:

@@ -1,0 +1,239 @@
+"""A run's verdict from what the robot did: the recording measured by the one model of the
+wire against the block (:mod:`ruledrobot.robot.wire_in_stock`, :mod:`~ruledrobot.robot.wire_cut`).
+
+After the motion the runner has the recording (the controller's actual joints) and, per
+recorded sample, the plan sample the live deviation match put it at (the child tags
+each sample; the samples recorded while the arm settled after a stop are matched here
+the same way, nearest in joint space near the last match).  From them:
+
+* the **actual wire**: forward kinematics of the recorded joints with the trajectory's
+  own model (:func:`~ruledrobot.robot.trajectory.model_for`: its kinematics, its TCP,
+  no base) — the TCP is the wire's midpoint with z along the wire;
+* **feed** (``feed_max:NAME``, ``feed_min:NAME``): :func:`~ruledrobot.robot.wire_cut.feed_measures`
+  of the actual wire against the trajectory's cut (``meta.cut``), whose feed windows
+  (plan samples) are carried over to the recorded samples matched into them; the set
+  speed scales with the run's ``speed_scale``;
+* **wire deviation** (``wire_deviation``): where the actual wire is in the block, the
+  distance of its chord's two ends from the planned wire (the line) at the matched
+  plan sample — the largest distance of a chord point, since the distance of a point
+  of one segment from a line is convex along it;
+* **skipped samples in the stock** (``skipped_in_stock``): samples the stream skipped to
+  keep the plan's schedule (:meth:`~.run_session.Session.keep_schedule`) where the
+  planned wire is in the block: the arm jumped ahead in the foam — a run with any fails;
+  the skipped samples in all and the longest slip are information;
+* **motion** (the run completed) and the **joint deviation** (the live monitor's largest).
+
+A trajectory without ``meta.cut`` (files from before the planner wrote it) has no feed
+or wire figures: they are information, "not measured", and the skipped samples are
+placed by the sidecar's ``in_stock`` ranges.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from ..robot.trajectory import Trajectory, model_for
+from ..robot.verdict import Check, Verdict
+from ..robot.wire_cut import FeedMeasure, FeedWindow, WireCut, feed_measures
+from ..robot.wire_in_stock import runs_of, wire_ends
+from .run_plan import inside_mask
+
+__all__ = ["RunMeasures", "align_recording", "measure_run", "recording_cut"]
+
+#: m: the wire deviation limit when the caller gives none (``[cut] wire_tolerance``'s
+#: default, docs/verdict.md)
+WIRE_TOLERANCE = 0.0005
+
+
+def align_recording(plan_q: np.ndarray, rec_q: np.ndarray, tags: np.ndarray,
+                    window: int) -> np.ndarray:  # fmt: skip
+    """(R,) the plan sample (row of ``plan_q``) of every recorded sample: its tag where the
+    live match made one (``tags`` >= 0), else the nearest plan sample in joint space
+    from a quarter ``window`` behind the last match to ``window`` ahead of it (the
+    live match's rule, :meth:`~.run_session.Session.check_deviation`); 0 before any."""
+    out = np.asarray(tags, dtype=np.int64).copy()
+    last, high = 0, 0
+    n = plan_q.shape[0]
+    for r in range(out.size):
+        if out[r] < 0:
+            lo = max(0, high - window // 4)
+            hi = min(n, max(lo, last + window) + 1)
+            d = np.max(np.abs(plan_q[lo:hi] - rec_q[r]), axis=1)
+            out[r] = lo + int(np.flatnonzero(d <= d.min() + 1e-6)[-1])
+        last = int(out[r])
+        high = max(high, last)
+    return out
+
+
+def _runs_in(index: np.ndarray, start: int, stop: int) -> tuple[tuple[int, int], ...]:
+    return runs_of((index >= start) & (index < stop))
+
+
+def recording_cut(cut: WireCut, plan_index: np.ndarray, speed_scale: float = 1.0) -> WireCut:
+    """The trajectory's cut for the recorded samples: each feed window (and its held
+    ranges) carried over to the recorded samples whose plan sample ``plan_index`` (R,)
+    lies in it, the set speed times ``speed_scale``."""
+    feeds = []
+    for w in cut.feeds:
+        held = tuple(r for a, b in w.held for r in _runs_in(plan_index, a, b))
+        for a, b in _runs_in(plan_index, w.start, w.stop):
+            feeds.append(FeedWindow(w.name, a, b, w.speed * speed_scale, w.tolerance, held))
+    return WireCut(cut.stock, cut.wire_length, tuple(feeds))
+
+
+@dataclass(frozen=True, eq=False)
+class RunMeasures:
+    """What the robot did to the cut (module doc).
+
+    ``verdict``: the run's checks; ``plan_index`` (R,): the plan sample of each recorded
+    sample; ``cut``: the trajectory's cut carried over to the recorded samples (None
+    without ``meta.cut``); ``in_stock``: recorded-sample ranges with the actual wire in
+    the block; ``feeds``: per cut, on the recording (sample indices are recorded ones);
+    ``wire_deviation`` m (NaN when not measured) at plan sample ``wire_deviation_at``;
+    ``skipped_in_stock``: skipped samples with the planned wire in the block, as plan
+    sample ranges ``skipped_in_stock_ranges``.
+    """
+
+    verdict: Verdict
+    plan_index: np.ndarray = field(repr=False)
+    cut: WireCut | None = field(repr=False)
+    in_stock: tuple[tuple[int, int], ...] = ()
+    feeds: tuple[FeedMeasure, ...] = ()
+    wire_deviation: float = float("nan")
+    wire_deviation_at: int = -1
+    skipped: int = 0
+    skipped_in_stock: int = 0
+    skipped_in_stock_ranges: tuple[tuple[int, int], ...] = ()
+    max_slip: float = 0.0
+
+    def as_dict(self) -> dict[str, Any]:
+        """The measures and the verdict, JSON-ready (the recording's sidecar, ``"run"``)."""
+        def num(x: float) -> float | None:
+            return float(x) if np.isfinite(x) else None
+
+        idx = self.plan_index
+        return {
+            "verdict": self.verdict.as_dict(),
+            "wire_deviation_m": num(self.wire_deviation),
+            "wire_deviation_at_sample": self.wire_deviation_at,
+            "feeds": [{"name": f.name, "speed_m_s": f.speed, "tolerance": f.tolerance,
+                       "highest_m_s": num(f.highest), "lowest_m_s": num(f.lowest),
+                       "highest_at_sample": int(idx[f.at_highest]) if f.at_highest >= 0 else None,
+                       "lowest_at_sample": int(idx[f.at_lowest]) if f.at_lowest >= 0 else None,
+                       "max_ok": f.max_ok, "min_ok": f.min_ok}
+                      for f in self.feeds],
+            "skipped_samples": self.skipped,
+            "skipped_in_stock": self.skipped_in_stock,
+            "skipped_in_stock_ranges": [list(r) for r in self.skipped_in_stock_ranges],
+            "max_slip_s": self.max_slip,
+            "in_stock_recorded": [list(r) for r in self.in_stock],
+            "plan_sample_first_last": [int(idx[0]), int(idx[-1])] if idx.size else None,
+        }  # fmt: skip
+
+
+def _where(traj: Trajectory, ranges: list[tuple[int, int]], most: int = 4) -> str:
+    parts = [f"{a}..{b - 1} (t = {traj.t[a]:.3f} s, {traj.phase_at(a)})" for a, b in ranges[:most]]
+    more = f" and {len(ranges) - most} more" if len(ranges) > most else ""
+    return ", ".join(parts) + more
+
+
+def measure_run(
+    traj: Trajectory,
+    rec: Trajectory | None,
+    plan_index: np.ndarray,
+    *,
+    status: str,
+    message: str,
+    skipped_ranges: list[tuple[int, int]] | tuple[tuple[int, int], ...] = (),
+    max_slip: float = 0.0,
+    max_latency: float = 0.1,
+    max_deviation: float = 0.0,
+    deviation_limit: float = 0.05,
+    speed_scale: float = 1.0,
+    wire_tolerance: float = WIRE_TOLERANCE,
+) -> RunMeasures:
+    """The run's verdict and measures (module doc).  ``traj``: the plan; ``rec``: the
+    recording (None when nothing was recorded); ``plan_index`` (R,): the plan sample of
+    each recorded sample (:func:`align_recording` mapped to input samples);
+    ``skipped_ranges``: the skipped samples as half-open plan-sample ranges."""
+    checks = [
+        Check("motion", "the motion ran to the end", status, "completed", "", "==",
+              status == "completed", True,
+              "" if status == "completed" else f"{status}: {message}"),
+        Check.at_most("joint_deviation", "joint deviation actual vs plan (live monitor)",
+                      max_deviation, deviation_limit, "rad",
+                      f"{max_deviation:.4f} rad from the plan"),
+    ]  # fmt: skip
+    inside = inside_mask(traj)
+    skip = np.zeros(traj.n, dtype=bool)
+    for a, b in skipped_ranges:
+        skip[int(a):int(b)] = True
+    skipped = int(skip.sum())
+    bad = skip & inside
+    bad_runs = list(runs_of(bad))
+    n_bad = int(bad.sum())
+    checks.append(Check.at_most(
+        "skipped_in_stock", "samples skipped with the wire in the block", n_bad, 0, "",
+        f"the stream fell behind its schedule (up to {1e3 * max_slip:.0f} ms) and skipped "
+        f"{n_bad} samples with the wire in the foam, where the arm jumped ahead: samples "
+        f"{_where(traj, bad_runs)}"))  # fmt: skip
+    checks.append(Check.info("skipped", "samples skipped to keep the schedule (all)", skipped))
+    checks.append(Check.info("slip", f"longest slip behind the schedule (stop beyond "
+                             f"{1e3 * max_latency:.0f} ms)", 1e3 * max_slip, "ms"))  # fmt: skip
+    cut = traj.meta.cut
+    idx = np.asarray(plan_index, dtype=np.int64)
+    if cut is None or rec is None or rec.n < 2:
+        why = "the trajectory names no cut (meta.cut)" if cut is None else "nothing recorded"
+        checks.append(Check.info("wire_deviation", "actual wire from the planned wire in the "
+                                 "block", f"not measured: {why}"))  # fmt: skip
+        checks.append(Check.info("feed", "feed of the actual wire in the block",
+                                 f"not measured: {why}"))  # fmt: skip
+        return RunMeasures(Verdict(tuple(checks)), idx, None, skipped=skipped,
+                           skipped_in_stock=n_bad, skipped_in_stock_ranges=tuple(bad_runs),
+                           max_slip=max_slip)  # fmt: skip
+    robot = model_for(traj.meta).with_base(np.eye(4))
+    rcut = recording_cut(cut, idx, speed_scale)
+    wis = rcut.measure(rec.t, robot.fk(rec.q))
+    # the actual chord's ends from the planned wire (a line) at the matched plan sample
+    plan_ends = wire_ends(traj.tcp_poses()[idx], cut.wire_length)
+    a = plan_ends[:, 0]
+    u = plan_ends[:, 1] - a
+    u /= np.linalg.norm(u, axis=1, keepdims=True)
+    p = wis.chord_points() - a[:, None, :]  # (R, 2, 3), NaN outside
+    perp = p - np.einsum("rki,ri->rk", p, u)[:, :, None] * u[:, None, :]
+    dev = np.where(wis.inside, np.nan_to_num(np.linalg.norm(perp, axis=2)).max(axis=1), 0.0)
+    if wis.inside.any():
+        r = int(np.argmax(dev))
+        wdev, wat = float(dev[r]), int(idx[r])
+        checks.append(Check.at_most(
+            "wire_deviation", "actual wire from the planned wire in the block", 1e3 * wdev,
+            1e3 * wire_tolerance, "mm",
+            f"{1e3 * wdev:.3f} mm at plan sample {wat} (t = {traj.t[wat]:.3f} s, "
+            f"{traj.phase_at(wat)})"))  # fmt: skip
+    else:
+        wdev, wat = float("nan"), -1
+        checks.append(Check.info("wire_deviation", "actual wire from the planned wire in the "
+                                 "block", "the actual wire never entered the block"))  # fmt: skip
+    feeds = feed_measures(wis, rcut)
+    of = len(feeds) > 1
+    for f in feeds:
+        key, name = (f":{f.name}", f" ({f.name})") if of else ("", "")
+        top, low = f.speed * (1 + f.tolerance), f.speed * (1 - f.tolerance)
+        scaled = f" at speed scale {speed_scale:g}" if speed_scale != 1.0 else ""
+        at_hi = int(idx[f.at_highest]) if f.at_highest >= 0 else -1
+        at_lo = int(idx[f.at_lowest]) if f.at_lowest >= 0 else -1
+        checks.append(Check.at_most(
+            "feed_max" + key, f"highest feed of the actual wire in the block{name}{scaled}",
+            1e3 * f.highest if np.isfinite(f.highest) else None, 1e3 * top, "mm/s",
+            f"{1e3 * f.highest:.2f} mm/s at plan sample {at_hi} against "
+            f"{1e3 * f.speed:.2f} mm/s +{100 * f.tolerance:g} %: the wire drags"))  # fmt: skip
+        checks.append(Check.at_least(
+            "feed_min" + key, f"lowest feed of the actual wire in the block{name}{scaled}",
+            1e3 * f.lowest if np.isfinite(f.lowest) else None, 1e3 * low, "mm/s",
+            f"{1e3 * f.lowest:.2f} mm/s at plan sample {at_lo} against "
+            f"{1e3 * f.speed:.2f} mm/s -{100 * f.tolerance:g} %: a wider kerf there"))  # fmt: skip
+    return RunMeasures(Verdict(tuple(checks)), idx, rcut, wis.runs(), feeds, wdev, wat,
+                       skipped, n_bad, tuple(bad_runs), max_slip)  # fmt: skip
