@@ -3,7 +3,10 @@
 1. The input rulings are refined (the cut's surface: algorithm, scheme, and either
    a number of steps or a target ``spacing`` — the largest gap between
    consecutive rulings inside the stock, the distance from the chord ends of one
-   to the next — for which the fewest steps that meet it are taken).
+   to the next — for which the fewest steps that meet it are taken).  There must
+   be as many as the scheme needs, checked as ``ruledrobot refine`` checks them
+   (G-code is refined between its corners, a piece too short for the scheme
+   linearly).
 2. The frame motion (the refined DH frames of ``dh``; sign-continuous DH frames
    of the refined rulings otherwise) is moved ``kerf / 2`` into the waste when the
    cut names the part's side (:mod:`.kerf`).
@@ -12,10 +15,12 @@
    either end by screw-geodesic extrapolation of the frame motion when the
    surface stops before the wire is clear of the stock by the lead distance.
    The extrapolation is a lead-in/out: it may not cut the block.  A surface that
-   stops short of the block (an extrapolated target ruling whose chord in the block
-   is longer than :data:`SPAN_TOLERANCE`) is refused, naming where it ends and
-   where the block does, unless the cut says ``extend = true``: then it is cut on
-   along the extrapolation and the pass notes how far.
+   stops short of the block -- an extrapolated target ruling (tested at each
+   extrapolated ruling and every :data:`SPAN_STEP` within the first gap) with a
+   chord in the block longer than :data:`SPAN_TOLERANCE` reaching farther than the
+   cut's ``wire_tolerance`` from the end ruling -- is refused, naming where it ends
+   and where the block does, unless the cut says ``extend = true``: then it is cut
+   on along the extrapolation and the pass notes how far and on how many rulings.
    Closed surfaces are cut as loops entered through a slit (:mod:`.closed`).
 4. The redundancy search (:mod:`.redundancy`) chooses roll, slide, wire
    direction and IK branch.
@@ -226,7 +231,7 @@ class _Overrun:
 
     end: str  #: "first" or "last"
     index: int  #: the surface's end ruling, an index of the input rulings (from 0)
-    rulings: int  #: extrapolated rulings whose chord in the block exceeds SPAN_TOLERANCE
+    rulings: int  #: extrapolated rulings that cut the block (:func:`_in_block`)
     reach: float  #: [m] farthest chord end in the block of the extrapolation from the end ruling
     point: FloatArray  #: the end ruling's point nearest the block centre (3,)
     inside: float  #: [m] from ``point`` to where the block ends, the way the surface runs
@@ -241,13 +246,16 @@ def _off_line(p: FloatArray, F: FloatArray) -> FloatArray:
     return np.linalg.norm(d - (d @ z)[..., None] * z, axis=-1)
 
 
-def _in_block(S: FloatArray, stock: Box) -> tuple[np.ndarray, FloatArray]:
-    """Which target rulings (K, 4, 4) cut ``stock`` (a chord longer than
-    :data:`SPAN_TOLERANCE`) and their chord ends (K, 2, 3) (NaN where they miss it)."""
+def _in_block(S: FloatArray, stock: Box, end: FloatArray, reach: float
+              ) -> tuple[np.ndarray, FloatArray]:  # fmt: skip
+    """Which extrapolated target rulings (K, 4, 4) cut ``stock`` beyond the surface's end
+    ruling ``end`` (4, 4) -- a chord longer than :data:`SPAN_TOLERANCE` with an end
+    farther than ``reach`` [m] from it -- and the distances (K,) of their chord ends
+    from it (NaN where they miss the block)."""
     c0, c1, hit = chords(S, stock)
-    cuts = hit & (np.nan_to_num(c1 - c0) > SPAN_TOLERANCE)
     ends = S[:, None, :3, 3] + np.stack([c0, c1], 1)[:, :, None] * S[:, None, :3, 2]
-    return cuts, ends
+    far = _off_line(ends, end).max(axis=1)
+    return hit & (np.nan_to_num(c1 - c0) > SPAN_TOLERANCE) & (np.nan_to_num(far) > reach), far
 
 
 def _first_gap(F: FloatArray, side: int, centre: FloatArray) -> FloatArray:
@@ -259,20 +267,20 @@ def _first_gap(F: FloatArray, side: int, centre: FloatArray) -> FloatArray:
 
 
 def _overrun(
-    side: int, pair: FloatArray, ext: FloatArray, gap: FloatArray, stock: Box, index: int,
-    more: bool,
+    side: int, pair: FloatArray, ext: FloatArray, gap: FloatArray, stock: Box,
+    allowed: float, index: int, more: bool,
 ) -> _Overrun | None:
-    """Whether the extrapolation past an end of the target rulings cuts ``stock``: ``pair``
-    (2, 4, 4) the end ruling and its neighbour, ``ext`` (K, 4, 4) the extrapolated rulings
-    at whole gaps past it (``more``: the extrapolation went on), ``gap`` (G, 4, 4) more
-    within its first gap (a surface stopping less than a gap short); None when it does
-    not cut the block."""
-    cuts, ends = _in_block(ext, stock)
-    g_cuts, g_ends = _in_block(gap, stock)
+    """Whether the extrapolation past an end of the target rulings cuts ``stock`` farther
+    than ``allowed`` [m] (the cut's wire tolerance) from the end ruling: ``pair`` (2, 4, 4)
+    the end ruling and its neighbour, ``ext`` (K, 4, 4) the extrapolated rulings at whole
+    gaps past it (``more``: the extrapolation went on), ``gap`` (G, 4, 4) more within its
+    first gap (a surface stopping less than a gap short); None when it does not."""
+    e = pair[0]
+    cuts, far = _in_block(ext, stock, e, allowed)
+    g_cuts, g_far = _in_block(gap, stock, e, allowed)
     if not (cuts.any() or g_cuts.any()):
         return None
-    e = pair[0]
-    reach = float(_off_line(np.concatenate([ends[cuts], g_ends[g_cuts]]), e).max())
+    reach = float(np.concatenate([far[cuts], g_far[g_cuts]]).max())
     near = anchored_frames(pair, stock.centre)[:, :3, 3]
     point, run = near[0], near[0] - near[1]  # the way the surface runs past its end
     run = run - (run @ e[:3, 2]) * e[:3, 2]
@@ -296,9 +304,12 @@ def _xyz(p: FloatArray) -> str:
 
 
 def _rulings(r: _Overrun) -> str:
+    """How the extrapolation cuts the block, for messages."""
     if r.rulings == 0:
-        return "within the gap to the first extrapolated ruling"
-    return f"on {'more than ' if r.more else ''}{r.rulings} ruling{'s' if r.rulings > 1 else ''}"
+        return ("along the surface's extrapolation (screw motion), between that ruling and "
+                "the first extrapolated one")
+    n = f"{'more than ' if r.more else ''}{r.rulings} ruling{'s' if r.rulings > 1 else ''}"
+    return f"on {n} extrapolated from the surface (screw motion)"
 
 
 def _short_of_block(where: str, label: str, n: int, runs: list[_Overrun]) -> str:
@@ -311,8 +322,7 @@ def _short_of_block(where: str, label: str, n: int, runs: list[_Overrun]) -> str
         parts.append(
             f"its {r.end} input ruling (index {r.index} of {n}, from 0) passes {_xyz(r.point)} "
             f"(its point nearest the block centre), {at}; going on would cut the block "
-            f"{_rulings(r)} extrapolated from the surface (screw motion), up to "
-            f"{_mm(r.reach)} past that ruling"
+            f"{_rulings(r)}, up to {_mm(r.reach)} past that ruling"
         )
     return (
         f"{where} the surface ({label}) stops short of the block: "
@@ -325,12 +335,12 @@ def _short_of_block(where: str, label: str, n: int, runs: list[_Overrun]) -> str
 
 def _extended_note(where: str, runs: list[_Overrun]) -> str:
     """The plan's note on a cut extended through the block (``extend = true``)."""
-    parts = [f"{_mm(r.reach)} past its {r.end} input ruling, {_rulings(r)}"
+    parts = [f"up to {_mm(r.reach)} past its {r.end} input ruling {_rulings(r)}"
              for r in runs]  # fmt: skip
     return (
-        f"{where} extend = true: the surface stops short of the block and is cut on along "
-        f"its extrapolated frame motion (screw motion), {' and '.join(parts)}; the wire "
-        "deviation there is measured against the extrapolated rulings"
+        f"{where} extend = true: the surface stops short of the block and the wire cuts on "
+        f"{' and '.join(parts)}; the wire deviation there is measured against those "
+        "extrapolated rulings"
     )
 
 
@@ -382,7 +392,8 @@ def cut_paths(
             run = _overrun(side, _translated(W[[end, end + 1 - 2 * side]], -off[end]),
                            _translated(frames, -off[end]),
                            _translated(_first_gap(W, side, job.stock.centre), -off[end]),
-                           job.stock, 0 if side == 0 else rc.input_rulings - 1,
+                           job.stock, cut.wire_tolerance,
+                           0 if side == 0 else rc.input_rulings - 1,
                            endless is not None)  # fmt: skip
         if endless is not None and (run is None or cut.extend):
             raise ValueError(f"{job.source or 'job'}: {where} {endless}") from None
