@@ -7,6 +7,7 @@ end the motion; the caller then stops the arm safely.
 
 from __future__ import annotations
 
+import gc
 import time
 
 import numpy as np
@@ -94,8 +95,8 @@ def stream(
     machine busy) is made up by skipping the samples whose time has passed — a feed
     held at the plan's speed, not a wire that slows in the foam and widens the kerf;
     a slip longer than ``max_latency`` at once stops the run (``client_slow``: the
-    jump would be a burst of speed).  Skipped samples and the longest slip are in
-    :meth:`Session.info`."""
+    jump would be a burst of speed).  Skipped samples (and where) and the longest slip
+    are in :meth:`Session.info`."""
     c = s.c
     dt = 1.0 / s.frequency
     K = q_grid.shape[0]
@@ -103,22 +104,31 @@ def stream(
     s.link.stage("streaming", heartbeat)
     s.start_recording()
     s.start_clock()
-    start = time.monotonic()
-    k = 0
-    while k < K:
-        if hot is not None and bool(hot[k]) != s.hot:
-            s.set_heat(bool(hot[k]))
-        if not c.servoJ(rows[k], 0.0, 0.0, dt, lookahead, gain):
-            raise s.classify(f"servoJ of grid sample {k}")
-        s.sent = k
-        qa = s.poll()
-        s.check_deviation(q_grid, qa, k)
-        s.service()
-        # the next sample's time on the schedule (absolute: a wait of one period after
-        # each send would add this loop's own time every period and drift behind, and
-        # keep_schedule would then skip a sample every ~100 periods on an idle machine)
-        wait_until(start + (k + 1) * dt)
-        k = s.keep_schedule(k, time.monotonic() - start, K)
+    # no cyclic garbage collection while streaming: a full collection walks every row
+    # of the grid (hundreds of thousands of objects on a long cut), milliseconds in which
+    # no command goes out; the loop makes no reference cycles, reference counting frees it
+    gc.freeze()
+    gc.disable()
+    try:
+        start = time.monotonic()
+        k = 0
+        while k < K:
+            if hot is not None and bool(hot[k]) != s.hot:
+                s.set_heat(bool(hot[k]))
+            if not c.servoJ(rows[k], 0.0, 0.0, dt, lookahead, gain):
+                raise s.classify(f"servoJ of grid sample {k}")
+            s.sent = k
+            qa = s.poll()
+            s.check_deviation(q_grid, qa, k)
+            s.service()
+            # the next sample's time on the schedule (absolute: a wait of one period after
+            # each send adds this loop's own time every period and drifts behind, and
+            # keep_schedule then skipped a sample every ~85 periods on an idle machine)
+            wait_until(start + (k + 1) * dt)
+            k = s.keep_schedule(k, time.monotonic() - start, K)
+    finally:
+        gc.enable()
+        gc.unfreeze()
     # hold the final target until the filter has converged
     last = rows[-1]
     deadline = time.monotonic() + 10.0 * lookahead + 0.5

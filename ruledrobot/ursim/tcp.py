@@ -170,16 +170,26 @@ def writable_fds(conns: list[QueuedConnection]) -> set[int]:
         return set()
 
 
+#: the nice value a thread asks for when real-time scheduling is refused
+FALLBACK_NICE = -10
+
+
 def try_realtime_priority(priority: int) -> bool:
-    """Give the calling thread ``SCHED_FIFO`` ``priority`` if allowed (Linux, CAP_SYS_NICE)."""
+    """Give the calling thread ``SCHED_FIFO`` ``priority`` if allowed (Linux, CAP_SYS_NICE);
+    when refused, nice :data:`FALLBACK_NICE` if allowed (Linux nice values are per
+    thread).  Returns whether the thread is real-time."""
     setter = getattr(os, "sched_setscheduler", None)
-    if setter is None:
-        return False
+    if setter is not None:
+        try:
+            setter(0, os.SCHED_FIFO, os.sched_param(priority))
+            return True
+        except (OSError, AttributeError):
+            pass
     try:
-        setter(0, os.SCHED_FIFO, os.sched_param(priority))
+        os.setpriority(os.PRIO_PROCESS, 0, FALLBACK_NICE)
     except (OSError, AttributeError):
-        return False
-    return True
+        pass
+    return False
 
 
 class TcpServer:
