@@ -44,22 +44,43 @@ def export(
     allow_long: bool = typer.Option(
         False, "--allow-long", help="Write a URScript program beyond the safe size (see docs)."
     ),
+    tolerance: float | None = typer.Option(
+        None, min=1e-6, help="movel/movep: decimation tolerance at the wire's ends [m] "
+        "(default a quarter of --wire-tolerance)."),
+    blend: float = typer.Option(0.002, min=0.0, help="movel/movep: blend radius [m]."),
+    wire_tolerance: float = typer.Option(
+        0.0005, min=1e-6, help="movel/movep: the wire's largest distance from the planned "
+        "wire in the stock [m] (the job's [cut] wire_tolerance)."),
 ) -> None:
     """Export a trajectory as CSV/JSON/NPZ or a standalone URScript program for the pendant.
 
-    Every program sets the TCP and the payload from the trajectory's metadata."""
+    Every program sets the TCP and the payload from the trajectory's metadata.  A movel or
+    movep program's motion is generated and measured against the plan (feed, wire) before
+    it is written: exit 1, nothing written, when it would not cut as planned."""
     from ..export import export_trajectory
+    from ..export.verify_program import ProgramRefused
     from ..io.trajectory import read_trajectory
 
     try:
         traj = read_trajectory(trajectory)
         is_script = (fmt and fmt.value == "urscript") or out.suffix in (".script", ".urscript")
-        options = {"mode": mode.value, "allow_long": allow_long} if is_script else {}
+        options: dict[str, object] = {}
+        if is_script:
+            options = {"mode": mode.value, "allow_long": allow_long}
+            if mode.value != "servoj":
+                options |= {"tolerance": tolerance, "blend": blend,
+                            "wire_tolerance": wire_tolerance}  # fmt: skip
         path = export_trajectory(traj, out, None if fmt is None else fmt.value, **options)
+    except ProgramRefused as exc:
+        err.print(f"refused: {exc}", highlight=False, markup=False)
+        raise typer.Exit(code=1) from None
     except ValueError as exc:
         raise fail(str(exc)) from None
     if is_script:
         say_program_size(path)
+        for line in path.read_text().splitlines()[:12]:
+            if line.strip().startswith("# verified"):
+                console.print(line.strip()[2:], highlight=False, markup=False)
     console.print(f"wrote {path}")
 
 

@@ -52,16 +52,27 @@ from ..io.atomic import atomic_write_text
 from ..io.trajectory import write_trajectory, write_trajectory_json, write_trajectory_npz
 from ..robot import model_for
 from ..robot.trajectory import Trajectory
-from .decimate import decimate_tcp_path
+from .decimate import path_steps
 from .heat import urscript_heat
 from .limits import check_trajectory
+from .verify_program import (
+    Move,
+    Op,
+    ProgramRefused,
+    Sleep,
+    Switch,
+    check_path_program,
+    refuse_unless_ok,
+)
 
 __all__ = [
     "EXPORT_FORMATS",
     "MAX_MOTION_LINES",
     "MAX_PROGRAM_BYTES",
     "WARN_MOTION_LINES",
+    "ProgramRefused",
     "export_trajectory",
+    "path_program",
     "program_size_note",
     "urscript_program",
 ]
@@ -77,6 +88,8 @@ MAX_PROGRAM_BYTES = 2_000_000
 #: servoj/lookahead ranges the controller accepts (URScript manual).
 LOOKAHEAD_RANGE = (0.03, 0.2)
 GAIN_RANGE = (100.0, 2000.0)
+#: phases whose TCP speed a path program keeps within 2 % (the wire near or in the stock)
+CUTTING_PHASES = ("preheat", "lead_in", "cut", "lead_out")
 
 
 def check_servo_options(lookahead: float, gain: float) -> None:
@@ -98,6 +111,59 @@ def _vec(v: np.ndarray, digits: int) -> str:
     return "[" + ", ".join(_num(x, digits) for x in v) + "]"
 
 
+def path_program(
+    traj: Trajectory,
+    *,
+    tolerance: float | None = None,
+    angle_tolerance: float | None = None,
+    blend: float = 0.002,
+    acceleration: float = 1.0,
+    wire_tolerance: float = 0.0005,
+) -> list[Op]:
+    """The statements of a movel/movep program of ``traj`` after its initial ``movej``:
+    moves, sleeps and heat switches (:func:`~.decimate.path_steps`; docs/rtde.md).
+
+    Waypoints: every phase start, the wire entering and leaving the stock, every heat
+    switch, both ends of a dwell; the decimation's tolerances default to a quarter of
+    ``wire_tolerance`` at the wire's ends (position, and angle times half the wire)."""
+    meta = traj.meta
+    n = traj.n
+    heat = meta.heat.on(n) if meta.heat is not None else None
+    bounds = [x for p in meta.phases for x in (p.start, p.stop)]
+    bounds += [x for r in meta.in_stock for x in r]
+    strict = np.zeros(n, dtype=bool) if meta.phases else np.ones(n, dtype=bool)
+    for p in meta.phases:
+        if p.name in CUTTING_PHASES:
+            strict[p.start : p.stop] = True
+    strict |= traj.inside_stock() | (heat if heat is not None else False)
+    tol = 0.25 * wire_tolerance if tolerance is None else tolerance
+    if angle_tolerance is None:
+        half = 0.5 * meta.cut.wire_length if meta.cut is not None else 0.2
+        angle_tolerance = tol / half
+    steps = path_steps(traj.t, traj.tcp, traj.q, boundaries=bounds, heat=heat, strict=strict,
+                       tolerance=tol, angle_tolerance=angle_tolerance, blend=blend)  # fmt: skip
+    robot = model_for(meta)
+    joint_acc = float(np.min(robot.max_acceleration))
+    ops: list[Op] = []
+    hot = False  # the program switched the heat off before its first move
+    tcp, p = traj.tcp, traj.tcp[:, :3]
+    for s in steps:
+        if heat is not None and s.heat != hot:
+            ops.append(Switch(s.heat))
+            hot = s.heat
+        if s.kind == "dwell":
+            ops.append(Sleep(s.seconds))
+        elif s.kind == "joint":
+            ops.append(Move(traj.q[s.stop].copy(), joint_acc, max(s.v, 1e-5), s.r, joint=True))
+        else:
+            # v: the move's own length (rotation for a pure reorientation) in the plan's time
+            chord = float(np.linalg.norm(p[s.stop] - p[s.start]))
+            v = chord / s.seconds if chord > 1e-6 else s.v
+            ops.append(Move(tcp[s.stop].copy(), acceleration, float(np.clip(v, 1e-5, 3.0)),
+                            s.r))  # fmt: skip
+    return ops
+
+
 def program_size_note(motion_lines: int, size: int) -> str | None:
     """A warning for a long program (None when it is short)."""
     if motion_lines <= WARN_MOTION_LINES:
@@ -115,10 +181,12 @@ def urscript_program(
     gain: float = 300.0,
     approach_speed: float = 0.25,
     approach_acceleration: float = 0.5,
-    tolerance: float = 0.0005,
-    angle_tolerance: float = 0.005,
+    tolerance: float | None = None,
+    angle_tolerance: float | None = None,
     blend: float = 0.002,
     acceleration: float = 1.0,
+    wire_tolerance: float = 0.0005,
+    verify: bool = True,
     name: str = "ruledrobot_cut",
     digits: int = 10,
     allow_long: bool = False,
@@ -133,10 +201,17 @@ def urscript_program(
         (decimated linear moves of the TCP column, with blends).
     lookahead, gain : servoj parameters (0.03-0.2 s, 100-2000).
     approach_speed, approach_acceleration : the initial ``movej`` [rad/s, rad/s^2].
-    tolerance, angle_tolerance : decimation of the path modes [m, rad].
+    tolerance, angle_tolerance : decimation of the path modes [m, rad]; default a
+        quarter of ``wire_tolerance`` at the wire's ends (:func:`path_program`).
     blend : blend radius of the path modes [m] (clipped to 45 % of the shorter
-        neighbouring segment).
+        neighbouring segment; none into a dwell, a heat switch or a rest of the plan).
     acceleration : tool acceleration of the path modes [m/s^2].
+    wire_tolerance : the wire's largest distance from the planned wire in the stock [m]
+        (the job's ``[cut] wire_tolerance``, default 0.5 mm).
+    verify : (path modes) generate the program's motion and measure it against the plan
+        before writing (:mod:`.verify_program`): a program whose feed or wire breaks the
+        plan's tolerances raises :class:`ProgramRefused` (a ``ValueError``) with the
+        numbers.
     name : the program's function name.
     digits : significant digits of every number.
     allow_long : write programs beyond :data:`MAX_MOTION_LINES` / :data:`MAX_PROGRAM_BYTES`.
@@ -155,6 +230,7 @@ def urscript_program(
     meta = traj.meta
     body = io.StringIO()
     w = body.write
+    verified = ""
     heat = meta.heat
     on = heat.on(t.size) if heat is not None else np.zeros(t.size, dtype=bool)
     w(f"  set_tcp(p{_vec(ur_vector_from_pose(meta.tcp_offset), digits)})\n")
@@ -180,28 +256,22 @@ def urscript_program(
         w("  stopj(2.0)\n")
         motion_lines = t.size
     else:
-        tcp = traj.tcp
-        keep = decimate_tcp_path(tcp, tolerance, angle_tolerance)
-        if heat is not None:  # every switch of the heat at a waypoint of its own
-            edges = np.flatnonzero(np.diff(on.astype(np.int8))) + 1
-            keep = np.union1d(keep, np.r_[edges - 1, edges].clip(0, t.size - 1))
-        p = tcp[:, :3]
-        arc = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(p, axis=0), axis=1))]
-        lengths = np.diff(arc[keep])
-        was = bool(on[0])
-        if was:
-            w(f"  {urscript_heat(heat, True)}\n")
-        for n, k in enumerate(keep[1:], start=1):
-            i = keep[n - 1]
-            if heat is not None and bool(on[k]) != was:
-                w(f"  {urscript_heat(heat, bool(on[k]))}\n")
-                was = bool(on[k])
-            L = float(lengths[n - 1])
-            v = float(np.clip(L / max(t[k] - t[i], 1e-6), 1e-4, 3.0))
-            r = min(blend, 0.45 * L, 0.45 * float(lengths[n])) if n < len(keep) - 1 else 0.0
-            w(f"  {mode}(p{_vec(tcp[k], digits)}, a={_num(acceleration, digits)}, "
-              f"v={_num(v, digits)}, r={_num(max(r, 0.0), digits)})\n")  # fmt: skip
-        motion_lines = len(keep) - 1
+        ops = path_program(traj, tolerance=tolerance, angle_tolerance=angle_tolerance,
+                           blend=blend, acceleration=acceleration)  # fmt: skip
+        if verify:
+            check = check_path_program(traj, ops, wire_tolerance=wire_tolerance)
+            refuse_unless_ok(check, mode)
+            verified = f"verified (its motion, generated at the control period): {check.summary()}"
+        for op in ops:
+            if isinstance(op, Switch):
+                w(f"  {urscript_heat(heat, op.on)}\n")  # type: ignore[arg-type]
+            elif isinstance(op, Sleep):
+                w(f"  sleep({_num(op.seconds, digits)})\n")
+            else:
+                target = _vec(op.pose, digits) if op.joint else f"p{_vec(op.pose, digits)}"
+                w(f"  {'movej' if op.joint else mode}({target}, a={_num(op.a, digits)}, "
+                  f"v={_num(op.v, digits)}, r={_num(op.r, digits)})\n")  # fmt: skip
+        motion_lines = sum(1 for op in ops if not isinstance(op, Switch))
     if heat is not None:
         w(f"  {urscript_heat(heat, False)}\n")
     w('  textmsg("ruledrobot: done")\n')
@@ -221,6 +291,8 @@ def urscript_program(
         out.write(f"  # from: {meta.source}\n")
     if meta.job:
         out.write(f"  # job: {meta.job.get('path')} sha256 {meta.job.get('sha256')}\n")
+    if verified:
+        out.write(f"  # {verified}\n")
     note = program_size_note(motion_lines, size)
     if note:
         out.write(f"  # {note}\n")

@@ -58,7 +58,8 @@ def test_path_program_within_tolerance(mode: str) -> None:
     sts = _statements(text)
     assert sts[3].name == "movej"
     moves = [s for s in sts if s.name == mode]
-    assert 3 <= len(moves) < traj.t.size // 10  # decimated
+    # decimated; a speed that changes everywhere (sin^2) is split where it changes by 2 %
+    assert 3 <= len(moves) < traj.t.size // 3
     poses = np.array([s.args[0].values for s in moves])
     np.testing.assert_allclose(pose_from_ur_vector(poses[-1]), traj.tcp_poses()[-1], atol=1e-9)
     # every TCP sample lies within the tolerance of the polyline
