@@ -47,6 +47,7 @@ __all__ = [
     "feed_chord",
     "runs_of",
     "wire_ends",
+    "wire_gap",
     "wire_in_stock",
 ]
 
@@ -224,25 +225,11 @@ def wire_in_stock(t: ArrayLike, ends: ArrayLike, stock: Box) -> WireInStock:
     return WireInStock(ta, e, lo, hi, inside, _depth(e, lo, hi, stock), feed)
 
 
-def feed_chord(ends: ArrayLike, stock: Box, near: float) -> FloatArray:
-    """The chord ends (M, 2) whose speed the time law bounds: the chord where the wire
-    is in the stock; where it is outside but within ``near`` (m) of the block, its
-    point nearest the block (twice: a chord of length 0); NaN further away.
-
-    As the wire comes to the block, its nearest point becomes the point where it
-    first touches, so the bound meets the chord without a jump (a bound that appears
-    only once the wire is inside leaves the path speed no room to fall to the feed
-    before it is needed).  The nearest point minimises the distance to the box, a
-    convex function along the wire: golden-section search, to 1e-9 of the wire.
-    """
-    e = np.asarray(ends, dtype=np.float64)
-    lo, hi = chord_fractions(e, stock)
-    out = np.stack([lo, hi], axis=1)
-    outside = np.isnan(lo)
-    if not outside.any() or near <= 0.0:
-        return out
-    a = stock.to_box(e[outside, 0])
-    d = stock.to_box(e[outside, 1]) - a
+def _nearest(ends: FloatArray, stock: Box) -> tuple[FloatArray, FloatArray]:
+    """The wire's distance (M,) [m] from the block and a fraction (M,) where it is that
+    close: golden-section search on the convex distance along the wire, to 1e-9 of it."""
+    a = stock.to_box(ends[:, 0])
+    d = stock.to_box(ends[:, 1]) - a
     h = 0.5 * stock.size
 
     def dist(lam: FloatArray) -> FloatArray:
@@ -257,11 +244,44 @@ def feed_chord(ends: ArrayLike, stock: Box, near: float) -> FloatArray:
         left = fc <= fd
         x1 = np.where(left, dd, x1)
         x0 = np.where(left, x0, c)
-        c_new, d_new = x1 - g * (x1 - x0), x0 + g * (x1 - x0)
-        c, dd = c_new, d_new
+        c, dd = x1 - g * (x1 - x0), x0 + g * (x1 - x0)
         fc, fd = dist(c), dist(dd)
     lam = 0.5 * (x0 + x1)
-    close = dist(lam) <= near
+    return dist(lam), lam
+
+
+def wire_gap(ends: ArrayLike, stock: Box) -> FloatArray:
+    """(M,) m: how far the wire (ends (M, 2, 3)) is from the block (0 where it touches
+    or crosses it)."""
+    e = np.asarray(ends, dtype=np.float64).reshape(-1, 2, 3)
+    return _nearest(e, stock)[0]
+
+
+def feed_chord(ends: ArrayLike, stock: Box, near: float) -> FloatArray:
+    """The chord ends (M, 2) whose speed the time law bounds: the chord where the wire
+    is in the stock; where it is outside but within ``near`` (m) of the block, the part
+    of the wire nearest the block — its chord in the block grown by the wire's distance
+    from it (a point, or a stretch where the wire runs parallel to a face); NaN further
+    away (``near = inf``: nowhere).
+
+    As the wire comes to the block, that part becomes the part where it first touches,
+    so the bound meets the chord's without a jump (a bound that appears only once the
+    wire is inside leaves the path speed no room to fall to the feed before it is
+    needed).  The distance is :func:`wire_gap`'s; the grown box is 1e-9 m bigger.
+    """
+    e = np.asarray(ends, dtype=np.float64)
+    lo, hi = chord_fractions(e, stock)
+    out = np.stack([lo, hi], axis=1)
+    outside = np.isnan(lo)
+    if not outside.any() or near <= 0.0:
+        return out
+    gap, lam = _nearest(e[outside], stock)
+    close = gap <= near
     pick = np.flatnonzero(outside)[close]
-    out[pick, 0] = out[pick, 1] = lam[close]
+    if pick.size:
+        t_in, t_out, hit = stock.clip_lines(e[pick, 0], e[pick, 1] - e[pick, 0],
+                                            gap[close][:, None] + 1e-9)  # fmt: skip
+        lam_c = lam[close]
+        out[pick, 0] = np.where(hit, np.clip(np.nan_to_num(t_in), 0.0, 1.0), lam_c)
+        out[pick, 1] = np.where(hit, np.clip(np.nan_to_num(t_out), 0.0, 1.0), lam_c)
     return out

@@ -26,7 +26,7 @@ import numpy as np
 from ..geometry.angles import wrap_near
 from ..geometry.checks import FloatArray
 from ..robot.tool import BowTool
-from ..robot.wire_in_stock import WireInStock, wire_ends, wire_in_stock
+from ..robot.wire_in_stock import WireInStock, wire_ends, wire_gap, wire_in_stock
 from .corners import corner_nodes, corner_stop_mask, time_between_corners
 from .densify import densified, pass_deviation, pass_feed_error, uneven_intervals
 from .path import CutPath
@@ -43,7 +43,8 @@ LIFT = 0.1  # m: approach from / retract to this far beyond the lead-in/out pose
 DENSIFY_ROUNDS = 3
 DENSIFY_SHARE = 0.25
 #: m: the time law bounds the speed of the wire's point nearest the block from this far
-#: out (at least; 1.5 ruling intervals where they are longer), so that its feed bound
+#: out (at least; 1.5 ruling intervals where they are longer: :func:`_feed_param`), so
+#: that its feed bound
 #: meets the chord's without a jump where the wire enters and leaves
 #: (:func:`ruledrobot.robot.wire_in_stock.feed_chord`)
 FEED_NEAR = 0.002
@@ -133,38 +134,48 @@ class _Builder:
         self.kinds.append((label, pass_index))
 
 
-def _wire_arclength(cp: CutPath) -> FloatArray:
-    """(M,) the distance [m] travelled along the pass by its fastest chord end across the
-    wire (the frame origin where no chord exists), from 0: the path parameter the feed
-    is held in.
+def _across(p: FloatArray, o: FloatArray, z: FloatArray) -> FloatArray:
+    """Distance (K, P) of points p (K, P, 3) from the lines (o, z) (K, 3): the wire's
+    travel across itself.  Not a chord end's own travel: where the wire leaves the
+    stock at a grazing angle that end runs along the wire, many times faster than the
+    wire moves, and would stretch the parameter there."""
+    d = p - o[:, None]
+    return np.linalg.norm(d - (d * z[:, None]).sum(-1, keepdims=True) * z[:, None], axis=-1)
 
-    With it the speed factor is about 1 everywhere in the stock; the time law bounds the
-    feed with the largest speed factor around each node, so uneven ruling spacing — a
-    subdivided polygon, a slit meeting a loop — would otherwise pull the feed below the
-    set value by the unevenness."""
-    m = cp.motion
+
+def _feed_param(job: Job, cp: CutPath) -> tuple[FloatArray, float]:
+    """(M,) the path parameter the feed is held in, and ``near`` (m): the distance [m]
+    travelled across the wire by the part of it nearest the block — the chord's ends
+    inside it — as the speed factor measures it (:func:`~.toolpath.speed_factor`, the
+    one model); ``near``: how far out of the block the time law bounds that part's
+    speed, :data:`FEED_NEAR` or farther, so that the bound reaches three rulings
+    beyond every entry and exit.
+
+    First the frame origins' travel across the wire ``s0``; then each interval's length
+    is the mean speed factor at its ends (per unit of ``s0``) times its ``s0`` length,
+    so that the speed factor in the new parameter is about 1 everywhere, through the
+    wire's entry and exit too.  The time law bounds the feed with the largest speed
+    factor around each node, so uneven spacing — a subdivided polygon, a slit meeting
+    a loop, a parameter that changes its measure where the wire enters — would hold
+    the feed below the set value by the unevenness (a parameter that switched from
+    chord-end to frame-origin travel at the block's face held the wire of a helicoid
+    to 58 % of its feed there, a conoid's to 63 %)."""
     F = cp.frames
-    c = np.nan_to_num(m.chord)
     o, z = F[:, :3, 3], F[:, :3, 2]
-    ends = o[:, None] + c[:, :, None] * z[:, None]
-
-    def across(p: FloatArray, o: FloatArray, z: FloatArray) -> FloatArray:
-        """Distance (K, 2) of points p (K, 2, 3) from the lines (o, z) (K, 3): the wire's
-        travel across itself.  Not the chord end's own travel: where the wire leaves
-        the stock at a grazing angle that end runs along the wire, many times faster
-        than the wire moves, and would stretch the parameter there."""
-        d = p - o[:, None]
-        return np.linalg.norm(d - (d * z[:, None]).sum(-1, keepdims=True) * z[:, None], axis=-1)
-
-    step_ends = np.maximum(across(ends[:-1], o[1:], z[1:]), across(ends[1:], o[:-1], z[:-1]))
-    step_ends = step_ends.max(axis=1)
-    # out of the stock: the frame origins (anchored nearest the stock centre), across
-    step_mid = np.maximum(across(o[:-1, None], o[1:], z[1:]), across(o[1:, None], o[:-1], z[:-1]))
-    step_mid = step_mid[:, 0]
-    both = m.hit[:-1] & m.hit[1:]
-    step = np.where(both, step_ends, step_mid)
-    step = np.maximum(step, 1e-9)  # strictly increasing, also where the wire holds still
-    return np.r_[0.0, np.cumsum(step)]
+    step0 = np.maximum(_across(o[:-1, None], o[1:], z[1:]),
+                       _across(o[1:, None], o[:-1], z[:-1]))[:, 0]  # fmt: skip
+    step0 = np.maximum(step0, 1e-9)  # strictly increasing, also where the wire holds still
+    s0 = np.r_[0.0, np.cumsum(step0)]
+    bow = BowTool.from_spec(job.tool)
+    ends = wire_ends(cp.motion.flange @ bow.wire_frame(), bow.wire_length)
+    sf0 = speed_factor(cp.motion.flange, s0, job.tool, job.stock, np.inf)
+    step = np.maximum(0.5 * (sf0[:-1] + sf0[1:]) * step0, 1e-9)
+    gap = wire_gap(ends, job.stock)
+    inside = gap == 0.0
+    edges = np.flatnonzero(np.diff(inside.astype(np.int8)))  # node before each change
+    beyond = np.r_[edges - 3, edges + 4].clip(0, len(gap) - 1)
+    near = max(FEED_NEAR, float(gap[beyond].max(initial=0.0)) * 1.01)
+    return np.r_[0.0, np.cumsum(step)], near
 
 
 def measure_wire(job: Job, model, t: FloatArray, q: FloatArray) -> WireInStock:
@@ -190,11 +201,11 @@ def _pass_timing(
     surface between them or its feed strays (:mod:`.densify`); returns the (denser)
     pass too and the samples where the wire stops at a corner (:mod:`.corners`)."""
     cut = next(c for c in job.cuts if c.name == cp.name)
-    cp = dataclasses.replace(cp, param=_wire_arclength(cp))
+    param, near = _feed_param(job, cp)
+    cp = dataclasses.replace(cp, param=param)
     for attempt in range(DENSIFY_ROUNDS + 1):
         m = cp.motion
         s = cp.s
-        near = max(FEED_NEAR, 1.5 * float(np.diff(s).max()))
         sf = speed_factor(m.flange, s, job.tool, job.stock, near)
         corners = corner_nodes(cp.frames, 0.5 * job.tool.wire_length)
         timed = time_between_corners(s, m.q, sf, cut.feed_speed, vel, acc, dt, corners)
