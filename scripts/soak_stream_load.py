@@ -79,7 +79,7 @@ def cpu_times() -> list[int]:
         return [0] * 8
 
 
-def trial(demo: str, traj: Path, args: argparse.Namespace) -> dict:
+def trial(demo: str, traj: Path, args: argparse.Namespace, normal: bool = False) -> dict:
     before = set(traj.parent.glob("trajectory.run-*.json"))
     cpu0, load0 = cpu_times(), os.getloadavg()[0]
     load = busy(args.load, args.timeout + 30)
@@ -91,8 +91,9 @@ def trial(demo: str, traj: Path, args: argparse.Namespace) -> dict:
         cmd = [*CLI, "run", str(traj), "--yes"]
     t0 = time.monotonic()
     try:
+        env = dict(os.environ, RULEDROBOT_RUN_PRIORITY="normal") if normal else None
         res = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True,
-                             timeout=args.timeout)  # fmt: skip
+                             timeout=args.timeout, env=env)  # fmt: skip
         code, text = res.returncode, res.stdout + res.stderr
     except subprocess.TimeoutExpired as exc:
         code, text = "timeout", f"{exc.stdout or ''}{exc.stderr or ''}"
@@ -140,13 +141,25 @@ def main() -> None:
     ap.add_argument("--full", action="store_true", help="run the whole demo in each trial")
     ap.add_argument("--out", type=Path, default=None, help="plan folders (default: a temp dir)")
     ap.add_argument("--json", type=Path, default=None, help="write every trial here")
+    ap.add_argument("--compare-priority", action="store_true",
+                    help="every other trial with the streaming process at normal priority "
+                    "(RULEDROBOT_RUN_PRIORITY=normal), to measure what the priority does")
+    ap.add_argument("--summarize", type=Path, default=None,
+                    help="only print the summary of a --json file written before")
     args = ap.parse_args()
+    if args.summarize is not None:
+        rows = json.loads(args.summarize.read_text())
+        for demo in dict.fromkeys(r["demo"] for r in rows):
+            for prio in sorted({r["priority"] or "?" for r in rows if r["demo"] == demo}):
+                summarize(demo, prio, [r for r in rows if r["demo"] == demo
+                                       and (r["priority"] or "?") == prio])  # fmt: skip
+        return
     base = args.out or Path(tempfile.mkdtemp(prefix="soak_stream_"))
     rows = []
     for demo in args.demos.split(","):
         traj = plan(demo, base / demo, 1200.0)
         for i in range(args.trials):
-            row = trial(demo, traj, args)
+            row = trial(demo, traj, args, normal=args.compare_priority and i % 2 == 1)
             rows.append(row)
             print(json.dumps({"trial": i + 1, **row}), flush=True)
             if args.json:
@@ -154,19 +167,25 @@ def main() -> None:
                 args.json.write_text(json.dumps(rows, indent=1))
     print(f"\nsummary (load {args.load}):")
     for demo in args.demos.split(","):
-        rs = [r for r in rows if r["demo"] == demo]
-        done = sum(r["status"] == "completed" for r in rs)
-        ok = sum(r["exit"] == 0 for r in rs)
-        sk = [r["skipped"] for r in rs if r["skipped"] is not None]
-        sl = [r["max_slip_ms"] for r in rs if r["max_slip_ms"] is not None]
-        codes = sorted({str(r["exit"]) for r in rs})
-        print(f"  {demo}: {done}/{len(rs)} completed, {ok} exit 0 (codes {', '.join(codes)}); "
-              f"skipped samples max {max(sk, default=0)}, in the stock max "
-              f"{max((r['skipped_in_stock'] or 0) for r in rs)}; longest slip max "
-              f"{max(sl, default=0):.1f} ms")
-        for r in rs:
-            if r["exit"] != 0:
-                print(f"    exit {r['exit']}: {r['status']} {r['failed']} {r['message']!s:.200}")
+        for prio in sorted({r["priority"] or "?" for r in rows if r["demo"] == demo}):
+            summarize(demo, prio, [r for r in rows if r["demo"] == demo
+                                   and (r["priority"] or "?") == prio])  # fmt: skip
+
+
+def summarize(demo: str, prio: str, rs: list[dict]) -> None:
+    """One line per demo and priority: completed, exit 0, skips, slip, feed."""
+    done = sum(r["status"] == "completed" for r in rs)
+    ok = sum(r["exit"] == 0 for r in rs)
+    sk = sorted(r["skipped"] for r in rs if r["skipped"] is not None)
+    sl = [r["max_slip_ms"] for r in rs if r["max_slip_ms"] is not None]
+    codes = sorted({str(r["exit"]) for r in rs})
+    print(f"  {demo} ({prio}): {done}/{len(rs)} completed, {ok} exit 0 (codes "
+          f"{', '.join(codes)}); skipped samples {sk} (in the stock max "
+          f"{max((r['skipped_in_stock'] or 0) for r in rs)}); longest slip max "
+          f"{max(sl, default=0):.1f} ms")
+    for r in rs:
+        if r["exit"] != 0:
+            print(f"    exit {r['exit']}: {r['status']} {r['failed']} {r['message']!s:.200}")
 
 
 if __name__ == "__main__":

@@ -30,6 +30,7 @@ from __future__ import annotations
 import math
 import os
 import re
+import weakref
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -89,12 +90,21 @@ class Entry:
         return self.check.ok
 
 
+_INSIDE: weakref.WeakKeyDictionary[Trajectory, np.ndarray] = weakref.WeakKeyDictionary()
+
+
 def inside_mask(traj: Trajectory) -> np.ndarray:
-    """(M,) bool: the wire is in the block at sample k — from the one model of the wire
-    against the block (:meth:`Trajectory.wire_in_stock`) when the metadata names its cut
-    (``meta.cut``), else from the sidecar's ``in_stock`` ranges."""
-    wis = traj.wire_in_stock()
-    return traj.inside_stock() if wis is None else np.asarray(wis.inside, dtype=bool)
+    """(M,) bool, read-only: the wire is in the block at sample k — from the one model of
+    the wire against the block (:meth:`Trajectory.wire_in_stock`) when the metadata names
+    its cut (``meta.cut``), else from the sidecar's ``in_stock`` ranges.  Computed once
+    per trajectory (a trajectory is immutable; ~1 s for a long cut)."""
+    mask = _INSIDE.get(traj)
+    if mask is None:
+        wis = traj.wire_in_stock()
+        mask = traj.inside_stock() if wis is None else np.array(wis.inside, dtype=bool)
+        mask.flags.writeable = False
+        _INSIDE[traj] = mask
+    return mask
 
 
 def _in_stock_run(inside: np.ndarray, k: int) -> tuple[int, int] | None:
