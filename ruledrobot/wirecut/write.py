@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..geometry import se3
 from ..geometry.lines import Lines
 from ..geometry.mesh import box_clipped_mesh
 from ..io.atomic import atomic_write_bytes, atomic_write_text
@@ -23,6 +24,7 @@ from ..robot.verdict import Verdict
 from .part import RESOLUTION, part_mesh, signed_volume
 from .plan import Plan
 from .plots import plot_plan
+from .toolpath import chords
 from .verify import Verification
 
 __all__ = ["write_plan"]
@@ -36,6 +38,26 @@ def _lines_of(frames: np.ndarray) -> Lines:
     return Lines(np.concatenate([z, np.cross(o, z)], axis=1))
 
 
+#: sub-rulings per interval where the surface enters or leaves the block (surface.stl)
+EDGE_SUBDIVISION = 32
+
+
+def _with_edge_rulings(frames: np.ndarray, stock) -> np.ndarray:
+    """``frames`` (M, 4, 4) with :data:`EDGE_SUBDIVISION` - 1 screw-geodesic frames added
+    in every interval where one ruling crosses the block and the next does not, so that
+    the meshed surface reaches the block's faces where the wire does (within 1/32 of a
+    ruling interval) rather than stopping at the last ruling inside."""
+    _, _, hit = chords(frames, stock)
+    edge = np.flatnonzero(hit[:-1] != hit[1:])
+    if not edge.size:
+        return frames
+    f = np.arange(1, EDGE_SUBDIVISION) / EDGE_SUBDIVISION
+    sub = se3.geodesic(frames[edge, None], frames[edge + 1, None], f[None, :])  # (E, k, 4, 4)
+    key = np.r_[np.arange(len(frames), dtype=float), (edge[:, None] + f[None, :]).ravel()]
+    allf = np.concatenate([frames, sub.reshape(-1, 4, 4)])
+    return allf[np.argsort(key, kind="stable")]
+
+
 def _surfaces(folder: Path, plan: Plan) -> dict[str, Path]:
     """``refined.json`` (the wire's rulings and frames of every pass, one after the
     other) and ``surface.stl`` (the target surfaces inside the stock)."""
@@ -45,7 +67,8 @@ def _surfaces(folder: Path, plan: Plan) -> dict[str, Path]:
     verts, faces, n = [], [], 0
     job = plan.job
     for cp in plan.passes:
-        mesh = box_clipped_mesh(_lines_of(cp.target_frames), job.stock.centre, job.stock.size,
+        frames = _with_edge_rulings(cp.target_frames, job.stock)
+        mesh = box_clipped_mesh(_lines_of(frames), job.stock.centre, job.stock.size,
                                 job.stock.rotation)  # fmt: skip
         if len(mesh.faces):
             verts.append(mesh.vertices)
