@@ -22,7 +22,8 @@ line, then one row per controller period, and nothing else (``csv.reader`` and
      "cut": {"stock": {"centre": [...], "size": [...], "rotvec": [...]},   # or null
              "wire_length_m": 0.4,
              "feeds": [{"name": "cut", "start": 1858, "stop": 13406, "speed_m_s": 0.01,
-                        "tolerance": 0.05, "held": [[2200, 12500]]}]},
+                        "tolerance": 0.05, "held": [[2200, 12500]],
+                        "wire_tolerance_m": 0.0005}]},
      "job": {"path": "job.toml", "sha256": "..."}, "source": "ruledrobot plan",
      "csv": "trajectory.csv", "csv_sha256": "...", "samples": 12925}
 
@@ -125,7 +126,8 @@ def _cut_to_dict(cut: WireCut) -> dict[str, Any]:
                   "rotvec": rotvec_from_matrix(st.rotation).tolist()},
         "wire_length_m": cut.wire_length,
         "feeds": [{"name": w.name, "start": w.start, "stop": w.stop, "speed_m_s": w.speed,
-                   "tolerance": w.tolerance, "held": [list(r) for r in w.held]}
+                   "tolerance": w.tolerance, "held": [list(r) for r in w.held],
+                   "wire_tolerance_m": w.wire_tolerance}
                   for w in cut.feeds],
     }  # fmt: skip
 
@@ -204,7 +206,8 @@ def _cut(d: _Doc) -> WireCut | None:
         try:
             feeds.append(FeedWindow(str(w["name"]), int(w["start"]), int(w["stop"]),
                                     float(w["speed_m_s"]), float(w["tolerance"]),
-                                    tuple(tuple(r) for r in w.get("held", []))))  # fmt: skip
+                                    tuple(tuple(r) for r in w.get("held", [])),
+                                    float(w.get("wire_tolerance_m", 0.0005))))  # fmt: skip
         except (KeyError, TypeError, ValueError, AttributeError) as exc:
             raise d.fail(f"cut.feeds[{i}]", "expected {name, start, stop, speed_m_s, tolerance, "
                          f"held}}: {exc}") from None  # fmt: skip

@@ -41,8 +41,9 @@ def _ranges(value: object, what: str) -> tuple[tuple[int, int], ...]:
 @dataclass(frozen=True)
 class FeedWindow:
     """One pass's feed: samples ``[start, stop)`` of the pass (lead-in to lead-out), the
-    cut's name, its set ``speed`` (m/s) and relative ``tolerance``, and the ``held``
-    ranges where the lowest feed is checked (module doc)."""
+    cut's name, its set ``speed`` (m/s) and relative ``tolerance``, the ``held``
+    ranges where the lowest feed is checked (module doc), and the cut's
+    ``wire_tolerance`` (m): how far the wire may stray from its target in the stock."""
 
     name: str
     start: int
@@ -50,6 +51,7 @@ class FeedWindow:
     speed: float
     tolerance: float
     held: tuple[tuple[int, int], ...] = ()
+    wire_tolerance: float = 0.0005
 
     def __post_init__(self) -> None:
         if not 0 <= int(self.start) < int(self.stop):
@@ -63,6 +65,9 @@ class FeedWindow:
         object.__setattr__(self, "start", int(self.start))
         object.__setattr__(self, "stop", int(self.stop))
         object.__setattr__(self, "held", _ranges(self.held, f"feed window {self.name!r} held"))
+        if not (np.isfinite(self.wire_tolerance) and self.wire_tolerance > 0):
+            raise ValueError(f"feed window {self.name!r}: wire_tolerance must be > 0 m, got "
+                             f"{self.wire_tolerance}")  # fmt: skip
 
     def mask(self, n: int) -> np.ndarray:
         m = np.zeros(n, dtype=bool)
@@ -82,7 +87,7 @@ class FeedWindow:
             return None
         held = tuple((max(x, start) - start, min(y, stop) - start) for x, y in self.held
                      if min(y, stop) > max(x, start))  # fmt: skip
-        return FeedWindow(self.name, a, b, self.speed, self.tolerance, held)
+        return FeedWindow(self.name, a, b, self.speed, self.tolerance, held, self.wire_tolerance)
 
 
 @dataclass(frozen=True, eq=False)
@@ -100,6 +105,11 @@ class WireCut:
             raise ValueError(f"cut.wire_length: expected a length > 0 m, got {self.wire_length}")
         object.__setattr__(self, "wire_length", float(self.wire_length))
         object.__setattr__(self, "feeds", tuple(self.feeds))
+
+    @property
+    def wire_tolerance(self) -> float:
+        """m: the strictest of the passes' wire tolerances (0.5 mm without passes)."""
+        return min((w.wire_tolerance for w in self.feeds), default=0.0005)
 
     def measure(self, t: ArrayLike, tcp: ArrayLike) -> WireInStock:
         """The wire against the block along TCP poses ``tcp`` (M, 4, 4) at times ``t`` (M,)."""

@@ -120,7 +120,8 @@ def wire_cut(job: Job, motion: Motion) -> WireCut:
         mask = np.zeros(len(motion.pass_of), dtype=bool)
         mask[rows] = True
         feeds.append(FeedWindow(cut.name, int(rows[0]), int(rows[-1]) + 1, cut.feed_speed,
-                                cut.feed_tolerance, runs(held_all & mask)))  # fmt: skip
+                                cut.feed_tolerance, runs(held_all & mask),
+                                cut.wire_tolerance))  # fmt: skip
     return WireCut(job.stock, BowTool.from_spec(job.tool).wire_length, tuple(feeds))
 
 
