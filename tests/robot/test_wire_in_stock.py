@@ -74,8 +74,14 @@ def test_feed_chord_meets_the_chord_without_a_jump():
     assert np.isnan(f[far]).all()
     near = (x > -0.15 + 1e-9) & (x < -0.1)
     assert np.isfinite(f[near]).all()
-    # the nearest point lies on the face's extent, within the chord the wire gets
-    assert ((f[near] >= 0.4 - 1e-6) & (f[near] <= 0.6 + 1e-6)).all()
+    # the part nearest the block (parallel to its face: a stretch) becomes the chord the
+    # wire gets on entering, [0.4, 0.6], continuously
+    gap = -0.1 - x[near]
+    np.testing.assert_allclose(f[near, 0], 0.4 - gap, atol=1e-6)
+    np.testing.assert_allclose(f[near, 1], 0.6 + gap, atol=1e-6)
+    w = wire_in_stock(t, ends, STOCK)
+    k = np.flatnonzero(w.inside)[0]
+    np.testing.assert_allclose([w.lo[k], w.hi[k]], [0.4, 0.6], atol=1e-9)
 
 
 def _independent(t: np.ndarray, ends: np.ndarray, box: Box, n: int = 2001):
