@@ -48,9 +48,9 @@ def export(
         None, min=1e-6, help="movel/movep: decimation tolerance at the wire's ends [m] "
         "(default a quarter of --wire-tolerance)."),
     blend: float = typer.Option(0.002, min=0.0, help="movel/movep: blend radius [m]."),
-    wire_tolerance: float = typer.Option(
-        0.0005, min=1e-6, help="movel/movep: the wire's largest distance from the planned "
-        "wire in the stock [m] (the job's [cut] wire_tolerance)."),
+    wire_tolerance: float | None = typer.Option(
+        None, min=1e-6, help="movel/movep: the wire's largest distance from the planned "
+        "wire in the stock [m] (default: the plan's [cut] wire_tolerance)."),
 ) -> None:
     """Export a trajectory as CSV/JSON/NPZ or a standalone URScript program for the pendant.
 

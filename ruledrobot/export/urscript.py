@@ -111,6 +111,14 @@ def _vec(v: np.ndarray, digits: int) -> str:
     return "[" + ", ".join(_num(x, digits) for x in v) + "]"
 
 
+def plan_wire_tolerance(traj: Trajectory, wire_tolerance: float | None = None) -> float:
+    """``wire_tolerance`` [m], or the plan's (the strictest of its cuts', from the
+    sidecar's ``cut``), or 0.5 mm for a trajectory that names no cut."""
+    if wire_tolerance is not None:
+        return float(wire_tolerance)
+    return traj.meta.cut.wire_tolerance if traj.meta.cut is not None else 0.0005
+
+
 def path_program(
     traj: Trajectory,
     *,
@@ -118,7 +126,7 @@ def path_program(
     angle_tolerance: float | None = None,
     blend: float = 0.002,
     acceleration: float = 1.0,
-    wire_tolerance: float = 0.0005,
+    wire_tolerance: float | None = None,
 ) -> list[Op]:
     """The statements of a movel/movep program of ``traj`` after its initial ``movej``:
     moves, sleeps and heat switches (:func:`~.decimate.path_steps`; docs/rtde.md).
@@ -128,6 +136,7 @@ def path_program(
     ``wire_tolerance`` at the wire's ends (position, and angle times half the wire)."""
     meta = traj.meta
     n = traj.n
+    wire_tolerance = plan_wire_tolerance(traj, wire_tolerance)
     heat = meta.heat.on(n) if meta.heat is not None else None
     bounds = [x for p in meta.phases for x in (p.start, p.stop)]
     bounds += [x for r in meta.in_stock for x in r]
@@ -185,7 +194,7 @@ def urscript_program(
     angle_tolerance: float | None = None,
     blend: float = 0.002,
     acceleration: float = 1.0,
-    wire_tolerance: float = 0.0005,
+    wire_tolerance: float | None = None,
     verify: bool = True,
     name: str = "ruledrobot_cut",
     digits: int = 10,
@@ -207,7 +216,7 @@ def urscript_program(
         neighbouring segment; none into a dwell, a heat switch or a rest of the plan).
     acceleration : tool acceleration of the path modes [m/s^2].
     wire_tolerance : the wire's largest distance from the planned wire in the stock [m]
-        (the job's ``[cut] wire_tolerance``, default 0.5 mm).
+        (default: the plan's, ``meta.cut.wire_tolerance``; 0.5 mm without one).
     verify : (path modes) generate the program's motion and measure it against the plan
         before writing (:mod:`.verify_program`): a program whose feed or wire breaks the
         plan's tolerances raises :class:`ProgramRefused` (a ``ValueError``) with the
@@ -259,7 +268,8 @@ def urscript_program(
         ops = path_program(traj, tolerance=tolerance, angle_tolerance=angle_tolerance,
                            blend=blend, acceleration=acceleration)  # fmt: skip
         if verify:
-            check = check_path_program(traj, ops, wire_tolerance=wire_tolerance)
+            check = check_path_program(traj, ops,
+                                       wire_tolerance=plan_wire_tolerance(traj, wire_tolerance))
             refuse_unless_ok(check, mode)
             verified = f"verified (its motion, generated at the control period): {check.summary()}"
         for op in ops:

@@ -25,6 +25,7 @@ most 0.1 degree); the corners of a polygon keep their full angle.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from itertools import pairwise
 
 import numpy as np
@@ -82,7 +83,7 @@ def _turning(o: FloatArray, z: FloatArray, half_length: float, angle: float) -> 
 def time_between_corners(
     s: FloatArray,
     q: FloatArray,
-    speed_factor: FloatArray,
+    speed_factor: FloatArray | Callable[[int, int], FloatArray],
     feed_speed: float,
     vel_limits: FloatArray,
     acc_limits: FloatArray,
@@ -91,10 +92,19 @@ def time_between_corners(
 ) -> TimedPath:
     """:func:`~.timing.time_path` of the pass in pieces split at ``corners`` (node
     indices), each from rest to rest, joined (:func:`~.timing.concatenate`; ``s_of_t``
-    stays the pass's parameter).  Without corners, the pass in one piece."""
+    stays the pass's parameter).  Without corners, the pass in one piece.
+
+    ``speed_factor``: (N,) for the whole pass, or a function of a piece's first and last
+    node giving its own (so that its differences never reach across a corner, where a
+    central difference of two directions would take the wire's speed for less than it
+    is: 0.7 of it at a right angle)."""
     cuts = [0, *(int(c) for c in corners), len(s) - 1]
+
+    def factor(a: int, b: int) -> FloatArray:
+        return speed_factor(a, b) if callable(speed_factor) else speed_factor[a : b + 1]
+
     parts = [
-        time_path(s[a : b + 1], q[a : b + 1], speed_factor[a : b + 1], feed_speed,
+        time_path(s[a : b + 1], q[a : b + 1], factor(a, b), feed_speed,
                   vel_limits, acc_limits, dt)
         for a, b in pairwise(cuts)
     ]  # fmt: skip

@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass, field
+from itertools import pairwise
 
 import numpy as np
 
@@ -168,8 +169,13 @@ def _feed_param(job: Job, cp: CutPath) -> tuple[FloatArray, float]:
     s0 = np.r_[0.0, np.cumsum(step0)]
     bow = BowTool.from_spec(job.tool)
     ends = wire_ends(cp.motion.flange @ bow.wire_frame(), bow.wire_length)
-    sf0 = speed_factor(cp.motion.flange, s0, job.tool, job.stock, np.inf)
-    step = np.maximum(0.5 * (sf0[:-1] + sf0[1:]) * step0, 1e-9)
+    step = np.empty_like(step0)
+    cuts = [0, *(int(c) for c in corner_nodes(F, 0.5 * job.tool.wire_length)), len(F) - 1]
+    for a, b in pairwise(cuts):  # between corners: differences never reach across one
+        sf0 = speed_factor(cp.motion.flange[a : b + 1], s0[a : b + 1], job.tool, job.stock,
+                           np.inf)  # fmt: skip
+        step[a:b] = 0.5 * (sf0[:-1] + sf0[1:]) * step0[a:b]
+    step = np.maximum(step, 1e-9)
     gap = wire_gap(ends, job.stock)
     inside = gap == 0.0
     edges = np.flatnonzero(np.diff(inside.astype(np.int8)))  # node before each change
@@ -206,8 +212,11 @@ def _pass_timing(
     for attempt in range(DENSIFY_ROUNDS + 1):
         m = cp.motion
         s = cp.s
-        sf = speed_factor(m.flange, s, job.tool, job.stock, near)
         corners = corner_nodes(cp.frames, 0.5 * job.tool.wire_length)
+
+        def sf(a: int, b: int, m=m, s=s) -> FloatArray:  # one piece between corners
+            return speed_factor(m.flange[a : b + 1], s[a : b + 1], job.tool, job.stock, near)
+
         timed = time_between_corners(s, m.q, sf, cut.feed_speed, vel, acc, dt, corners)
         if attempt == DENSIFY_ROUNDS:
             break
