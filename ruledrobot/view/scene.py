@@ -34,8 +34,8 @@ from ..robot.model import RobotModel
 from ..robot.rates import finite_difference_rates
 from ..robot.trajectory import KinematicsRef, model_for
 from ..robot.verdict import Check
-from ..sim._mujoco import mujoco
 from ..robot.wire_in_stock import chord_fractions, wire_in_stock
+from ..sim._mujoco import mujoco
 from ..sim.scene import Scene, default_camera
 from .clearance import Event, contacts_along, locate, near_misses
 from .folder import PlanFolder, read_plan_folder
