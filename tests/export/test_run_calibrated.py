@@ -29,9 +29,10 @@ RESULTS: dict[str, float] = {}
 
 
 def _plan(tmp_path, calibration: str | None):
+    # a 6 cm strip of the demo's surface through a block it spans (5 cm)
     text = DEMO_JOB.replace("u = [-0.12, 0.12]", "u = [-0.03, 0.03]").replace(
         "feed_speed = 0.01", "feed_speed = 0.02"
-    )
+    ).replace("size = [0.2, 0.2, 0.15]", "size = [0.05, 0.2, 0.15]")
     if calibration:
         text = text.replace("speed_scale = 1.0",
                             f'speed_scale = 1.0\ncalibration = "{calibration}"')  # fmt: skip
