@@ -25,6 +25,7 @@ import subprocess
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from ..io.paths import input_path
 from ..wirecut.job import file_fields, job_document
 from .jobs import BatchInputError, JobEntry, merge_overrides
 
@@ -125,9 +126,9 @@ class JobContent:
 
 def resolve_input(named: str, job_path: Path) -> Path:
     """Where an input file named ``named`` by the job file at ``job_path`` (absolute)
-    is: relative paths from the job's folder, normalised (``..`` removed)."""
-    p = Path(named)
-    return Path(os.path.normpath(p if p.is_absolute() else job_path.parent / p))
+    is: relative paths from the job's folder, normalised
+    (:func:`ruledrobot.io.paths.input_path`, the one rule of every format)."""
+    return input_path(named, job_path.parent)
 
 
 def _digest(text: bytes | None, error: str | None, inputs: tuple[InputFile, ...],

@@ -31,6 +31,7 @@ from ..geometry.mesh import Mesh
 from ..io.lines import read_lines_document
 from ..io.mesh import read_stl
 from ..io.outdir import read_manifest
+from ..io.paths import input_path
 from ..io.text import read_user_text
 from ..robot.trajectory import Trajectory
 from ..robot.verdict import Check
@@ -120,16 +121,13 @@ def _job(folder: Path, report: dict[str, Any], notes: list[str]) -> Any:
     base_dir = Path(origin).parent if origin and Path(origin).parent.is_dir() else folder
     surface = doc.get("surface")
     if isinstance(surface, dict) and isinstance(surface.get("file"), str):
-        lines_file = Path(surface["file"])
-        if not lines_file.is_absolute():
-            lines_file = base_dir / lines_file
+        lines_file = input_path(surface["file"], base_dir)
         if not lines_file.exists() and (folder / "refined.json").exists():
             surface["file"] = str(folder / "refined.json")
             notes.append(f"the job's lines file {lines_file} is gone; not needed to view")
     robot = doc.get("robot")
     if isinstance(robot, dict) and isinstance(robot.get("calibration"), str):
-        cal = Path(robot["calibration"])
-        cal = cal if cal.is_absolute() else base_dir / cal
+        cal = input_path(robot["calibration"], base_dir)
         if not cal.exists():
             del robot["calibration"]
             notes.append(f"the job's calibration {cal} is gone: the arm is drawn with the "

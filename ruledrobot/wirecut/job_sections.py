@@ -15,6 +15,7 @@ import numpy as np
 
 from ..geometry import se3
 from ..geometry.box import Box
+from ..io.paths import input_path, missing_file
 from ..robot.calibration import Calibration
 from ..subdivision.schemes import SCHEME_NAMES
 from .spec import HeatSpec, RobotSpec, SurfaceSpec
@@ -166,11 +167,13 @@ def parse_surface(s: Section, base_dir: Path | None) -> SurfaceSpec:
     else:
         if not isinstance(file, str):
             raise s.fail("file", f"expected a path string, got {file!r}")
-        path = Path(file)
-        if not path.is_absolute() and base_dir is not None:
-            path = base_dir / path
-        if not path.exists():
-            raise s.fail(foreign[0] if foreign else "file", f"no such lines file: {path}")
+        if foreign:  # resolved and checked by the format's options (parse_read_spec)
+            path = Path(file)
+        else:
+            path = input_path(file, base_dir)
+            missing = missing_file(path, "lines")
+            if missing:
+                raise s.fail("file", missing)
         if "u" in s.raw:
             raise s.fail("u", "only for a builtin surface")
         if params:
@@ -264,9 +267,7 @@ def _calibration(sec: Section, model: str, base_dir: Path | None) -> Calibration
         return None
     if not isinstance(value, str):
         raise sec.fail("calibration", f"expected a path string, got {value!r}")
-    path = Path(value)
-    if not path.is_absolute() and base_dir is not None:
-        path = base_dir / path
+    path = input_path(value, base_dir)
     from ..io.calibration import load_calibration
 
     try:

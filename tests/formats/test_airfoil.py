@@ -93,7 +93,7 @@ def test_wing_options_from_a_job_table(files):
     w = WingOptions.parse(o)
     assert w.twist == -0.03 and w.tip == files / "n0012.dat"
     bad = [({"root": "n2412.dat", "span": 0.3}, r"\[surface.airfoil\] root_chord: missing"),
-           ({"root": "x.dat", "span": 0.3, "root_chord": 0.2}, r"root: no such file"),
+           ({"root": "x.dat", "span": 0.3, "root_chord": 0.2}, r"root: no such airfoil file"),
            ({"root": "n2412.dat", "span": 0.3, "root_chord": 0.2, "twist": 0.1,
              "washout": 0.1}, r"twist: give twist or washout, not both"),
            ({"root": "n2412.dat", "span": 0.3, "root_chord": 0.2, "chord": 1},

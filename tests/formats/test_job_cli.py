@@ -84,7 +84,7 @@ def _write(tmp, table: str, surface_fields: str = "") -> Path:
         ('gcode = { file = "wedge.ngc", tower_distance = 0.8, towers = 2 }\n',
          r"\[surface\.gcode\]: unknown option\(s\) towers; expected some of"),
         ('gcode = { file = "nope.ngc", tower_distance = 0.8 }\n',
-         r"\[surface\.gcode\] file: no such file"),
+         r"\[surface\.gcode\] file: no such G-code file"),
         ('gcode = { file = "wedge.ngc", tower_distance = 0.8 }\nbuiltin = "helicoid"\n',
          r"\[surface\] builtin/file/gcode/airfoil/dxf/rhino: give exactly one of"),
         ('gcode = { file = "wedge.ngc", tower_distance = 0.8, axes = "XYZ" }\n',
@@ -151,7 +151,8 @@ def test_convert_round_trips_and_says_what_it_wrote(wedge):
          r"--out-faces: expected 2 comma-separated numbers"),
         (["wedge.ngc", "--to", "w.ngc", "--tower-distance", "0.8", "--out-feed-at", "faces"],
          r"faces \(--out-faces\): missing; feed_at = faces"),
-        (["missing.ngc", "--to", "w.json", "--tower-distance", "0.8"], r"--file: no such file"),
+        (["missing.ngc", "--to", "w.json", "--tower-distance", "0.8"],
+         r"--file: no such G-code file"),
     ],
 )
 def test_convert_refuses_bad_input_with_exit_2_and_writes_nothing(wedge, args, message):

@@ -109,7 +109,7 @@ def parse_read_spec(kind: str, value: str | os.PathLike[str] | Mapping[str, Any]
     key = "root" if kind == "airfoil" else "file"
     raw = {key: value} if isinstance(value, (str, os.PathLike)) else value
     o = Options(raw, where, cli=cli, base_dir=base_dir)
-    path = o.path(key)
+    path = o.path(key, kind=kind)
     if kind == "airfoil":
         return ReadSpec(kind, path, _wing_options(o))
     return ReadSpec(kind, path, _READ_OPTIONS[kind](o))

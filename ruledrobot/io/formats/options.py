@@ -14,6 +14,7 @@ from typing import Any
 
 import numpy as np
 
+from ..paths import input_path, missing_file
 from ..units import unit_name
 
 __all__ = ["Options"]
@@ -149,8 +150,10 @@ class Options:
             return None
         return unit_name(v, self.label(key))
 
-    def path(self, key: str, required: bool = True) -> Path | None:
-        """A file that exists (relative paths from ``base_dir``)."""
+    def path(self, key: str, required: bool = True, kind: str = "file") -> Path | None:
+        """A file that exists (relative paths from ``base_dir``,
+        :func:`ruledrobot.io.paths.input_path`); ``kind`` names it in the message when it
+        is missing (``"lines"``, ``"gcode"``, ...: ``"no such G-code file: PATH"``)."""
         v = self.get(key)
         if v is None:
             if required:
@@ -158,11 +161,10 @@ class Options:
             return None
         if not isinstance(v, (str, os.PathLike)):
             raise self.fail(key, f"expected a path string, got {v!r}")
-        p = Path(v)
-        if not p.is_absolute() and self.base_dir is not None:
-            p = self.base_dir / p
-        if not p.is_file():
-            raise self.fail(key, f"no such file: {p}")
+        p = input_path(v, self.base_dir)
+        missing = missing_file(p, kind)
+        if missing:
+            raise self.fail(key, missing)
         return p
 
     def done(self) -> None:

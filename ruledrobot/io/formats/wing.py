@@ -57,8 +57,8 @@ class WingOptions:
 
     @classmethod
     def parse(cls, o: Options) -> WingOptions:
-        root = o.path("root")
-        tip = o.path("tip", required=False)
+        root = o.path("root", kind="airfoil")
+        tip = o.path("tip", required=False, kind="airfoil")
         if o.has("twist") and o.has("washout"):
             raise o.fail("twist", "give twist or washout, not both (washout = -twist)")
         twist = o.number("twist", 0.0, lo=-np.pi / 2, hi=np.pi / 2)
