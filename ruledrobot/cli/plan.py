@@ -73,6 +73,9 @@ def _run_plan(job_path: Path, out: Path, video: bool = False):
     print_verdict(result.verdict, f"checks of {job_path}")
     for name, path in result.files.items():
         console.print(f"wrote {path}  ({name})", highlight=False, markup=False)
+    for path in result.kept:
+        console.print(f"kept {path}  (a recording of an earlier run)", highlight=False,
+                      markup=False)  # fmt: skip
     if not result.feasible:
         err.print(f"no trajectory written: the plan fails ({out / 'report.json'} says why)",
                   highlight=False, markup=False)  # fmt: skip

@@ -51,13 +51,17 @@ def export(
     wire_tolerance: float | None = typer.Option(
         None, min=1e-6, help="movel/movep: the wire's largest distance from the planned "
         "wire in the stock [m] (default: the plan's [cut] wire_tolerance)."),
+    force: bool = typer.Option(False, "--force", help="Replace files the export did not "
+                               "write (a user's file, a recording) at --out."),
 ) -> None:
     """Export a trajectory as CSV/JSON/NPZ or a standalone URScript program for the pendant.
 
     Every program sets the TCP and the payload from the trajectory's metadata.  A movel or
     movep program's motion is generated and measured against the plan (feed, wire) before
-    it is written: exit 1, nothing written, when it would not cut as planned."""
-    from ..export import export_trajectory
+    it is written: exit 1, nothing written, when it would not cut as planned.  An export
+    replaces only files of the kind it writes (an earlier export): anything else at --out
+    (or at a CSV's sidecar) is refused, exit 2, unless --force."""
+    from ..export import EXPORT_FORMATS, export_targets, export_trajectory
     from ..export.verify_program import ProgramRefused
     from ..io.trajectory import read_trajectory
 
@@ -70,7 +74,11 @@ def export(
             if mode.value != "servoj":
                 options |= {"tolerance": tolerance, "blend": blend,
                             "wire_tolerance": wire_tolerance}  # fmt: skip
-        path = export_trajectory(traj, out, None if fmt is None else fmt.value, **options)
+        kind = fmt.value if fmt is not None else EXPORT_FORMATS.get(out.suffix.lower())
+        targets = export_targets(out, kind) if kind else [out]
+        existed = {t for t in targets if t.exists()}
+        path = export_trajectory(traj, out, None if fmt is None else fmt.value, force=force,
+                                 **options)  # fmt: skip
     except ProgramRefused as exc:
         err.print(f"refused: {exc}", highlight=False, markup=False)
         raise typer.Exit(code=1) from None
@@ -81,7 +89,11 @@ def export(
         for line in path.read_text().splitlines()[:12]:
             if line.strip().startswith("# verified"):
                 console.print(line.strip()[2:], highlight=False, markup=False)
-    console.print(f"wrote {path}")
+    for target in targets:
+        notes = ([] if target == path else [f"the sidecar of {path.name}"]) + \
+            (["replaced an earlier export"] if target in existed else [])  # fmt: skip
+        said = f"  ({'; '.join(notes)})" if notes else ""
+        console.print(f"wrote {target}{said}", highlight=False, markup=False)
 
 
 class RunModeName(str, Enum):

@@ -11,7 +11,16 @@ before the commit leaves the target as it was (the staging folder, named
 
 The target must be new, empty, or an earlier output folder of ruledrobot (it
 holds a ``manifest.json`` of ours, or only names this project writes): a folder
-of the user's own files is never replaced.
+of the user's own files is never replaced, and neither is one where a user's file
+was put beside the results (a name neither the manifest lists nor this project
+writes): the error names it.
+
+**Recordings survive.** The recordings of runs (``<stem>.run-NNN.csv`` and its
+sidecar ``.json``, as the runner names them; the older ``<stem>.actual.csv/json``)
+are the only evidence of what a robot did: :meth:`StagedFolder.commit` carries them
+over into the new folder (hard links, else copies, before the swap), lists them in
+the manifest's ``"kept"`` (not ``"files"``: they are not the plan's) and says so in
+:attr:`StagedFolder.kept`.
 """
 
 from __future__ import annotations
@@ -20,6 +29,7 @@ import ctypes
 import hashlib
 import json
 import os
+import re
 import shutil
 import tempfile
 import time
@@ -29,7 +39,7 @@ from typing import Any
 
 from .atomic import atomic_write_text
 
-__all__ = ["MANIFEST", "MANIFEST_FORMAT", "StagedFolder", "read_manifest"]
+__all__ = ["MANIFEST", "MANIFEST_FORMAT", "StagedFolder", "is_recording", "read_manifest"]
 
 MANIFEST = "manifest.json"
 MANIFEST_FORMAT = "ruledrobot.output/1"
@@ -40,6 +50,13 @@ _OURS = {
     "reach.json", "part.stl",
 }  # fmt: skip
 _OUR_PATTERNS = ("*.run-*.csv", "*.run-*.json", "*.actual.csv", "*.actual.json", "cut.*")
+#: recordings of runs (``export/run_plan.recording_path_for``): carried over, never replaced
+_RECORDING = re.compile(r".+(\.run-\d{3,}|\.actual)\.(csv|json)$")
+
+
+def is_recording(name: str) -> bool:
+    """Whether a file name is a run's recording (or its sidecar)."""
+    return _RECORDING.fullmatch(name) is not None
 
 
 def _exchange(a: Path, b: Path) -> bool:
@@ -70,15 +87,16 @@ def _replaceable(target: Path) -> str | None:
         return None
     if not target.is_dir():
         return f"{target} exists and is not a folder"
-    if read_manifest(target) is not None:
-        return None
+    man = read_manifest(target) or {}
+    listed = {k.split("/")[0] for k in man.get("files", {})} | set(man.get("kept", {}))
     foreign = sorted(p.name for p in target.iterdir()
-                     if p.name not in _OURS and not p.name.startswith(".")
+                     if p.name not in _OURS and p.name not in listed
+                     and not p.name.startswith(".")
                      and not any(fnmatch(p.name, pat) for pat in _OUR_PATTERNS))  # fmt: skip
     if foreign:
         shown = ", ".join(foreign[:5]) + (" ..." if len(foreign) > 5 else "")
-        return (f"{target} holds files that ruledrobot did not write ({shown}); choose a new "
-                "or empty output folder")  # fmt: skip
+        return (f"{target} holds files that ruledrobot did not write ({shown}); move them, or "
+                "choose a new or empty output folder")  # fmt: skip
     return None
 
 
@@ -108,6 +126,8 @@ class StagedFolder:
         self.path = Path(tempfile.mkdtemp(prefix=f".{self.target.name}.staging-",
                                           dir=self.target.parent))  # fmt: skip
         self.committed = False
+        #: recordings carried over from the folder replaced (names), set by :meth:`commit`
+        self.kept: list[str] = []
 
     def _sweep(self) -> None:
         """Remove staging folders of runs that were killed (older than an hour)."""
@@ -137,9 +157,12 @@ class StagedFolder:
             if p.is_file():
                 rel = p.relative_to(self.path).as_posix()
                 files[rel] = {"bytes": p.stat().st_size, "sha256": _sha256(p)}
+        kept = self._carry_recordings()
         doc = {"format": MANIFEST_FORMAT, "complete": True,
                "written": time.strftime("%Y-%m-%dT%H:%M:%S%z"), **(info or {}),
                "files": files}  # fmt: skip
+        if kept:
+            doc["kept"] = kept
         atomic_write_text(self.path / MANIFEST, json.dumps(doc, indent=1) + "\n")
         os.chmod(self.path, 0o755)
         if not self.target.exists():
@@ -153,3 +176,23 @@ class StagedFolder:
             shutil.rmtree(old, ignore_errors=True)
         self.committed = True
         return self.target
+
+    def _carry_recordings(self) -> dict[str, dict[str, Any]]:
+        """Hard-link (else copy) the target's recordings into the staging folder; their
+        sizes and SHA-256 by name."""
+        kept: dict[str, dict[str, Any]] = {}
+        if not self.target.is_dir():
+            return kept
+        for src in sorted(self.target.iterdir()):
+            if not (src.is_file() and is_recording(src.name)):
+                continue
+            dst = self.path / src.name
+            if dst.exists():  # never over a file of the new results
+                continue
+            try:
+                os.link(src, dst)
+            except OSError:
+                shutil.copy2(src, dst)
+            kept[src.name] = {"bytes": dst.stat().st_size, "sha256": _sha256(dst)}
+        self.kept = sorted(kept)
+        return kept

@@ -50,6 +50,8 @@ class PlanResult:
     path: CutPath | None = field(default=None, repr=False)
     verdict: Verdict | None = None
     plan: Plan | None = field(default=None, repr=False)
+    #: recordings of earlier runs carried over from the folder replaced (io/outdir.py)
+    kept: tuple[Path, ...] = ()
 
 
 def plan(
@@ -98,7 +100,8 @@ def plan(
         target = stage.commit({"kind": "plan", "feasible": verdict.ok,
                                "verdict": verdict.summary()})  # fmt: skip
         files = {k: target / Path(v).relative_to(stage.path) for k, v in files.items()}
-        return dataclasses.replace(result, files=files)
+        kept = tuple(Path(out_dir) / name for name in stage.kept)
+        return dataclasses.replace(result, files=files, kept=kept)
     except BaseException:
         if stage is not None:
             stage.abort()
