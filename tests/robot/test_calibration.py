@@ -225,8 +225,8 @@ def test_dh_from_axes_of_a_random_calibration_gives_its_axes() -> None:
     # 2-4 (d of hundreds of metres) cost some digits
     for i in range(7):
         np.testing.assert_allclose(G[i, :3, 2], F[i, :3, 2], atol=1e-12)
-        assert np.linalg.norm(np.cross(G[i, :3, 3] - F[i, :3, 3], F[i, :3, 2])) < 1e-8
-    np.testing.assert_allclose(G[6], F[6], atol=1e-8)
+        assert np.linalg.norm(np.cross(G[i, :3, 3] - F[i, :3, 3], F[i, :3, 2])) < 5e-8
+    np.testing.assert_allclose(G[6], F[6], atol=5e-8)  # 1.4e-8 with numpy 2.4
 
 
 # ---------------------------------------------------------------------- files
@@ -342,7 +342,10 @@ def test_fk_equals_a_product_of_dh_matrices(model: str, seed: int, qseed: int) -
     m = load(model, calibration=cal)
     q = np.random.default_rng(qseed).uniform(-2 * np.pi, 2 * np.pi, (20, 6))
     ref = dh_fk_reference(q, cal.d, cal.a, cal.alpha, cal.theta_offset)
-    assert np.abs(m.fk(q) - ref).max() < 1e-12
+    # two float64 products of six transforms whose offsets reach hundreds of metres (the
+    # nearly cancelling d2..d4 of a calibration): rounding scales with their sum
+    tol = 1e-12 + 64 * np.finfo(float).eps * float(np.abs(cal.d).sum() + np.abs(cal.a).sum())
+    assert np.abs(m.fk(q) - ref).max() < tol
 
 
 @pytest.mark.parametrize("model", sorted(REAL))
