@@ -49,6 +49,11 @@ DENSIFY_SHARE = 0.25
 #: meets the chord's without a jump where the wire enters and leaves
 #: (:func:`ruledrobot.robot.wire_in_stock.feed_chord`)
 FEED_NEAR = 0.002
+#: s: the wire moves at its feed for at least this long before it enters the block (and
+#: after it leaves), so that a servo following the plan has settled by then: ruledrobot's
+#: streams filter with a 0.1 s look-ahead, and the part demo's wire entered its side cut
+#: at 12.7 mm/s against 12 +- 5 % when the lead-in sped up until just before the block
+SETTLE_S = 0.3
 
 
 @dataclass(frozen=True, eq=False)
@@ -144,13 +149,13 @@ def _across(p: FloatArray, o: FloatArray, z: FloatArray) -> FloatArray:
     return np.linalg.norm(d - (d * z[:, None]).sum(-1, keepdims=True) * z[:, None], axis=-1)
 
 
-def _feed_param(job: Job, cp: CutPath) -> tuple[FloatArray, float]:
+def _feed_param(job: Job, cp: CutPath, feed_speed: float) -> tuple[FloatArray, float]:
     """(M,) the path parameter the feed is held in, and ``near`` (m): the distance [m]
     travelled across the wire by the part of it nearest the block — the chord's ends
     inside it — as the speed factor measures it (:func:`~.toolpath.speed_factor`, the
     one model); ``near``: how far out of the block the time law bounds that part's
-    speed, :data:`FEED_NEAR` or farther, so that the bound reaches three rulings
-    beyond every entry and exit.
+    speed: :data:`FEED_NEAR`, or farther so that the bound reaches three rulings beyond
+    every entry and exit and the wire moves at the feed for :data:`SETTLE_S` before it.
 
     First the frame origins' travel across the wire ``s0``; then each interval's length
     is the mean speed factor at its ends (per unit of ``s0``) times its ``s0`` length,
@@ -180,7 +185,7 @@ def _feed_param(job: Job, cp: CutPath) -> tuple[FloatArray, float]:
     inside = gap == 0.0
     edges = np.flatnonzero(np.diff(inside.astype(np.int8)))  # node before each change
     beyond = np.r_[edges - 3, edges + 4].clip(0, len(gap) - 1)
-    near = max(FEED_NEAR, float(gap[beyond].max(initial=0.0)) * 1.01)
+    near = max(FEED_NEAR, feed_speed * SETTLE_S, float(gap[beyond].max(initial=0.0)) * 1.01)
     return np.r_[0.0, np.cumsum(step)], near
 
 
@@ -207,7 +212,7 @@ def _pass_timing(
     surface between them or its feed strays (:mod:`.densify`); returns the (denser)
     pass too and the samples where the wire stops at a corner (:mod:`.corners`)."""
     cut = next(c for c in job.cuts if c.name == cp.name)
-    param, near = _feed_param(job, cp)
+    param, near = _feed_param(job, cp, cut.feed_speed)
     cp = dataclasses.replace(cp, param=param)
     for attempt in range(DENSIFY_ROUNDS + 1):
         m = cp.motion
