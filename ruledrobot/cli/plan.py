@@ -120,10 +120,10 @@ def demo(
     --part, a part of three cuts): refine, plan, time, verify in MuJoCo, render a video,
     export URScript, and stream the cut through ur_rtde to the embedded controller
     emulator."""
-    import tempfile
-
     from ..export import export_trajectory
     from ..export.urscript import MAX_MOTION_LINES
+    from ..io.atomic import atomic_write_text
+    from ..io.outdir import check_replaceable
     from ..wirecut.demo import DEMO_JOB, PART_JOB
     from .robot import say_program_size
     from .robot import stream as stream_run
@@ -134,10 +134,14 @@ def demo(
                       "twisted side, all the way round), kerf compensated, heat switched, UR5e")
     else:
         console.print("[bold]ruledrobot demo[/]: hyperbolic paraboloid through a foam block, UR5e")
-    with tempfile.TemporaryDirectory() as tmp:
-        job_path = Path(tmp) / "job.toml"
-        job_path.write_text(PART_JOB if part else DEMO_JOB, encoding="utf-8")
-        result = _run_plan(job_path, out, video=video)
+    # the job file lives in the output folder (the plan keeps it there as job.toml), so the
+    # reports name a file that exists; written only where a plan may write
+    try:
+        check_replaceable(out)
+        job_path = atomic_write_text(out / "job.toml", PART_JOB if part else DEMO_JOB)
+    except (OSError, ValueError) as exc:
+        raise fail(str(exc)) from None
+    result = _run_plan(job_path, out, video=video)
     traj_path = out / "trajectory.csv"
     mode = "servoj" if result.trajectory.n <= MAX_MOTION_LINES else "movep"
     try:

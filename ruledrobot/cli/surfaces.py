@@ -17,6 +17,7 @@ class AlgorithmName(str, Enum):
 
 
 class SchemeName(str, Enum):
+    linear = "linear"
     chaikin = "chaikin"
     bspline3 = "bspline3"
     four_point = "four_point"
@@ -130,6 +131,9 @@ def chain(
         path = write_chain(lines_file, out)
     except ValueError as exc:
         raise fail(str(exc)) from None
-    console.print(f"wrote {path}")
+    joints = path.read_text(encoding="utf-8").count("<joint name=")
+    console.print(f"wrote {path}: a serial chain of {joints} hinge joints whose axes are the "
+                  f"lines of {lines_file} (MuJoCo MJCF; load it with mujoco.MjModel.from_xml_path)",
+                  highlight=False, markup=False)  # fmt: skip
 
 

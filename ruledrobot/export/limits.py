@@ -55,7 +55,7 @@ def check_trajectory(
         raise ValueError(f"trajectory sample {k}: joint q{j + 1} is not a finite number")
     if np.any(~np.isfinite(t)) or np.any(np.diff(t) <= 0):
         k = int(np.argmax(~np.isfinite(t[1:]) | (np.diff(t) <= 0))) + 1
-        raise ValueError(f"trajectory sample {k}: time t = {t[k]!r} does not increase")
+        raise ValueError(f"trajectory sample {k}: time t = {float(t[k])!r} does not increase")
     ts = (t - t[0]) / speed_scale
     lo, hi = np.asarray(model.lower), np.asarray(model.upper)
     bad = (q < lo - 1e-9) | (q > hi + 1e-9)

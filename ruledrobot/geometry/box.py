@@ -34,7 +34,8 @@ class Box:
             raise ValueError(f"box_size: expected 3 edge lengths, got shape {s.shape}")
         if np.any(s <= 0.0):
             k = int(np.flatnonzero(s <= 0.0)[0])
-            raise ValueError(f"box_size[{k}]: expected a positive edge length (m), got {s[k]!r}")
+            raise ValueError(f"box_size[{k}]: expected a positive edge length (m), "
+                             f"got {float(s[k])!r}")  # fmt: skip
         R = as_float_array(self.rotation, "box_rotation")
         if R.shape != (3, 3):
             raise ValueError(f"box_rotation: expected a 3x3 rotation matrix, got shape {R.shape}")

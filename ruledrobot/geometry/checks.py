@@ -118,7 +118,8 @@ def as_per_joint(
         if low.any():
             k = int(np.flatnonzero(low)[0])
             rel = ">" if strict else ">="
-            raise ValueError(f"{name}[{k}]: expected a value {rel} {minimum:g}, got {arr[k]!r}")
+            raise ValueError(f"{name}[{k}]: expected a value {rel} {minimum:g}, "
+                             f"got {float(arr[k])!r}")  # fmt: skip
     return arr
 
 
@@ -157,8 +158,8 @@ def check_increasing(arr: FloatArray, name: str) -> None:
     if bad.size:
         i = int(bad[0]) + 1
         raise ValueError(
-            f"{name}[{i}]: expected strictly increasing values, got {arr[i]!r} after "
-            f"{name}[{i - 1}] = {arr[i - 1]!r}"
+            f"{name}[{i}]: expected strictly increasing values, got {float(arr[i])!r} after "
+            f"{name}[{i - 1}] = {float(arr[i - 1])!r}"
         )
 
 

@@ -39,7 +39,8 @@ from typing import Any
 
 from .atomic import atomic_write_text
 
-__all__ = ["MANIFEST", "MANIFEST_FORMAT", "StagedFolder", "is_recording", "read_manifest"]
+__all__ = ["MANIFEST", "MANIFEST_FORMAT", "StagedFolder", "check_replaceable", "is_recording",
+           "read_manifest"]
 
 MANIFEST = "manifest.json"
 MANIFEST_FORMAT = "ruledrobot.output/1"
@@ -98,6 +99,13 @@ def _replaceable(target: Path) -> str | None:
         return (f"{target} holds files that ruledrobot did not write ({shown}); move them, or "
                 "choose a new or empty output folder")  # fmt: skip
     return None
+
+
+def check_replaceable(target: str | os.PathLike[str]) -> None:
+    """ValueError (saying why) when a plan may not replace the folder ``target``."""
+    why = _replaceable(Path(target).absolute())
+    if why is not None:
+        raise ValueError(why)
 
 
 def _sha256(path: Path) -> str:

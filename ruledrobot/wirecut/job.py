@@ -140,13 +140,14 @@ def _keep(c: Section, closed: bool | None) -> str | np.ndarray | None:
     return c.vector("keep", 3)
 
 
-def _cut(c: Section, name: str, surface: SurfaceSpec) -> CutSpec:
+def _cut(c: Section, name: str, surface: SurfaceSpec, surface_title: str = "surface") -> CutSpec:
     closed = surface.closed
     if closed is None:  # the rulings decide: a closed file, a periodic built-in surface
         try:
             closed = bool(surface.document().closed)
-        except (OSError, ValueError) as exc:
-            raise c.fail("surface", str(exc)) from None
+        except (OSError, ValueError) as exc:  # the surface's table and field, then the file's
+            field_ = "file" if surface.kind in (None, "lines") and surface.file else "builtin"
+            raise ValueError(f"{c.where}: [{surface_title}] {field_}: {exc}") from None
     cut = CutSpec(
         name=name,
         surface=surface,
@@ -192,7 +193,7 @@ def _cuts(doc: dict, where: str, base_dir: Path | None) -> tuple[CutSpec, ...]:
             surface = parse_surface(Section(entry, "surface", where, title=f"{title}.surface"),
                                     base_dir)  # fmt: skip
             c.get("surface")
-            cuts.append(_cut(c, name, surface))
+            cuts.append(_cut(c, name, surface, f"{title}.surface"))
         return tuple(cuts)
     surface = parse_surface(Section(doc, "surface", where), base_dir)
     c = Section(doc, "cut", where, required=False)

@@ -225,7 +225,7 @@ def parse_stock(st: Section) -> Box:
     centre, size = st.vector("centre", 3), st.vector("size", 3)
     for k in range(3):
         if size[k] <= 0:
-            raise st.fail("size", f"edge {k} must be positive, got {size[k]!r}")
+            raise st.fail("size", f"edge {k} must be positive, got {float(size[k])!r}")
     rot = se3.pose_from_rotvec(st.vector("rotvec", 3, [0.0, 0.0, 0.0]))[:3, :3]
     stock = Box(centre, size, rot)
     st.done()
@@ -235,10 +235,14 @@ def parse_stock(st: Section) -> Box:
 def parse_robot(r: Section, base_dir: Path | None) -> RobotSpec:
     """``[robot]`` -> :class:`.spec.RobotSpec` (the calibration file read and checked)."""
     from ..robot import MODEL_NAMES
+    from ..robot.ur_tables import canonical_name
 
-    model = r.get("model", "ur5e")
-    if model not in MODEL_NAMES:
-        raise r.fail("model", f"unknown robot {model!r}; expected one of {', '.join(MODEL_NAMES)}")
+    raw = r.get("model", "ur5e")
+    try:
+        model = canonical_name(raw)  # case-insensitive: "UR5e" is "ur5e"
+    except ValueError:
+        raise r.fail("model", f"unknown robot {raw!r}; expected one of {', '.join(MODEL_NAMES)} "
+                     "(any case)") from None  # fmt: skip
     acc = r.get("acceleration")
     acceleration = None
     if acc is not None:

@@ -125,6 +125,10 @@ def write_plan(
                                                   phases=plan.trajectory.meta.phases)  # fmt: skip
                 except RenderUnavailable as exc:
                     report.setdefault("notes", []).append(f"no video: {exc}")
+    if video and not verdict.ok:
+        report.setdefault("notes", []).append(
+            "no video: the plan fails (--video renders the cut of a plan that passes; "
+            "plots.png and report.json show this one)")
     files["report"] = atomic_write_text(folder / "report.json",
                                         json.dumps(report, indent=1) + "\n")  # fmt: skip
     job = plan.job

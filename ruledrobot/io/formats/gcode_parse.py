@@ -260,7 +260,12 @@ def parse_gcode(text: str, where: str, axes: str = "XYUV", units: str | None = N
             target = np.where(given, pos + np.nan_to_num(axis_vals), pos)
         else:
             target = np.where(given, axis_vals + off, pos)
-        if motion == 1:
+        positioning = motion == 0
+        if motion == 1 and np.isnan(pos).any() and not np.isnan(target).any():
+            # a first G1 naming every axis (from wherever the wire is, e.g. after G28):
+            # it brings the wire to a known place; it is no ruling of the cut (as a G0)
+            positioning = True
+        elif motion == 1:
             unknown = np.isnan(pos) | np.isnan(target)
             if unknown.any():
                 idx = sorted({i % len(axes) for i in np.flatnonzero(unknown)})
@@ -272,7 +277,7 @@ def parse_gcode(text: str, where: str, axes: str = "XYUV", units: str | None = N
             if fmode == 93 and "F" not in vals:
                 raise ValueError(f"{where}: line {lineno}: G1 in inverse time mode (G93) without "
                                  "F; expected F on every move")  # fmt: skip
-        rows.append((pos.copy(), target.copy(), lineno, motion == 0, heat, feed,
+        rows.append((pos.copy(), target.copy(), lineno, positioning, heat, feed,
                      93 if feed_mode == "inverse_time" else fmode))  # fmt: skip
         pos = target
         if any(mc in _END for mc in ms):
