@@ -31,6 +31,7 @@ Units: m, s, m/s.  Frames: the wire and the block in one frame (the robot base f
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import cached_property
 from itertools import combinations
 
 import numpy as np
@@ -152,9 +153,9 @@ class WireInStock:
 
     ``t`` (M,) s; ``ends`` (M, 2, 3) the wire's start and end (m); ``lo``, ``hi``
     (M,) the chord as fractions of the wire from its start (NaN outside); ``inside``
-    (M,) the wire is in the stock; ``depth`` (M,) m (0 outside); ``feed`` (M,) m/s,
-    the cutting speed: the fastest speed across the wire of a chord point (NaN outside:
-    the wire cuts nothing there).
+    (M,) the wire is in the stock; ``feed`` (M,) m/s, the cutting speed: the fastest
+    speed across the wire of a chord point (NaN outside: the wire cuts nothing there);
+    ``stock`` the block; :attr:`depth` (M,) m (0 outside), computed when first read.
     """
 
     t: FloatArray = field(repr=False)
@@ -162,8 +163,13 @@ class WireInStock:
     lo: FloatArray = field(repr=False)
     hi: FloatArray = field(repr=False)
     inside: np.ndarray = field(repr=False)
-    depth: FloatArray = field(repr=False)
     feed: FloatArray = field(repr=False)
+    stock: Box = field(repr=False)
+
+    @cached_property
+    def depth(self) -> FloatArray:
+        """(M,) m: how far the chord reaches into the block (module doc); 0 outside."""
+        return _depth(self.ends, self.lo, self.hi, self.stock)
 
     @property
     def n(self) -> int:
@@ -222,7 +228,7 @@ def wire_in_stock(t: ArrayLike, ends: ArrayLike, stock: Box) -> WireInStock:
     feed = np.full(ta.size, np.nan)
     if inside.any():
         feed[inside] = across_speeds(ta, e, np.stack([lo, hi], axis=1))[inside].max(axis=1)
-    return WireInStock(ta, e, lo, hi, inside, _depth(e, lo, hi, stock), feed)
+    return WireInStock(ta, e, lo, hi, inside, feed, stock)
 
 
 def _nearest(ends: FloatArray, stock: Box) -> tuple[FloatArray, FloatArray]:
