@@ -58,12 +58,28 @@ class SurfaceSpec:
             from ..geometry.surfaces import sample_surface
 
             lo, hi = self.u if self.u is not None else (None, None)
-            sample = sample_surface(self.builtin, n=self.rulings, start=lo, stop=hi,
-                                    **self.params)  # fmt: skip
+            if self.whole_period:  # sampled without its repeated end (u + period is u)
+                sample = sample_surface(self.builtin, n=self.rulings, start=lo, closed=True,
+                                        **self.params)  # fmt: skip
+            else:
+                sample = sample_surface(self.builtin, n=self.rulings, start=lo, stop=hi,
+                                        **self.params)  # fmt: skip
             lines, closed = sample.lines, sample.closed
         if self.closed is not None:
             closed = self.closed
         return LinesDocument(lines.transform(self.pose), closed)
+
+    @property
+    def whole_period(self) -> bool:
+        """A periodic built-in surface, ``closed = true``, whose ``u`` range is one whole
+        period (within 0.1 %: ``u = [0.0, 6.2832]`` for 2 pi): its ``rulings`` are spread
+        over the period and the end, the start again, is not repeated."""
+        if self.builtin is None or self.u is None or self.closed is not True:
+            return False
+        from ..geometry.surfaces import SURFACES
+
+        period = SURFACES[self.builtin].period
+        return period is not None and abs(self.u[1] - self.u[0] - period) <= 1e-3 * period
 
     def lines(self) -> Lines:
         """The input rulings in the robot base frame."""
