@@ -110,7 +110,7 @@ def _job(folder: Path, report: dict[str, Any], notes: list[str]) -> Any:
     exists, else in the folder.  The viewer does not refine, so a lines file that
     cannot be found any more is replaced by the plan's own ``refined.json`` (noted).
     """
-    from ..wirecut.job import parse_job
+    from ..wirecut.job import file_fields, parse_job
 
     p, text = read_user_text(folder / "job.toml", "job file")
     try:
@@ -120,11 +120,16 @@ def _job(folder: Path, report: dict[str, Any], notes: list[str]) -> Any:
     origin = (report.get("job") or {}).get("path")
     base_dir = Path(origin).parent if origin and Path(origin).parent.is_dir() else folder
     surface = doc.get("surface")
-    if isinstance(surface, dict) and isinstance(surface.get("file"), str):
-        lines_file = input_path(surface["file"], base_dir)
+    for loc, named in file_fields(doc):  # the surface's file of any format (issue 22)
+        if loc[0] != "surface" or not isinstance(surface, dict):
+            continue
+        lines_file = input_path(named, base_dir)
         if not lines_file.exists() and (folder / "refined.json").exists():
+            surface.pop(loc[1], None)  # the one source of the surface: file, gcode, ...
             surface["file"] = str(folder / "refined.json")
-            notes.append(f"the job's lines file {lines_file} is gone; not needed to view")
+            notes.append(f"the job's {loc[1] if loc[1] != 'file' else 'lines'} file "
+                         f"{lines_file} is not found; not needed to view")  # fmt: skip
+            break
     robot = doc.get("robot")
     if isinstance(robot, dict) and isinstance(robot.get("calibration"), str):
         cal = input_path(robot["calibration"], base_dir)

@@ -117,3 +117,11 @@ def test_plan_from_the_parent_folder_with_a_gcode_table(tmp_path, inputs, monkey
     r = runner.invoke(app, ["plan", "jobs/foreign/job.toml", "--out", "out"])
     assert r.exit_code == 0, r.output
     assert (tmp_path / "out" / "trajectory.csv").is_file()
+    # viewed from another folder: the job's G-code is not found from there, not needed
+    from ruledrobot.view.folder import read_plan_folder
+
+    (tmp_path / "elsewhere").mkdir()
+    monkeypatch.chdir(tmp_path / "elsewhere")
+    seen = read_plan_folder(tmp_path / "out")
+    assert seen.job.stock is not None
+    assert any("gcode file" in n and "not needed to view" in n for n in seen.notes), seen.notes
