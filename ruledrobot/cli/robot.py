@@ -112,7 +112,8 @@ def run(
         None, help="Robot controller address; default: an embedded emulator on 127.0.0.42."
     ),
     mode: RunModeName = typer.Option(
-        RunModeName.servoj, help="servoj (stream one servoJ per period) or path (moveL path)."
+        RunModeName.servoj, help="servoj (stream one servoJ per period) or path (the plan's "
+        "movel/movej program at its speeds, verified before motion)."
     ),
     speed_scale: float = typer.Option(1.0, min=0.01, max=1.0, help="Slow the whole run down."),
     resume: int | None = typer.Option(
@@ -123,6 +124,10 @@ def run(
     force: bool = typer.Option(
         False, "--force", help="Run although the controller's kinematics differ from the plan's."
     ),
+    wire_tolerance: float | None = typer.Option(
+        None, "--wire-tolerance", min=1e-6, help="The largest distance of the wire from the "
+        "planned wire in the stock [m] (the run's verdict, the path program's check; default: "
+        "the plan's [cut] wire_tolerance)."),
 ) -> None:
     """Stream a planned trajectory to a UR controller through RTDE (ur_rtde): checks the
     controller (robot model, period, state) and shows the approach move before asking to
@@ -140,8 +145,8 @@ def run(
                   "the wire may miss the cut", style="bold red", highlight=False,
                   markup=False)  # fmt: skip
     result = stream(trajectory, host, yes=yes, mode=mode.value, speed_scale=speed_scale,
-                     dry_run=dry_run, start_index=resume or 0,
-                     force_kinematics=force)  # fmt: skip
+                     dry_run=dry_run, start_index=resume or 0, force_kinematics=force,
+                     wire_tolerance=wire_tolerance)  # fmt: skip
     if not result.ok:
         raise typer.Exit(code=1)
 

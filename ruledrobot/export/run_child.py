@@ -35,7 +35,7 @@ from multiprocessing.connection import Connection
 import numpy as np
 
 from ..robot.trajectory import Heat
-from .run_motion import approach, preheat, run_path, stream
+from .run_motion import approach, preheat, run_program, stream
 from .run_session import Link, Session, SessionError, Stop
 
 __all__ = ["NICE", "RT_PRIORITY", "main", "raise_priority"]
@@ -109,10 +109,8 @@ def _motion(s: Session, m: dict) -> None:
         preheat(s, float(heat["preheat"]), m["heartbeat"])
     if m["mode"] == "servoj":
         stream(s, q_grid, m["lookahead"], m["gain"], m["heartbeat"], hot)
-    else:
-        if hot is not None and hot.any():
-            s.set_heat(True)
-        run_path(s, q_grid, m["path_rows"], m["duration"], m["heartbeat"])
+    else:  # the path program switches the heat where the plan does
+        run_program(s, q_grid, m["program"], m["heartbeat"])
         s.set_heat(False)
 
 

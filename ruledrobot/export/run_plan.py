@@ -44,7 +44,6 @@ __all__ = [
     "StopPlace",
     "inside_mask",
     "moveJ_time",
-    "path_waypoints",
     "plan_entry",
     "recording_path_for",
     "resample",
@@ -302,26 +301,3 @@ def resample(t: np.ndarray, q: np.ndarray, dt: float) -> tuple[np.ndarray, np.nd
     for j in range(q.shape[1]):
         qg[:, j] = np.interp(tg, t, q[:, j])
     return tg, qg
-
-
-def path_waypoints(
-    tcp: np.ndarray,
-    t: np.ndarray,
-    keep: np.ndarray,
-    *,
-    blend: float,
-    acceleration: float,
-) -> list[list[float]]:
-    """moveL path rows ``[x, y, z, rx, ry, rz, v, a, r]`` for the kept samples."""
-    rows = []
-    p = tcp[:, :3]
-    seg_len = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(p, axis=0), axis=1))]
-    lengths = np.diff(seg_len[keep])
-    for n, k in enumerate(keep[1:], start=1):
-        i = keep[n - 1]
-        L = lengths[n - 1]
-        dur = max(t[k] - t[i], 1e-6)
-        v = float(np.clip(L / dur, 1e-4, 3.0))
-        r = min(blend, 0.45 * L, 0.45 * lengths[n]) if n < len(keep) - 1 else 0.0
-        rows.append([*map(float, tcp[k]), v, float(acceleration), float(max(r, 0.0))])
-    return rows

@@ -14,12 +14,14 @@ from .run_plan import Entry, StopPlace
 
 if TYPE_CHECKING:
     from .run_verdict import RunMeasures
+    from .verify_program import ProgramCheck
 
 __all__ = ["ControllerError", "RunMode", "RunPlan", "RunResult"]
 
 
 class RunMode(str, Enum):
-    """How the motion is sent: one servoJ per controller period, or one blended moveL path."""
+    """How the motion is sent: one servoJ per controller period, or the plan's path program
+    (UR moves at the plan's speeds, verified before motion: :mod:`.run_program`)."""
 
     servoj = "servoj"
     path = "path"
@@ -122,6 +124,9 @@ class RunResult:
     #: the streaming process's scheduling, in words, and whether it is real-time
     priority: str = ""
     realtime: bool = False
+    #: mode path: the program's motion (generated at the control period) measured against
+    #: the plan before motion (:mod:`.run_program`)
+    program_check: ProgramCheck | None = None
 
     @property
     def completed(self) -> bool:

@@ -40,12 +40,9 @@ from ..robot.verdict import Check, Verdict
 from ..robot.wire_cut import FeedMeasure, FeedWindow, WireCut, feed_measures
 from ..robot.wire_in_stock import runs_of, wire_ends
 from .run_plan import inside_mask
+from .urscript import plan_wire_tolerance
 
 __all__ = ["RunMeasures", "align_recording", "measure_run", "recording_cut"]
-
-#: m: the wire deviation limit when the caller gives none (``[cut] wire_tolerance``'s
-#: default, docs/verdict.md)
-WIRE_TOLERANCE = 0.0005
 
 
 def align_recording(plan_q: np.ndarray, rec_q: np.ndarray, tags: np.ndarray,
@@ -80,7 +77,8 @@ def recording_cut(cut: WireCut, plan_index: np.ndarray, speed_scale: float = 1.0
     for w in cut.feeds:
         held = tuple(r for a, b in w.held for r in _runs_in(plan_index, a, b))
         for a, b in _runs_in(plan_index, w.start, w.stop):
-            feeds.append(FeedWindow(w.name, a, b, w.speed * speed_scale, w.tolerance, held))
+            feeds.append(FeedWindow(w.name, a, b, w.speed * speed_scale, w.tolerance, held,
+                                    w.wire_tolerance))  # fmt: skip
     return WireCut(cut.stock, cut.wire_length, tuple(feeds))
 
 
@@ -153,12 +151,15 @@ def measure_run(
     max_deviation: float = 0.0,
     deviation_limit: float = 0.05,
     speed_scale: float = 1.0,
-    wire_tolerance: float = WIRE_TOLERANCE,
+    wire_tolerance: float | None = None,
 ) -> RunMeasures:
     """The run's verdict and measures (module doc).  ``traj``: the plan; ``rec``: the
     recording (None when nothing was recorded); ``plan_index`` (R,): the plan sample of
     each recorded sample (:func:`align_recording` mapped to input samples);
-    ``skipped_ranges``: the skipped samples as half-open plan-sample ranges."""
+    ``skipped_ranges``: the skipped samples as half-open plan-sample ranges;
+    ``wire_tolerance`` (m): the wire deviation's limit, default the plan's
+    (:func:`~.urscript.plan_wire_tolerance`: the strictest of its cuts')."""
+    wire_tolerance = plan_wire_tolerance(traj, wire_tolerance)
     checks = [
         Check("motion", "the motion ran to the end", status, "completed", "", "==",
               status == "completed", True,

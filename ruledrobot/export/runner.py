@@ -9,8 +9,10 @@ monitoring, safe stops, resume, recording.
    control period against the trajectory's (dashboard, :mod:`.run_checks`);
    the controller kinematics (information: not read yet); robot mode RUNNING
    and safety NORMAL; where the run enters the trajectory (:mod:`.run_plan`:
-   continue, replay the kerf, or approach).  A failing check refuses the run
-   (status ``"refused"``); ``dry_run=True`` stops here.
+   continue, replay the kerf, or approach); in mode ``"path"`` the path program of the
+   samples from the entry, its motion generated and measured against the plan
+   (:mod:`.run_program`).  A failing check refuses the run (status ``"refused"``);
+   ``dry_run=True`` stops here.
 2. **Confirmation** — ``confirm(plan)`` (a :class:`RunPlan`: the checks and the
    approach move) must return True; none given means confirmed.
 3. **Motion**, in a child process (:mod:`.run_child`) that alone loads ur_rtde,
@@ -43,22 +45,15 @@ from ..io.trajectory import read_trajectory, sidecar_path, write_trajectory
 from ..robot import RobotModel, load, model_for
 from ..robot.trajectory import Trajectory
 from ..robot.verdict import Check, Verdict
-from .decimate import decimate_tcp_path
 from .heat import send_heat_off
 from .limits import check_trajectory
 from .run_checks import controller_checks, kinematics_check, query_dashboard, readiness_check
-from .run_plan import (
-    Entry,
-    path_waypoints,
-    plan_entry,
-    recording_path_for,
-    resample,
-    stop_place,
-)
+from .run_plan import Entry, plan_entry, recording_path_for, resample, stop_place
+from .run_program import PathRun, plan_path_run
 from .run_result import ControllerError, RunMode, RunPlan, RunResult
 from .run_supervisor import Child, ChildGone
-from .run_verdict import WIRE_TOLERANCE, RunMeasures, align_recording, measure_run
-from .urscript import check_servo_options
+from .run_verdict import RunMeasures, align_recording, measure_run
+from .urscript import check_servo_options, plan_wire_tolerance
 
 __all__ = ["ControllerError", "RunMode", "RunPlan", "RunResult", "run_trajectory"]
 
@@ -86,11 +81,6 @@ def _validate(
     n = traj.n
     if not 0 <= start_index < n - 1:
         raise ValueError(f"start sample {start_index} outside [0, {n - 2}] for {n} samples")
-    heat = traj.meta.heat
-    if mode == "path" and heat is not None and len(heat.windows) > 1:
-        raise ValueError(f"mode path: the wire's heat ({heat.output}) is switched "
-                         f"{len(heat.windows)} times in this trajectory, a path switches it "
-                         "once (on before, off after): stream it (mode servoj)")  # fmt: skip
     return mode
 
 
@@ -115,7 +105,7 @@ def run_trajectory(
     resume_window: float = 1.0,
     stop_deceleration: float = 4.0,
     max_latency: float = 0.1,
-    path_tolerance: float = 0.0005,
+    path_tolerance: float | None = None,
     path_blend: float = 0.002,
     path_acceleration: float = 1.0,
     actual_path: str | os.PathLike[str] | None = None,
@@ -123,7 +113,7 @@ def run_trajectory(
     heartbeat: float = 1.0,
     stop_budget: float = 1.0,
     connect_timeout: float = 15.0,
-    wire_tolerance: float = WIRE_TOLERANCE,
+    wire_tolerance: float | None = None,
 ) -> RunResult:
     """Run a joint trajectory on the UR controller at ``host`` (ur_rtde), checked and monitored.
 
@@ -134,9 +124,12 @@ def run_trajectory(
         None only with ``dry_run`` (the controller is not contacted).
     model : the robot model or its name; default, and it must agree with, the
         trajectory's metadata (:func:`ruledrobot.robot.model_for`).
-    mode : ``"servoj"`` (one servoJ per controller period) or ``"path"`` (one blended
-        moveL path through the TCP samples decimated to ``path_tolerance`` m,
-        blend radius ``path_blend`` m); a :class:`RunMode` or its value.
+    mode : ``"servoj"`` (one servoJ per controller period) or ``"path"`` (the path program
+        an export writes for the samples the run plays, :mod:`.run_program`: ``movel`` /
+        ``movej`` at the plan's speeds with ``path_blend`` m blends and ``path_acceleration``
+        m/s^2, sleeps, heat switches; the TCP path decimated to ``path_tolerance`` m, by
+        default a quarter of ``wire_tolerance``; its motion generated and measured against
+        the plan before motion: check ``path_program``); a :class:`RunMode` or its value.
     lookahead, gain : servoJ parameters (ur_rtde accepts 0.03-0.2 s, 100-2000).
     speed_scale : play the trajectory this much faster (< 1 slower); the limits
         are checked at the scaled speed.
@@ -161,7 +154,9 @@ def run_trajectory(
     stop_budget : the longest the safe stop (servoStop/stopJ, stopScript) may take [s].
     connect_timeout : the longest a connection step may take [s].
     wire_tolerance : the largest distance of the actual wire from the planned wire in the
-        block [m] in the run's verdict (the job's ``[cut] wire_tolerance``).
+        block [m], in the run's verdict and the path program's check; default the plan's
+        (``meta.cut.wire_tolerance``: the job's ``[cut] wire_tolerance``, the strictest of
+        its passes'; 0.5 mm for a trajectory that names no cut).
 
     Returns
     -------
@@ -183,6 +178,7 @@ def run_trajectory(
     if host is None and not dry_run:
         raise ValueError("host: a controller address is needed unless dry_run")
     check_trajectory(traj, robot, speed_scale=speed_scale)
+    wire_tolerance = plan_wire_tolerance(traj, wire_tolerance)
     n = traj.n
     checks = [
         Check(
@@ -209,6 +205,13 @@ def run_trajectory(
         return RunPlan(Verdict(tuple(checks)), entry, host, mode, traj, approach_speed, speed_scale)
 
     if host is None:
+        if mode == "path":  # the program from the sample asked for: measured, not sent
+            program = plan_path_run(traj, start_index, speed_scale=speed_scale,
+                                    tolerance=path_tolerance, blend=path_blend,
+                                    acceleration=path_acceleration,
+                                    wire_tolerance=wire_tolerance)  # fmt: skip
+            checks.append(program.verdict_check())
+            result.program_check = program.check
         checks.append(
             Check.info(
                 "controller",
@@ -218,6 +221,9 @@ def run_trajectory(
         )
         result.verdict = make_plan(None).verdict
         result.message = "trajectory checked; controller not contacted"
+        if not result.verdict.ok:
+            result.status = "refused"
+            result.message = "; ".join(c.detail or c.label for c in result.verdict.failed)
         return result
     try:
         info = query_dashboard(host, timeout=min(connect_timeout, 5.0))
@@ -314,6 +320,16 @@ def _run(
         approach_acceleration=o["approach_acceleration"],
     )
     checks.append(entry.check)
+    program: PathRun | None = None
+    if mode == "path" and entry.check.ok:
+        # the program of the samples the run plays, its motion measured before anything
+        # is sent (the check refuses a program that would not cut as planned)
+        program = plan_path_run(traj, entry.sample, speed_scale=o["speed_scale"],
+                                tolerance=o["path_tolerance"], blend=o["path_blend"],
+                                acceleration=o["path_acceleration"],
+                                wire_tolerance=o["wire_tolerance"])  # fmt: skip
+        checks.append(program.verdict_check())
+        result.program_check = program.check
     plan = make_plan(entry)
     result.verdict, result.entry = plan.verdict, entry
     result.approach_distance = entry.distance
@@ -331,7 +347,7 @@ def _run(
     if o["confirm"] is not None and not o["confirm"](plan):
         result.status, result.message = "cancelled", "not confirmed: nothing moved"
         return result
-    return _move(child, traj, source, result, entry, state, mode, host, dt, o)
+    return _move(child, traj, source, result, entry, state, mode, host, dt, o, program)
 
 
 def _move(
@@ -345,6 +361,7 @@ def _move(
     host: str,
     dt: float,
     o: dict,
+    program: PathRun | None = None,
 ) -> RunResult:
     k0 = entry.sample
     n = traj.n
@@ -354,20 +371,19 @@ def _move(
     t_grid, q_grid = resample(ts_in, np.asarray(traj.q[k0:], dtype=float), dt)
     grid_to_input = np.clip(np.searchsorted(ts_in, t_grid + 1e-9, side="right") - 1, 0, None)
     window = max(10, math.ceil((3.0 * o["lookahead"] + 0.1) / dt))
-    rows: list[list[float]] = []
-    if mode == "path":
-        tcp = np.asarray(traj.tcp[k0:], dtype=float)
-        keep = decimate_tcp_path(tcp, o["path_tolerance"], 10 * o["path_tolerance"])
-        rows = path_waypoints(
-            tcp, ts_in, keep, blend=o["path_blend"], acceleration=o["path_acceleration"]
-        )
+    ops: list[tuple] = []
+    if program is not None:  # the grid sample at each input sample's time
+
+        def grid_of(k: int) -> int:
+            return min(round(float(ts_in[k]) / dt), t_grid.size - 1)
+
+        ops = program.child_ops(grid_of)
     from ..geometry.se3 import ur_vector_from_pose
 
     motion = {
         "mode": mode,
         "q_grid": q_grid,
-        "path_rows": rows,
-        "duration": float(ts_in[-1]),
+        "program": ops,
         "lookahead": o["lookahead"],
         "gain": o["gain"],
         "window": window,
