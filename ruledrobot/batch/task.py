@@ -155,8 +155,7 @@ def _plan(task: JobTask, tmp: Path, t0: float) -> TaskResult:
                 table = table[key]
             mine = str(_mirror(root, resolve_input(value, job_path)))
             table[loc[-1]] = mine
-            v = Path(value)
-            named[mine] = value if v.is_absolute() else str(Path(task.named_path).parent / v)
+            named[mine] = str(resolve_input(value, Path(task.named_path)))
         job = parse_job(doc, task.label, base_dir=_mirror(root, job_path.parent))
         job = dataclasses.replace(_as_named(job, named), source=Path(task.label),
                                   source_bytes=task.text)  # fmt: skip
