@@ -34,27 +34,62 @@ RESOLUTION = 0.002
 SAMPLE = 0.001
 #: most grid points (about 40 MB of distances): the step grows for large blocks
 MAX_POINTS = 5_000_000
+#: distances nearer zero than this fraction of the grid step are moved out to it
+SNAP = 0.005
 
 
-def _surface_samples(cp: CutPath, stock: Box, keep) -> tuple[FloatArray, FloatArray]:
-    """Points (P, 3) of the pass's target surface inside the stock (grown by 2 mm) and
-    their normals (P, 3) pointing into the waste (a closed cut's slits, in the waste,
-    are not its surface)."""
-    S = cp.target_frames
-    if cp.closed:
-        a, b = cp.extended
-        S = S[a : len(S) - b]
+def _surface_samples(
+    passes: list[CutPath], stock: Box, keep
+) -> tuple[FloatArray, FloatArray]:
+    """Points (P, 3) of a cut's target surface inside the stock (grown by 2 mm), over all
+    its ``passes``, and their normals (P, 3) pointing into the waste (a closed cut's
+    slits, in the waste, are not its surface).
+
+    A loop cut in two passes (:mod:`.closed`) is two arcs, each cut out to the meeting
+    ruling and back along its own kerf: only the way out is sampled (sampled both ways,
+    every point of the arc had two samples of opposite normals, and the nearest of them
+    gave the distance its sign at random: hundreds of specks of part in the waste and of
+    waste in the part).  The normals are taken on each arc's whole sequence of rulings
+    before those missing the block are left out (a difference across the gap between
+    two stretches in the block, as where a column as wide as the block crosses only its
+    corners, turns them anywhere), periodic only for a loop cut in one pass.  Which way
+    is the waste, for ``"inside"``/``"outside"``: from the centroid of the chord
+    midpoints of the whole cut (an arc's own centroid can lie near the arc)."""
+    whole = len(passes) == 1
+    arcs = []
     grown = Box(stock.centre, stock.size + 0.004, stock.rotation)
-    c0, c1, hit = chords(S, grown)
-    if not hit.any():
+    for cp in passes:
+        S = cp.target_frames
+        if cp.closed:
+            a, b = cp.extended
+            S = S[a : len(S) - b]
+            if not whole and np.allclose(S, S[::-1], rtol=0.0, atol=1e-12):
+                S = S[: len(S) // 2 + 1]  # out and back along its own kerf: the way out
+        c0, c1, hit = chords(S, grown)
+        if not hit.any():
+            continue
+        c0, c1 = np.where(hit, c0, 0.0), np.where(hit, c1, 0.0)
+        n = max(2, int(np.ceil(float(np.max(c1 - c0)) / SAMPLE)) + 1)
+        t = c0[:, None] + (c1 - c0)[:, None] * np.linspace(0.0, 1.0, n)[None, :]
+        normals = ruling_normals(S, t, cp.closed and whole)
+        pts = S[:, None, :3, 3] + t[..., None] * S[:, None, :3, 2]
+        arcs.append((S, cp.closed and whole, pts[hit], normals[hit]))
+    if not arcs:
         return np.zeros((0, 3)), np.zeros((0, 3))
-    S, c0, c1 = S[hit], c0[hit], c1[hit]
-    n = max(2, int(np.ceil(float(np.max(c1 - c0)) / SAMPLE)) + 1)
-    u = np.linspace(0.0, 1.0, n)
-    t = c0[:, None] + (c1 - c0)[:, None] * u[None, :]
-    normals = waste_sign(S, stock, keep, cp.closed) * ruling_normals(S, t, cp.closed)
-    pts = S[:, None, :3, 3] + t[..., None] * S[:, None, :3, 2]
-    return pts.reshape(-1, 3), normals.reshape(-1, 3)
+    if isinstance(keep, str):  # the centroid of every arc's chord midpoints
+        centre = np.concatenate([p[:, p.shape[1] // 2] for _, _, p, _ in arcs]).mean(axis=0)
+    out_p, out_n = [], []
+    for S, closed, pts, normals in arcs:
+        if isinstance(keep, str):
+            k = pts.shape[1] // 2
+            inward = np.einsum("mi,mi->m", centre - pts[:, k], normals[:, k])
+            part_along_normal = (float(np.mean(inward)) > 0.0) == (keep == "inside")
+            sign = -1.0 if part_along_normal else 1.0
+        else:
+            sign = waste_sign(S, stock, keep, closed)
+        out_p.append(pts.reshape(-1, 3))
+        out_n.append(sign * normals.reshape(-1, 3))
+    return np.concatenate(out_p), np.concatenate(out_n)
 
 
 def _cut_sdf(pts: FloatArray, nrm: FloatArray, world: FloatArray, shape: tuple[int, ...],
@@ -96,9 +131,7 @@ def part_sdf(job: Job, passes: tuple[CutPath, ...], world: FloatArray,
     for cut in job.cuts:
         if cut.keep is None:
             continue
-        samples = [_surface_samples(cp, stock, cut.keep) for cp in passes if cp.name == cut.name]
-        pts = np.concatenate([s[0] for s in samples])
-        nrm = np.concatenate([s[1] for s in samples])
+        pts, nrm = _surface_samples([cp for cp in passes if cp.name == cut.name], stock, cut.keep)
         if len(pts):
             out = np.maximum(out, _cut_sdf(pts, nrm, world, shape, band))
     return out
@@ -120,7 +153,7 @@ def part_mesh(
     X, Y, Z = np.meshgrid(*axes, indexing="ij")
     local = np.stack([X, Y, Z], axis=-1).reshape(-1, 3)
     world = local @ stock.rotation.T + stock.centre
-    f = part_sdf(job, passes, world, tuple(counts), 3.0 * h)
+    f = _off_grid_points(part_sdf(job, passes, world, tuple(counts), 3.0 * h), h)
     if f.min() >= 0.0:
         return None
     verts, faces, _, _ = marching_cubes(f, level=0.0, spacing=(h, h, h))
@@ -129,6 +162,19 @@ def part_mesh(
     if signed_volume(verts, faces) < 0.0:  # outward normals (counter-clockwise seen outside)
         faces = faces[:, ::-1]
     return Mesh(verts @ stock.rotation.T + stock.centre, faces)
+
+
+def _off_grid_points(f: FloatArray, h: float) -> FloatArray:
+    """The distances ``f`` with none nearer zero than ``SNAP * h``: the surface passes no
+    grid point.  Marching cubes puts a vertex of every sign-changing edge at a grid point
+    that holds 0 (or nearly: a stock face on a grid plane, a cut through a grid point), so
+    that several vertices of different index coincide: zero-area triangles, and in an STL
+    (which welds equal coordinates, in float32) edges shared by 4 to 16 faces.  Moved off
+    by ``SNAP * h`` (10 um at the 2 mm step; the surface moves no farther), every vertex
+    lies at least that far from a grid point and the mesh is a closed 2-manifold after
+    the float32 rounding of STL too."""
+    eps = SNAP * h
+    return np.where(np.abs(f) < eps, np.where(f < 0.0, -eps, eps), f)
 
 
 def signed_volume(vertices: FloatArray, faces: np.ndarray) -> float:

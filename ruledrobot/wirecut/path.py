@@ -5,8 +5,8 @@
    consecutive rulings inside the stock, the distance from the chord ends of one
    to the next — for which the fewest steps that meet it are taken).  There must
    be as many as the scheme needs, checked as ``ruledrobot refine`` checks them
-   (G-code is refined between its corners, a piece too short for the scheme
-   linearly).
+   (the open rulings of any file are refined between the corners of their
+   polyline, a piece too short for the scheme linearly: :func:`_polyline_pieces`).
 2. The frame motion (the refined DH frames of ``dh``; sign-continuous DH frames
    of the refined rulings otherwise) is moved ``kerf / 2`` into the waste when the
    cut names the part's side (:mod:`.kerf`).
@@ -93,14 +93,11 @@ def _frames(
     lines, closed: bool, cut: CutSpec, steps: int, stock: Box, half: float
 ) -> tuple[FloatArray, bool]:
     """Refined frames (anchored at the rulings' points nearest the stock centre where
-    their origins stray).  A foam cutter's open polygon of moves is refined piece by
-    piece between its corners (:func:`.corners.polygon_corners`), which stay corners;
-    ``half`` [m]: half the wire."""
+    their origins stray).  An open polyline of a file (:func:`_polyline_pieces`) is
+    refined piece by piece between its corners, which stay corners; ``half`` [m]: half
+    the wire."""
     s = cut.surface
-    pieces = [lines]
-    if s.kind == "gcode" and not closed:
-        cuts = [0, *polygon_corners(lines.plucker, stock.centre, half).tolist(), len(lines) - 1]
-        pieces = [lines[a : b + 1] for a, b in pairwise(cuts)]
+    pieces = _polyline_pieces(lines, closed, s.kind, stock, half)
     frames, flip = [], False
     for k, piece in enumerate(pieces):
         scheme = s.scheme if len(piece) >= get_scheme(s.scheme).min_points else "linear"
@@ -119,6 +116,20 @@ def _frames(
     return F, flip
 
 
+def _polyline_pieces(lines, closed: bool, kind: str | None, stock: Box, half: float) -> list:
+    """The rulings split at their corners (:func:`.corners.polygon_corners`: the wire's
+    travel turns by more than ``CORNER_ANGLE``), each piece refined on its own: the one
+    rule for the open rulings of every file — G-code, DXF, 3DM, airfoil, lines — whose
+    rulings form a polyline with corners (a foam cutter's entry and exit moves, a
+    trailing edge).  Refined over a corner, a scheme swings the wire centimetres off the
+    file's straight moves and the wire cannot stop there.  A built-in surface is smooth
+    (its samples are not a polygon): one piece, as is a closed surface."""
+    if closed or kind is None:
+        return [lines]
+    cuts = [0, *polygon_corners(lines.plucker, stock.centre, half).tolist(), len(lines) - 1]
+    return [lines[a : b + 1] for a, b in pairwise(cuts)]
+
+
 def refine_cut(
     cut: CutSpec, stock: Box, where: str = "job", wire_length: float = 0.4
 ) -> RefinedCut:
@@ -132,9 +143,9 @@ def refine_cut(
     check_distinct_neighbours(lines.plucker, closed, f"{label} {s.label}")
     n = len(lines)
     sch = get_scheme(s.scheme)
-    if s.kind != "gcode":  # (a foam cutter's polygon: pieces too short are refined linearly)
-        check_length(sch, n, f"{label} {s.label}")
     half = 0.5 * wire_length
+    if len(_polyline_pieces(lines, closed, s.kind, stock, half)) == 1 and s.kind != "gcode":
+        check_length(sch, n, f"{label} {s.label}")  # (a polyline's short pieces: linearly)
     if s.steps is not None:
         check_size(sch, n, s.steps, closed, f"{label} steps", MAX_PATH_RULINGS, None)
         F, flip = _frames(lines, closed, cut, s.steps, stock, half)
