@@ -146,7 +146,7 @@ def test_a_program_that_would_not_cut_as_planned_is_refused(demo: Trajectory, tm
            Move(demo.tcp[k], 1.0, arc / (demo.t[k] - demo.t[i]), 0.0)]  # fmt: skip
     check = check_path_program(demo, old)
     (feed,) = check.feeds
-    assert not feed.max_ok and feed.highest > 1.1 * feed.speed
+    assert not feed.max_ok and feed.highest > 1.05 * feed.speed  # 10.8 mm/s against 10
     assert any("above 10.50 mm/s" in f for f in check.failures())
     with pytest.raises(ProgramRefused, match=r"movel program refused: .*beyond 0.10 mm"):
         urscript_program(demo, mode="movel", tolerance=0.01, wire_tolerance=0.0001)
