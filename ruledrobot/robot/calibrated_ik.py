@@ -1,45 +1,52 @@
-r"""Inverse kinematics of a calibrated UR arm: analytic nominal seeds, batched Newton finish.
+r"""Inverse kinematics of a calibrated UR arm: analytic nominal seeds, damped Newton finish.
 
 With the factory corrections the UR closed form no longer holds: joints 2-4 are not
 exactly parallel, the wrist axes do not exactly intersect.  The corrections are
 small in the arm's geometry, so each of the 8 nominal analytic solutions of a pose
 lies within about 1e-2 rad of the calibrated solution of the same branch.  This
-module refines all of them at once:
+module refines all of them; for batches of more than :data:`NUMPY_POSES` poses both
+steps run in compiled kernels (:mod:`ruledrobot.robot._calibrated_kernel`, numba, loaded
+by the first such batch or by :func:`load_kernels`); smaller batches run the same steps
+in numpy (:mod:`ruledrobot.robot._calibrated_numpy`, see :func:`uses_kernel`):
 
-1. **Seeds.**  The nominal closed form (:func:`~ruledrobot.robot.analytic_ik.ur_ik_chunk`)
-   of the flange pose gives up to 8 seeds.  Branches the nominal arm cannot reach
-   (the pose lies just beyond its reach, inside its shoulder cylinder or closer than
-   its folded elbow) are seeded from the closed form of a nominal arm that reaches
-   1 cm further in each direction (:func:`fallback_geometry`; 3 cm for poses with no
-   seed at all), so that poses only the calibrated arm reaches are solved too.  This
-   matters: near the stretched elbow a millimetre of reach is a wide band of ``q3``
-   (``dD ~ q3^2``), and about 2.5 % of the (pose, branch) pairs of random
-   configurations of a calibrated UR5e lie there.
-2. **Newton / Levenberg-Marquardt** on the calibrated DH chain, vectorised over all
-   (pose, branch) pairs, chunk by chunk (no loop over poses).  The residual is the
-   flange's position error and its rotation error (the small rotation vector), both
-   in the frame turned with joint 1.  The Jacobian is taken at the wrist point
-   ``p5`` in that frame, where the nominal UR Jacobian is block triangular
-   (``det J = a2 a3 sin q3 sin q5 s``): the linear system is solved by block
-   elimination in the order shoulder (1x1), wrist (2x2), q4 (1x1), elbow (2x2), which
-   is exact for any matrix and well conditioned for a near-UR one.  Each pivot
+1. **Seeds.**  The nominal closed form of the flange pose (the formulas of
+   :mod:`~ruledrobot.robot.analytic_ik`) gives up to 8 seeds.  Branches the nominal
+   arm cannot reach (the pose lies just beyond its reach, inside its shoulder cylinder
+   or closer than its folded elbow) are seeded from the closed form of a nominal arm
+   that reaches 1 cm further in each direction (:func:`fallback_geometry`; 3 cm for
+   poses with no seed at all), so that poses only the calibrated arm reaches are
+   solved too.  This matters: near the stretched elbow a millimetre of reach is a wide
+   band of ``q3`` (``dD ~ q3^2``), and about 2.5 % of the (pose, branch) pairs of
+   random configurations of a calibrated UR5e lie there.  Poses whose wrist is within
+   ``analytic_ik.RESCUE_W`` of singular (where ``q6_seed`` and the singular-wrist rules
+   apply) are seeded by the numpy closed form itself (:func:`numpy_seeds`).
+2. **Newton / Levenberg-Marquardt** on the calibrated DH chain, per (pose, branch)
+   pair, 8 pairs side by side in vectorised lanes (a lane whose pair finishes takes the
+   next one).  The residual is the flange's position error and its rotation error (the
+   small rotation vector), both in the frame turned with joint 1.  The Jacobian is
+   taken at the wrist point ``p5`` in that frame, where the nominal UR Jacobian is
+   block triangular (``det J = a2 a3 sin q3 sin q5 s``): the linear system is solved by
+   block elimination in the order shoulder (1x1), wrist (2x2), q4 (1x1), elbow (2x2),
+   which is exact for any matrix and well conditioned for a near-UR one.  Each pivot
    block is damped Levenberg-Marquardt style (``1/p -> p / (p^2 + mu^2)``, ``mu^2 =
    lambda * |e|``), so the iteration converges quadratically away from singularities
-   and stays bounded next to them; a step that raises the residual is undone and
-   ``lambda`` raised tenfold for that pair.
+   and stays bounded next to them; a step that raises the residual more than
+   thousandfold over the pair's best is undone and taken again at half length from the
+   best iterate; a step longer than 0.5 rad is shortened (trust region).
 3. **Result.**  A pair is converged when the position error is below ``tol`` [m]
    and the rotation error below ``tol`` [rad] (default 1e-11).  Pairs that do not
-   converge within ``max_iter`` iterations, or stall, are NaN rows flagged in
-   :class:`CalibratedIKSolutions`.  A branch keeps its identity: the iteration starts
-   at the nominal solution of the branch and moves by about the calibration's size.
+   converge within ``max_iter`` iterations, or stall (8 iterations without reducing
+   their best residual by 30 %), are NaN rows flagged in :class:`CalibratedIKSolutions`.
+   A branch keeps its identity: the iteration starts at the nominal solution of the
+   branch and moves by about the calibration's size.
 
-Sines and cosines are formed from ``tan(theta / 2)`` (``c = (1 - t^2) / (1 + t^2)``,
-``s = 2t / (1 + t^2)``): numpy's ``tan`` is vectorised, its ``sin`` and ``cos`` are
-not, and this is about six times faster at the same accuracy (a few 1e-16).
+Sines and cosines come from a branch-free polynomial (Cody-Waite reduction by pi/2,
+the fdlibm kernels; within 1 ulp of libm here), so that the lane loops vectorise.
 """
 
 from __future__ import annotations
 
+import sys
 from dataclasses import dataclass
 
 import numpy as np
@@ -47,19 +54,25 @@ import numpy as np
 from . import analytic_ik as _ik
 from ._checks import FloatArray
 
-__all__ = ["DEFAULT_MAX_ITER", "DEFAULT_TOL", "CalibratedIKSolutions", "refine_solutions"]
+__all__ = [
+    "DEFAULT_MAX_ITER",
+    "DEFAULT_TOL",
+    "CalibratedIKSolutions",
+    "kernels_loaded",
+    "load_kernels",
+    "nominal_seeds",
+    "refine_solutions",
+    "uses_kernel",
+]
 
 #: Convergence tolerance: position error [m] and rotation error [rad] of a solution.
 DEFAULT_TOL = 1e-11
 #: Largest number of Newton iterations per (pose, branch).
 DEFAULT_MAX_ITER = 40
-_CHUNK = 8192  # (pose, branch) pairs per chunk
-_MAX_STEP = 0.5  # rad: a longer step is shortened (trust region)
-_LAMBDA0 = 1e-6  # damping factor: mu^2 = lambda * |e|
+#: Batches of at most this many poses are solved in numpy (``_calibrated_numpy``), larger
+#: ones by the compiled kernels (see :func:`uses_kernel`).
+NUMPY_POSES = 1024
 _FALLBACK = 0.01  # m: links lengthened / shoulder shortened for the fallback seeds
-_BULK = 5  # iterations per chunk; the pairs still open then are iterated together
-_REJECT = 1e3  # a residual above this many times the best halves the step
-_STALL = 8  # iterations without reducing the best residual by 30 % before a pair is given up
 
 
 @dataclass(frozen=True, eq=False)
@@ -85,6 +98,49 @@ class CalibratedIKSolutions(_ik.IKSolutions):
     seeded: np.ndarray
     residual: FloatArray
     iterations: np.ndarray
+
+
+# ---------------------------------------------------------------------- kernels
+
+
+def kernels_loaded() -> bool:
+    """Whether the compiled kernels (numba) are loaded in this process."""
+    return "ruledrobot.robot._calibrated_kernel" in sys.modules
+
+
+def load_kernels() -> None:
+    """Load (or, the first time after an install, compile: 10-20 s) the compiled kernels.
+
+    The first calibrated IK of more than :data:`NUMPY_POSES` poses does this by itself.
+    A process with a clock thread (the emulator's 500 Hz loop) calls it at start-up, at a
+    moment that can wait: importing numba and loading the kernels takes about a second, in
+    C calls that hold the interpreter lock up to about 0.1 s at a time.
+    """
+    from . import _calibrated_kernel as _kernel
+
+    flange = np.broadcast_to(np.eye(4), (1, 4, 4)).copy()
+    flange[0, :3, 3] = (0.3, 0.2, 0.1)
+    geoms = np.array([(0.16, -0.4, -0.4, 0.13, 0.1, 0.1)] * 3)
+    out = np.empty((1, 8, 6))
+    _kernel.seeds(geoms, flange, out, np.empty((1, 8), bool), np.empty(1, bool))
+    ch = np.array([np.zeros(6), np.zeros(6), np.ones(6), np.zeros(6)])
+    _kernel.refine(
+        ch, np.zeros(6), flange, np.zeros((1, 8, 6)), np.zeros(6), DEFAULT_TOL, 1,
+        np.empty((1, 8, 6)), np.empty((1, 8), bool), np.empty((1, 8)),
+        np.empty((1, 8), np.int16),
+    )  # fmt: skip
+
+
+def uses_kernel(n: int) -> bool:
+    """Whether a batch of ``n`` poses runs in the compiled kernels: ``n > NUMPY_POSES``.
+
+    Smaller batches run the same iteration in numpy (:mod:`ruledrobot.robot._calibrated_numpy`):
+    a process that solves single poses and short moves, such as the emulator in its clock
+    thread, then never waits a second for numba; and the choice depends on the batch alone,
+    so that a job planned in a worker thread gives the bytes the main thread gives.  Both
+    converge to ``tol``; their solutions agree to rounding.
+    """
+    return n > NUMPY_POSES
 
 
 # ---------------------------------------------------------------------- seeds
@@ -114,7 +170,32 @@ def nominal_seeds(
 ) -> tuple[FloatArray, np.ndarray]:
     """Seeds (n, 8, 6) (DH angles of the nominal table) and (n, 8) "from the closed form of
     the nominal arm" flags; branches the nominal arm misses are filled from
-    :func:`fallback_geometry` where that reaches (flag False), else NaN."""
+    :func:`fallback_geometry` where that reaches (flag False), else NaN.
+
+    Compiled closed form (``_calibrated_kernel.seeds``, the formulas of ``analytic_ik``);
+    poses whose wrist is within ``analytic_ik.RESCUE_W`` of singular, where ``seed6`` and
+    the singular-wrist rules apply, are seeded by :func:`numpy_seeds`.
+    """
+    n = flange.shape[0]
+    if not uses_kernel(n):
+        return numpy_seeds(g, flange, np.asarray(seed6, dtype=np.float64))
+    from . import _calibrated_kernel as _kernel  # numba
+
+    geoms = np.array([g, fallback_geometry(g, _FALLBACK), fallback_geometry(g, 3 * _FALLBACK)])
+    out = np.empty((n, 8, 6))
+    exact = np.empty((n, 8), dtype=bool)
+    rows = np.empty(n, dtype=bool)
+    _kernel.seeds(geoms, np.ascontiguousarray(flange, dtype=np.float64), out, exact, rows)
+    if rows.any():
+        rows = np.flatnonzero(rows)
+        out[rows], exact[rows] = numpy_seeds(g, flange[rows], np.asarray(seed6)[rows])
+    return out, exact
+
+
+def numpy_seeds(
+    g: _ik.URGeometry, flange: FloatArray, seed6: FloatArray
+) -> tuple[FloatArray, np.ndarray]:
+    """:func:`nominal_seeds` with the numpy closed form (:func:`analytic_ik.ur_ik_chunk`)."""
     n = flange.shape[0]
     out = np.empty((n, 8, 6))
     for lo in range(0, n, _ik._CHUNK):
@@ -139,289 +220,6 @@ def nominal_seeds(
     return out, exact
 
 
-# ---------------------------------------------------------------------- the chain
-
-
-def _cos_sin(theta: FloatArray) -> tuple[FloatArray, FloatArray]:
-    """cos and sin of ``theta`` from ``t = tan(theta / 2)`` (vectorised ``tan``)."""
-    t = np.tan(0.5 * theta)
-    t2 = t * t
-    u = 1.0 / (1.0 + t2)
-    return (1.0 - t2) * u, (t + t) * u
-
-
-class _Chain:
-    """Constants of a calibrated 6R DH chain, for the iteration in the frame turned with joint 1."""
-
-    def __init__(self, d: FloatArray, a: FloatArray, alpha: FloatArray, offset: FloatArray):
-        self.d = [float(v) for v in d]
-        self.a = [float(v) for v in a]
-        self.ca = [float(np.cos(v)) for v in alpha]
-        self.sa = [float(np.sin(v)) for v in alpha]
-        self.offset = np.asarray(offset, dtype=np.float64)
-        # frame 1 in the frame turned with joint 1: L1 = Tz(d1) Tx(a1) Rx(alpha1)
-        ca, sa = self.ca[0], self.sa[0]
-        self.x1 = (1.0, 0.0, 0.0)
-        self.y1 = (0.0, ca, sa)
-        self.z1 = (0.0, -sa, ca)
-        self.p1 = (self.a[0], 0.0, self.d[0])
-
-
-def _cross(u, v):
-    return (u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0])
-
-
-def _evaluate(ch: _Chain, cs: list, tgt: tuple):
-    """Residual and Jacobian at the wrist point of the pairs whose (cos, sin) are ``cs``.
-
-    ``tgt`` = (x_t, y_t, p_t) target columns in the base frame (3-tuples of arrays).
-    Returns (e (6-tuple: v5 x, y, z, omega x, y, z), position error norm, rotation
-    error norm, Jacobian columns [(v5 3-tuple, omega 3-tuple)] * 6).
-    """
-    c1, s1 = cs[0]
-    # target in the frame turned with joint 1: Rz(-theta1) applied to each column
-    xt, yt, pt = ((c1 * v[0] + s1 * v[1], c1 * v[1] - s1 * v[0], v[2]) for v in tgt)
-    # frame 2 from the constant frame 1
-    c, s = cs[1]
-    y1, z1, p1 = ch.y1, ch.z1, ch.p1
-    ca, sa, d, a = ch.ca[1], ch.sa[1], ch.d[1], ch.a[1]
-    xr = (c, s * y1[1], s * y1[2])
-    yr = (-s, c * y1[1], c * y1[2])
-    frame_y = (ca * yr[0] + sa * z1[0], ca * yr[1] + sa * z1[1], ca * yr[2] + sa * z1[2])
-    frame_z = (ca * z1[0] - sa * yr[0], ca * z1[1] - sa * yr[1], ca * z1[2] - sa * yr[2])
-    p = (p1[0] + d * z1[0] + a * xr[0], p1[1] + d * z1[1] + a * xr[1],
-         p1[2] + d * z1[2] + a * xr[2])  # fmt: skip
-    x, y, z = xr, frame_y, frame_z
-    zs, ps = [z1, z], [p1, p]
-    for j in range(2, 6):
-        c, s = cs[j]
-        ca, sa, d, a = ch.ca[j], ch.sa[j], ch.d[j], ch.a[j]
-        xr = (c * x[0] + s * y[0], c * x[1] + s * y[1], c * x[2] + s * y[2])
-        yr = (c * y[0] - s * x[0], c * y[1] - s * x[1], c * y[2] - s * x[2])
-        if d != 0.0:
-            p = (p[0] + d * z[0], p[1] + d * z[1], p[2] + d * z[2])
-        if a != 0.0:
-            p = (p[0] + a * xr[0], p[1] + a * xr[1], p[2] + a * xr[2])
-        if sa == 0.0 and ca == 1.0:
-            yn, zn = yr, z
-        else:
-            yn = (ca * yr[0] + sa * z[0], ca * yr[1] + sa * z[1], ca * yr[2] + sa * z[2])
-            zn = (ca * z[0] - sa * yr[0], ca * z[1] - sa * yr[1], ca * z[2] - sa * yr[2])
-        x, y, z = xr, yn, zn
-        if j < 5:
-            zs.append(z)
-            ps.append(p)
-    # zs = z1..z5, ps = p1..p5 (frames 1..5); x, y, z, p the flange
-    p5 = ps[4]
-    ep = (pt[0] - p[0], pt[1] - p[1], pt[2] - p[2])
-    e1 = _cross(x, xt)
-    e2 = _cross(y, yt)
-    er = (e1[0] + e2[0], e1[1] + e2[1], e1[2] + e2[2])
-    h = 0.5 * (er[0] * z[0] + er[1] * z[1] + er[2] * z[2])
-    dw = (er[0] - h * z[0], er[1] - h * z[1], er[2] - h * z[2])
-    lever = (p[0] - p5[0], p[1] - p5[1], p[2] - p5[2])
-    m = _cross(dw, lever)
-    ev = (ep[0] - m[0], ep[1] - m[1], ep[2] - m[2])
-    pos = np.sqrt(ep[0] * ep[0] + ep[1] * ep[1] + ep[2] * ep[2])
-    rot = np.sqrt(dw[0] * dw[0] + dw[1] * dw[1] + dw[2] * dw[2])
-    # Jacobian at p5 (frame turned with joint 1): columns (v, omega)
-    cols = [((-p5[1], p5[0], 0.0), (0.0, 0.0, 1.0))]
-    for k in range(4):
-        zk, pk = zs[k], ps[k]
-        r = (p5[0] - pk[0], p5[1] - pk[1], p5[2] - pk[2])
-        cols.append((_cross(zk, r), zk))
-    cols.append((None, zs[4]))
-    return ev + dw, pos, rot, cols
-
-
-# block elimination order: rows (v5 y), (omega x, omega z), (omega y), (v5 x, v5 z);
-# columns (q1), (q5, q6), (q4), (q2, q3)
-_ROWS = (1, 3, 5, 4, 0, 2)
-_COLS = (0, 4, 5, 3, 1, 2)
-_BLOCKS = ((0,), (1, 2), (3,), (4, 5))
-
-
-def _entry(cols, i: int, j: int):
-    """Jacobian entry (row i of [v5; omega], joint j), None for a structural zero."""
-    part = cols[j][0] if i < 3 else cols[j][1]
-    if part is None:
-        return None
-    v = part[i % 3]
-    if isinstance(v, float) and v == 0.0:
-        return None
-    return v
-
-
-def _solve(cols, e, mu2):
-    """Damped block elimination of ``J dq = e`` (see the module docstring); dq (6-list)."""
-    A = [[_entry(cols, _ROWS[r], _COLS[k]) for k in range(6)] for r in range(6)]
-    b = [e[_ROWS[r]] for r in range(6)]
-    inv = []
-    for bi, blk in enumerate(_BLOCKS):
-        if len(blk) == 1:
-            (k,) = blk
-            p = A[k][k]
-            P = [[p / (p * p + mu2)]]
-        else:
-            k, l = blk
-            a11, a12, a21, a22 = A[k][k], A[k][l], A[l][k], A[l][l]
-            a11 = 0.0 if a11 is None else a11
-            a12 = 0.0 if a12 is None else a12
-            a21 = 0.0 if a21 is None else a21
-            a22 = 0.0 if a22 is None else a22
-            det = a11 * a22 - a12 * a21
-            f = det / (det * det + mu2)
-            P = [[a22 * f, -a12 * f], [-a21 * f, a11 * f]]
-        inv.append(P)
-        later = [r for b2 in _BLOCKS[bi + 1 :] for r in b2]
-        for r in later:
-            row = [A[r][k] for k in blk]
-            if all(v is None for v in row):
-                continue
-            # multipliers m = row @ P
-            mult = []
-            for jj in range(len(blk)):
-                acc = None
-                for ii, v in enumerate(row):
-                    if v is not None:
-                        t = v * P[ii][jj]
-                        acc = t if acc is None else acc + t
-                mult.append(acc)
-            for c in later:
-                acc = A[r][c]
-                for ii, k in enumerate(blk):
-                    u = A[k][c]
-                    if u is not None and mult[ii] is not None:
-                        t = mult[ii] * u
-                        acc = -t if acc is None else acc - t
-                A[r][c] = acc
-            for ii, k in enumerate(blk):
-                if mult[ii] is not None:
-                    b[r] = b[r] - mult[ii] * b[k]
-            for k in blk:
-                A[r][k] = None
-    x = [None] * 6
-    for bi in range(len(_BLOCKS) - 1, -1, -1):
-        blk = _BLOCKS[bi]
-        later = [r for b2 in _BLOCKS[bi + 1 :] for r in b2]
-        rhs = []
-        for k in blk:
-            acc = b[k]
-            for c in later:
-                if A[k][c] is not None:
-                    acc = acc - A[k][c] * x[c]
-            rhs.append(acc)
-        P = inv[bi]
-        for ii, k in enumerate(blk):
-            acc = None
-            for jj in range(len(blk)):
-                t = P[ii][jj] * rhs[jj]
-                acc = t if acc is None else acc + t
-            x[k] = acc
-    dq = [None] * 6
-    for k in range(6):
-        dq[_COLS[k]] = x[k]
-    return dq
-
-
-class _Batch:
-    """Iteration state of a batch of (pose, branch) pairs; angles stored as (6, m)."""
-
-    def __init__(self, idx, th, tgt, best_th=None, best_r=None, step=None, stall=None):
-        m = idx.shape[0]
-        self.idx = idx
-        self.th = th
-        self.tgt = tgt
-        self.best_th = th.copy() if best_th is None else best_th
-        self.best_r = np.full(m, np.inf) if best_r is None else best_r
-        self.step = np.zeros_like(th) if step is None else step
-        self.stall = np.zeros(m, dtype=np.int16) if stall is None else stall
-
-    def take(self, keep: np.ndarray) -> _Batch:
-        return _Batch(
-            self.idx[keep],
-            self.th[:, keep],
-            tuple(tuple(v[keep] for v in col) for col in self.tgt),
-            self.best_th[:, keep],
-            self.best_r[keep],
-            self.step[:, keep],
-            self.stall[keep],
-        )
-
-    @staticmethod
-    def concat(batches: list[_Batch]) -> _Batch:
-        cat = np.concatenate
-        tgt = tuple(tuple(cat([b.tgt[c][k] for b in batches]) for k in range(3)) for c in range(3))
-        return _Batch(
-            cat([b.idx for b in batches]),
-            cat([b.th for b in batches], axis=1),
-            tgt,
-            cat([b.best_th for b in batches], axis=1),
-            cat([b.best_r for b in batches]),
-            cat([b.step for b in batches], axis=1),
-            cat([b.stall for b in batches]),
-        )
-
-
-def _iterate(ch: _Chain, b: _Batch, out: tuple, tol: float, first: int, last: int, final: bool):
-    """Newton / LM iterations ``first..last`` on batch ``b``; finished pairs go to ``out``.
-
-    The iteration is not monotone (a Newton step may raise the residual for a while
-    and still converge, and often does next to singularities); a step that raises a
-    pair's residual beyond ``_REJECT`` times its best is halved and taken again from
-    the best iterate; a pair that has not reduced its best
-    residual by 30 % for ``_STALL`` iterations is given up, and with ``final`` every pair still
-    open after iteration ``last``.  Returns the batch of the pairs still open (or None).
-    """
-    theta_out, conv_out, res_out, it_out = out
-    for it in range(first, last + 1):
-        th = b.th
-        cs = [_cos_sin(th[j]) for j in range(6)]
-        e, pos, rot, cols = _evaluate(ch, cs, b.tgt)
-        r = np.maximum(pos, rot)
-        done = (pos <= tol) & (rot <= tol)
-        better = r < b.best_r
-        reject = ~done & (r > _REJECT * b.best_r)
-        b.best_th = np.where(better, th, b.best_th)
-        b.stall = np.where(r < 0.7 * b.best_r, 0, b.stall + 1)
-        b.best_r = np.where(better, r, b.best_r)
-        give_up = ~done & (b.stall > _STALL)
-        if final and it == last:
-            give_up = ~done
-        fin = done | give_up
-        if fin.any():
-            ids = b.idx[fin]
-            theta_out[ids] = np.where(done[fin], th[:, fin], b.best_th[:, fin]).T
-            conv_out[ids] = done[fin]
-            res_out[ids] = np.where(done[fin], r[fin], b.best_r[fin])
-            it_out[ids] = it
-            keep = ~fin
-            if not keep.any():
-                return None
-            b = b.take(keep)
-            r, reject = r[keep], reject[keep]
-            e = tuple(v[keep] for v in e)
-            cols = [tuple(_take(part, keep) for part in col) for col in cols]
-        if it == last:
-            return b
-        dq = _solve(cols, e, _LAMBDA0 * r)
-        step = np.stack([np.broadcast_to(v, r.shape) for v in dq])
-        big = np.abs(step).max(axis=0)
-        step *= np.minimum(1.0, _MAX_STEP / np.maximum(big, 1e-300))
-        if reject.any():  # back to the best iterate, half the step taken from it
-            step = np.where(reject, 0.5 * b.step, step)
-            b.th = np.where(reject, b.best_th, b.th)
-        b.step = step
-        b.th = b.th + step
-    return b
-
-
-def _take(part, keep):
-    if part is None:
-        return None
-    return tuple(v[keep] if isinstance(v, np.ndarray) else v for v in part)
-
-
 def refine_solutions(
     d: FloatArray,
     a: FloatArray,
@@ -440,34 +238,36 @@ def refine_solutions(
     joint positions ``seeds - seed_offset``); ``d, a, alpha, offset`` the calibrated
     table; ``flange`` (n, 4, 4) the flange poses in the robot base frame.  Returns joint
     positions (n, 8, 6) in (-pi, pi] (NaN where not converged), converged (n, 8),
-    residual (n, 8) and iterations (n, 8).
+    residual (n, 8) and iterations (n, 8).  Runs in the compiled kernel or in numpy
+    (same iteration and rules) as :func:`uses_kernel` says.
     """
     n = flange.shape[0]
-    ch = _Chain(d, a, alpha, offset)
-    shift = ch.offset - np.asarray(seed_offset, dtype=np.float64)
-    flat_seed = seeds.reshape(n * 8, 6)
-    pairs = np.flatnonzero(~np.isnan(flat_seed[:, 0]))
-    theta = np.full((n * 8, 6), np.nan)
-    conv = np.zeros(n * 8, dtype=bool)
-    res = np.full(n * 8, np.nan)
-    its = np.zeros(n * 8, dtype=np.int16)
-    out = (theta, conv, res, its)
-    cols = np.ascontiguousarray(flange.reshape(n, 16)[:, :12].T)
-    bulk = min(_BULK, max_iter)
-    rest = []
-    for lo in range(0, pairs.size, _CHUNK):
-        pr = pairs[lo : lo + _CHUNK]
-        c = cols[:, pr // 8]
-        tgt = ((c[0], c[4], c[8]), (c[1], c[5], c[9]), (c[3], c[7], c[11]))
-        th = np.ascontiguousarray((flat_seed[pr] + shift).T)
-        left = _iterate(ch, _Batch(pr, th, tgt), out, tol, 0, bulk, bulk == max_iter)
-        if left is not None:
-            rest.append(left)
-    if rest:  # the slow pairs of every chunk together
-        _iterate(ch, _Batch.concat(rest), out, tol, bulk, max_iter, True)
-    ok = np.flatnonzero(conv)
-    for lo in range(0, ok.size, _CHUNK):
-        rows = ok[lo : lo + _CHUNK]
-        theta[rows] = _ik.wrap_angle(theta[rows] - ch.offset)
-    theta[~conv] = np.nan
-    return theta.reshape(n, 8, 6), conv.reshape(n, 8), res.reshape(n, 8), its.reshape(n, 8)
+    if not uses_kernel(n):
+        from . import _calibrated_numpy
+
+        return _calibrated_numpy.refine_solutions(
+            d, a, alpha, offset, flange, seeds, seed_offset, tol=tol, max_iter=max_iter
+        )
+    from . import _calibrated_kernel as _kernel  # numba
+
+    ch = np.array([d, a, np.cos(alpha), np.sin(alpha)], dtype=np.float64)
+    off = np.asarray(offset, dtype=np.float64)
+    shift = off - np.asarray(seed_offset, dtype=np.float64)
+    theta = np.empty((n, 8, 6))
+    conv = np.empty((n, 8), dtype=bool)
+    res = np.empty((n, 8))
+    its = np.empty((n, 8), dtype=np.int16)
+    _kernel.refine(
+        ch,
+        off,
+        np.ascontiguousarray(flange, dtype=np.float64),
+        np.ascontiguousarray(seeds, dtype=np.float64),
+        shift,
+        float(tol),
+        int(max_iter),
+        theta,
+        conv,
+        res,
+        its,
+    )
+    return theta, conv, res, its
