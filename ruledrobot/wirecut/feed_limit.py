@@ -16,6 +16,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..robot.wire_cut import FeedMeasure
+from .motion import feed_param
 from .plan import Plan
 from .toolpath import speed_factor
 
@@ -47,7 +48,8 @@ def _factor_change(plan: Plan, k: int) -> tuple[float, float] | None:
         return None
     cp = plan.passes[p]
     s = cp.s
-    near = max(0.002, 1.5 * float(np.diff(s).max()))
+    cut = next(c for c in plan.job.cuts if c.name == cp.name)
+    near = feed_param(plan.job, cp, cut.feed_speed)[1]  # the time law's own reach
     sf = speed_factor(cp.motion.flange, s, plan.job.tool, plan.job.stock, near)
     i = int(np.clip(np.searchsorted(s, mo.s[k]) - 1, 0, len(s) - 2))
     a, b = max(0, i - 1), min(len(s), i + 3)

@@ -44,7 +44,7 @@ LIFT = 0.1  # m: approach from / retract to this far beyond the lead-in/out pose
 DENSIFY_ROUNDS = 3
 DENSIFY_SHARE = 0.25
 #: m: the time law bounds the speed of the wire's point nearest the block from this far
-#: out (at least; 1.5 ruling intervals where they are longer: :func:`_feed_param`), so
+#: out (at least; 1.5 ruling intervals where they are longer: :func:`feed_param`), so
 #: that its feed bound
 #: meets the chord's without a jump where the wire enters and leaves
 #: (:func:`ruledrobot.robot.wire_in_stock.feed_chord`)
@@ -149,7 +149,7 @@ def _across(p: FloatArray, o: FloatArray, z: FloatArray) -> FloatArray:
     return np.linalg.norm(d - (d * z[:, None]).sum(-1, keepdims=True) * z[:, None], axis=-1)
 
 
-def _feed_param(job: Job, cp: CutPath, feed_speed: float) -> tuple[FloatArray, float]:
+def feed_param(job: Job, cp: CutPath, feed_speed: float) -> tuple[FloatArray, float]:
     """(M,) the path parameter the feed is held in, and ``near`` (m): the distance [m]
     travelled across the wire by the part of it nearest the block — the chord's ends
     inside it — as the speed factor measures it (:func:`~.toolpath.speed_factor`, the
@@ -212,7 +212,7 @@ def _pass_timing(
     surface between them or its feed strays (:mod:`.densify`); returns the (denser)
     pass too and the samples where the wire stops at a corner (:mod:`.corners`)."""
     cut = next(c for c in job.cuts if c.name == cp.name)
-    param, near = _feed_param(job, cp, cut.feed_speed)
+    param, near = feed_param(job, cp, cut.feed_speed)
     cp = dataclasses.replace(cp, param=param)
     for attempt in range(DENSIFY_ROUNDS + 1):
         m = cp.motion
