@@ -1,0 +1,77 @@
+"""The part's surface in regions: faces joined across smooth edges, split at sharp ones.
+
+Two triangles sharing an edge are in one region when their normals differ by less
+than ``sharp`` (radians, default 25 degrees): a column's side is one region, its caps two
+more, a saddle-topped block six.  Each region is then fitted on its own
+(:mod:`.quadric`); a region too small to fit (fewer than ``MIN_FACES`` triangles) is
+left to the roughing cuts.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..geometry.checks import FloatArray
+from .readers import PartMesh
+
+__all__ = ["MIN_FACES", "Region", "face_normals", "segment"]
+
+MIN_FACES = 12
+SHARP = np.radians(25.0)
+
+
+@dataclass(frozen=True)
+class Region:
+    """One smooth piece of the part's surface: ``faces`` (K,) indices into the mesh's
+    faces, ``points`` (P, 3) its vertices [m, base frame], ``normals`` (P, 3) their
+    outward unit normals (area-weighted over the region's faces), ``area`` [m^2]."""
+
+    index: int
+    faces: np.ndarray = field(repr=False)
+    points: FloatArray = field(repr=False)
+    normals: FloatArray = field(repr=False)
+    area: float
+
+    @property
+    def centroid(self) -> FloatArray:
+        return self.points.mean(axis=0)
+
+
+def face_normals(mesh: PartMesh) -> tuple[FloatArray, FloatArray]:
+    """Unit outward normals (F, 3) and areas (F,) of the mesh's triangles."""
+    t = mesh.triangles
+    n = np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0])
+    a = np.linalg.norm(n, axis=1)
+    return n / np.maximum(a, 1e-300)[:, None], 0.5 * a
+
+
+def segment(mesh: PartMesh, sharp: float = SHARP) -> list[Region]:
+    """The regions of ``mesh`` (module doc), largest first."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    f = mesh.faces
+    nf = len(f)
+    normals, areas = face_normals(mesh)
+    e = np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]])
+    owner = np.tile(np.arange(nf), 3)
+    key = np.sort(e, axis=1)
+    order = np.lexsort((key[:, 1], key[:, 0]))
+    k, o = key[order], owner[order]
+    same = np.all(k[1:] == k[:-1], axis=1)
+    a, b = o[:-1][same], o[1:][same]
+    smooth = np.einsum("ij,ij->i", normals[a], normals[b]) > np.cos(sharp)
+    g = coo_matrix((np.ones(int(smooth.sum())), (a[smooth], b[smooth])), shape=(nf, nf))
+    count, labels = connected_components(g, directed=False)
+    regions = []
+    for lab in np.argsort(-np.bincount(labels, weights=areas)):
+        faces = np.flatnonzero(labels == lab)
+        verts, inv = np.unique(f[faces].ravel(), return_inverse=True)
+        vn = np.zeros((len(verts), 3))
+        np.add.at(vn, inv, np.repeat(normals[faces] * areas[faces, None], 3, axis=0))
+        vn /= np.maximum(np.linalg.norm(vn, axis=1), 1e-300)[:, None]
+        regions.append(Region(len(regions), faces, mesh.vertices[verts], vn,
+                              float(areas[faces].sum())))  # fmt: skip
+    return regions
