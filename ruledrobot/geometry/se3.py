@@ -29,6 +29,12 @@ geodesic is then (derivation in ``docs/math.md``)::
 
 which needs one ``sin`` and one ``cos`` per evaluation, is exact for a pure
 translation (``phi = 0``) and stable for ``phi -> 0`` and ``phi -> pi/2``.
+
+:func:`geodesic` and :func:`geodesic_many` on more than :data:`NUMPY_PAIRS` pairs run
+in a compiled loop (:mod:`ruledrobot.geometry._se3_kernel`, numba: the numpy chunk's
+operations in the same order, one pair at a time in registers), which gives the numpy
+path's results bit for bit where numpy's ``sin``/``cos``/``arctan2`` are libm's (without
+AVX-512; else within 1e-15); once loaded it serves every batch (see :func:`uses_kernel`).
 """
 
 from __future__ import annotations
@@ -49,6 +55,8 @@ __all__ = [
     "geodesic",
     "identity",
     "inverse",
+    "kernel_loaded",
+    "load_kernel",
     "log",
     "matrix_from_quaternion",
     "pose_from_quaternion",
@@ -59,10 +67,16 @@ __all__ = [
     "rotation_about_axis",
     "rotvec_from_matrix",
     "ur_vector_from_pose",
+    "uses_kernel",
     "validate_poses",
 ]
 
 _CHUNK = 4096  # elements per chunk: ~40 component arrays of 32 kB stay in L2
+
+#: Geodesics of more pairs than this load the compiled kernel (see :func:`uses_kernel`).
+NUMPY_PAIRS = 10_000
+
+_kernel = None  # ruledrobot.geometry._se3_kernel once loaded (numba)
 
 
 # ---------------------------------------------------------------------------
@@ -488,6 +502,41 @@ def _qt_from_matrices(T: FloatArray) -> tuple[tuple, tuple]:
     return _quat_from_rot(rot), trans
 
 
+def load_kernel() -> None:
+    """Load (or, the first time after an install, compile: a few seconds) the compiled
+    geodesic kernel; the first geodesic of more than :data:`NUMPY_PAIRS` pairs does this
+    by itself.  Importing numba and loading the kernel take about a second."""
+    global _kernel
+    if _kernel is None:
+        from . import _se3_kernel
+
+        _kernel = _se3_kernel  # set only once the module is complete (other threads)
+
+
+def kernel_loaded() -> bool:
+    """Whether the compiled geodesic kernel (numba) is loaded in this process."""
+    return _kernel is not None
+
+
+def uses_kernel(n: int) -> bool:
+    """Whether a geodesic of ``n`` pairs runs in the compiled kernel: when it is loaded
+    (then at every size: it takes ~1 us for one pair where numpy takes ~200 us), or when
+    ``n > NUMPY_PAIRS`` (which loads it).  The kernel's results are the numpy path's bit
+    for bit, so the choice changes the time only; a process that computes only small
+    batches (the emulator's clock thread) never waits a second for numba."""
+    return _kernel is not None or n > NUMPY_PAIRS
+
+
+def _geodesic_kernel(A: FloatArray, B: FloatArray, t: FloatArray) -> FloatArray:
+    """Geodesic of (n, 4, 4) pairs at (n,) parameters in the compiled kernel."""
+    load_kernel()
+    out = np.empty((A.shape[0], 4, 4))
+    _kernel.geodesic_rows(  # type: ignore[union-attr]
+        np.ascontiguousarray(A), np.ascontiguousarray(B), np.ascontiguousarray(t), out
+    )
+    return out
+
+
 def geodesic(A: ArrayLike, B: ArrayLike, t: ArrayLike) -> FloatArray:
     """Screw-motion geodesic ``A exp(t log(inv(A) B))`` for poses (..., 4, 4).
 
@@ -507,6 +556,8 @@ def geodesic(A: ArrayLike, B: ArrayLike, t: ArrayLike) -> FloatArray:
     A = np.broadcast_to(A, (*shape, 4, 4)).reshape(n, 4, 4)
     B = np.broadcast_to(B, (*shape, 4, 4)).reshape(n, 4, 4)
     scalar_t = t.ndim == 0
+    if uses_kernel(n):
+        return _geodesic_kernel(A, B, np.broadcast_to(t, shape).reshape(n)).reshape(*shape, 4, 4)
     tt = float(t) if scalar_t else np.broadcast_to(t, shape).reshape(n)
     out = np.empty((n, 4, 4))
     for lo in range(0, n, _CHUNK):
@@ -523,6 +574,9 @@ def geodesic_many(A: FloatArray, B: FloatArray, ts: Sequence[float]) -> list[Flo
     n = int(np.prod(shape))
     A = np.broadcast_to(A, (*shape, 4, 4)).reshape(n, 4, 4)
     B = np.broadcast_to(B, (*shape, 4, 4)).reshape(n, 4, 4)
+    if uses_kernel(n):
+        A, B = np.ascontiguousarray(A), np.ascontiguousarray(B)
+        return [_geodesic_kernel(A, B, np.full(n, float(t))).reshape(*shape, 4, 4) for t in ts]
     outs = [np.empty((n, 4, 4)) for _ in ts]
     for lo in range(0, n, _CHUNK):
         hi = min(lo + _CHUNK, n)
