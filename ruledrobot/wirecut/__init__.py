@@ -7,6 +7,7 @@ Usage::
 """
 
 from .job import Job, load_job, parse_job
+from .part import part_mesh, signed_volume
 from .planner import PlanResult, plan
 
-__all__ = ["Job", "PlanResult", "load_job", "parse_job", "plan"]
+__all__ = ["Job", "PlanResult", "load_job", "parse_job", "part_mesh", "plan", "signed_volume"]
