@@ -214,6 +214,7 @@ def parse_surface(s: Section, base_dir: Path | None) -> SurfaceSpec:
         closed=closed,
         read_lines=None if read is None else read.lines,
         read_closed=False if read is None else bool(read.closed),
+        read_planes=None if read is None else read.planes,
         kind=foreign[0] if foreign else ("lines" if file is not None else None),
     )
     s.done()

@@ -43,6 +43,7 @@ from .closed import loop_paths
 from .corners import CORNER_ANGLE, polygon_corners
 from .cutpath import CutPath, RefinedCut
 from .kerf import kerf_offsets
+from .profile_entry import PROFILE_KINDS, profile_entry
 from .redundancy import solve_redundancy
 from .spec import CutSpec, Job
 from .toolpath import anchored_frames, chords, world_referenced
@@ -59,6 +60,8 @@ __all__ = [
 ]
 
 MAX_STEPS = 10
+#: files whose rulings are a foam cutter's profile pair (world-referenced roll)
+FIELD_PROFILE_KINDS = (*PROFILE_KINDS, "gcode")
 #: Most refined rulings a cut may have (the redundancy search, the time law and the
 #: simulation scale with them: ~2 min of planning and ~2 GB at this size).
 MAX_PATH_RULINGS = 250_000
@@ -90,18 +93,31 @@ def _gaps(frames: FloatArray, stock: Box) -> float:
 
 
 def _frames(
-    lines, closed: bool, cut: CutSpec, steps: int, stock: Box, half: float
+    lines, closed: bool, cut: CutSpec, steps: int, stock: Box, half: float,
+    straight: tuple[int, int] = (0, 0),
 ) -> tuple[FloatArray, bool]:
     """Refined frames (anchored at the rulings' points nearest the stock centre where
     their origins stray).  An open polyline of a file (:func:`_polyline_pieces`) is
     refined piece by piece between its corners, which stay corners; ``half`` [m]: half
-    the wire."""
+    the wire.  ``straight``: rulings of a profile's entry and exit moves
+    (:mod:`.profile_entry`) ahead of and past the profile, each move refined as a piece
+    of its own by ``projection`` and ``linear`` (the wire's ends stay on their straight
+    lines, as a foam cutter's towers move)."""
     s = cut.surface
-    pieces = _polyline_pieces(lines, closed, s.kind, stock, half)
+    before, after = straight
+    n = len(lines)
+    inner = lines[before : n - after]
+    pieces = [(p, s.algorithm, s.scheme)
+              for p in _polyline_pieces(inner, closed, s.kind, stock, half)]  # fmt: skip
+    if before:
+        pieces.insert(0, (lines[: before + 1], "projection", "linear"))
+    if after:
+        pieces.append((lines[n - after - 1 :], "projection", "linear"))
     frames, flip = [], False
-    for k, piece in enumerate(pieces):
-        scheme = s.scheme if len(piece) >= get_scheme(s.scheme).min_points else "linear"
-        res = refine(RuledSurface(piece, closed=closed), s.algorithm, scheme, steps)
+    for k, (piece, algorithm, scheme) in enumerate(pieces):
+        if len(piece) < get_scheme(scheme).min_points:
+            scheme = "linear"
+        res = refine(RuledSurface(piece, closed=closed), algorithm, scheme, steps)
         F = res.frames
         if F is None:
             F = RuledSurface(res.lines, closed=closed).dh_frames("continuous")
@@ -141,14 +157,21 @@ def refine_cut(
     doc = s.document()
     lines, closed = doc.lines, bool(doc.closed)
     check_distinct_neighbours(lines.plucker, closed, f"{label} {s.label}")
-    n = len(lines)
     sch = get_scheme(s.scheme)
     half = 0.5 * wire_length
+    try:
+        entry = profile_entry(lines, s.kind, closed, stock, half, s.planes())
+    except ValueError as exc:
+        raise ValueError(f"{label} {s.label}: {exc}") from None
+    straight = (0, 0)
+    if entry is not None:  # a profile's straight entry and exit moves (:mod:`.profile_entry`)
+        lines, straight = entry.lines, (entry.before, entry.after)
+    n = len(lines)
     if len(_polyline_pieces(lines, closed, s.kind, stock, half)) == 1 and s.kind != "gcode":
         check_length(sch, n, f"{label} {s.label}")  # (a polyline's short pieces: linearly)
     if s.steps is not None:
         check_size(sch, n, s.steps, closed, f"{label} steps", MAX_PATH_RULINGS, None)
-        F, flip = _frames(lines, closed, cut, s.steps, stock, half)
+        F, flip = _frames(lines, closed, cut, s.steps, stock, half, straight)
         return RefinedCut(F, s.steps, closed, flip, n)
     gap = np.inf
     for steps in range(MAX_STEPS + 1):
@@ -158,7 +181,7 @@ def refine_cut(
                 f"{MAX_PATH_RULINGS:,} rulings (the limit of a cut); {steps - 1} steps give a "
                 f"largest gap of {gap:.3g} m: ask for a larger spacing"
             )
-        F, flip = _frames(lines, closed, cut, steps, stock, half)
+        F, flip = _frames(lines, closed, cut, steps, stock, half, straight)
         gap = _gaps(F, stock)
         if gap <= s.spacing:
             return RefinedCut(F, steps, closed, flip, n)
@@ -416,7 +439,10 @@ def cut_paths(
             where, cut.surface.label, rc.input_rulings, runs))  # fmt: skip
     before, after = len(ext[0]), len(ext[1])
     F = np.concatenate([ext[0][::-1], W, ext[1]])
-    if _x_jumps(F):  # a corner turned the frames about the rulings: roll = bow attitude
+    if _x_jumps(F) or cut.surface.kind in FIELD_PROFILE_KINDS:
+        # a corner turned the frames about the rulings, or a profile of the field (whose
+        # common normals turn with its travel, half a turn round a leading edge): the
+        # roll is the bow's attitude in the world, as a foam cutter's frame keeps it
         F = world_referenced(F)
     off = np.concatenate([np.repeat(off[:1], before, 0), off, np.repeat(off[-1:], after, 0)])
     S = _translated(F, -off)  # the target rulings (the lead-in/out ones lie outside the stock)

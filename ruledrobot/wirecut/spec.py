@@ -42,6 +42,9 @@ class SurfaceSpec:
     #: names one (``file`` is then that file), in the file's frame, and whether they close
     read_lines: Lines | None = field(default=None, repr=False)
     read_closed: bool = False
+    #: the file's two planes its rulings end on (towers, a panel's faces, the profiles'
+    #: planes; :class:`~ruledrobot.io.formats.rulings.Planes`), in the file's frame
+    read_planes: Any = None
     kind: str | None = None
 
     def document(self):
@@ -80,6 +83,13 @@ class SurfaceSpec:
 
         period = SURFACES[self.builtin].period
         return period is not None and abs(self.u[1] - self.u[0] - period) <= 1e-3 * period
+
+    def planes(self) -> tuple[np.ndarray, float] | None:
+        """The file's planes ``z = 0`` and ``z = distance`` as their frame (4, 4) in the
+        robot base frame and the distance [m], or None (a file without, a built-in)."""
+        if self.read_planes is None:
+            return None
+        return self.pose @ self.read_planes.pose, float(self.read_planes.distance)
 
     def lines(self) -> Lines:
         """The input rulings in the robot base frame."""
