@@ -7,7 +7,8 @@ Usage::
 """
 
 from .job import Job, load_job, parse_job
-from .part import part_mesh, signed_volume
+from .part import part_mesh, part_sdf, signed_volume
 from .planner import PlanResult, plan
 
-__all__ = ["Job", "PlanResult", "load_job", "parse_job", "part_mesh", "plan", "signed_volume"]
+__all__ = ["Job", "PlanResult", "load_job", "parse_job", "part_mesh", "part_sdf", "plan",
+           "signed_volume"]
