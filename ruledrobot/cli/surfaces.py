@@ -51,9 +51,13 @@ def refine(
     from ..algorithms import refine as do_refine
     from ..geometry.ruled import RuledSurface
     from ..io.lines import read_lines_document, save_lines
+    from ..io.paths import check_not_input
 
     params = {k: v for k, v in (("w", w), ("mu", mu)) if v is not None}
     try:
+        for target in (out, mesh):
+            if target is not None:
+                check_not_input(target, lines_file)
         doc = read_lines_document(lines_file)
         is_closed = doc.closed if closed is None else closed
         surf = RuledSurface(doc.lines, closed=is_closed)
@@ -125,9 +129,11 @@ def chain(
     At zero joint angles the joint axes coincide with the lines (the paper's view of
     a discrete ruled surface as the axes of a robot).
     """
+    from ..io.paths import check_not_input
     from ..sim import write_chain
 
     try:
+        check_not_input(out, lines_file)
         path = write_chain(lines_file, out)
     except ValueError as exc:
         raise fail(str(exc)) from None

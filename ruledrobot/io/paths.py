@@ -11,7 +11,7 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-__all__ = ["FILE_KINDS", "input_path", "missing_file"]
+__all__ = ["FILE_KINDS", "check_not_input", "input_path", "missing_file"]
 
 #: how messages name a file of each kind (``"no such G-code file: ..."``)
 FILE_KINDS = {
@@ -43,3 +43,19 @@ def missing_file(path: Path, kind: str = "file") -> str | None:
     if path.is_dir():
         return f"expected a {what}, {path} is a folder"
     return f"no such {what}: {path}"
+
+
+def check_not_input(output: str | os.PathLike[str], *inputs: str | os.PathLike[str]) -> None:
+    """ValueError when ``output`` is one of the ``inputs`` (the same file by path, or by
+    device and inode through a link): a command never writes over the file it reads
+    (``ruledrobot refine wing.json --out wing.json`` would have replaced the user's
+    rulings with the refined ones)."""
+    out = Path(os.path.normpath(Path(output).expanduser().absolute()))
+    for given in inputs:
+        src = Path(os.path.normpath(Path(given).expanduser().absolute()))
+        same = out == src
+        if not same and out.exists() and src.exists():
+            same = os.path.samefile(out, src)
+        if same:
+            raise ValueError(f"{output}: is the input file {given}; the command would write "
+                             "over what it reads: choose another output name")

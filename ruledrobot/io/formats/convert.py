@@ -15,6 +15,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from ..paths import check_not_input
 from . import (
     READ_KINDS,
     WRITE_KINDS,
@@ -55,6 +56,8 @@ def convert(source: str | os.PathLike[str], target: str | os.PathLike[str], *,
     """Read ``source`` and write ``target`` (see the module doc).  ``cli=True`` names
     options as command-line options in errors (writer options with ``--out-``)."""
     src, dst = Path(source), Path(target)
+    tip = (read_options or {}).get("tip")
+    check_not_input(dst, src, *([] if tip is None else [tip]))
     read_options = dict(read_options or {})
     write_options = dict(write_options or {})
     if target_kind is not None and target_kind not in WRITE_KINDS:
