@@ -111,8 +111,9 @@ def _part(raw: object, where: str, base_dir: Path | None) -> PartSpec:
         raise _fail(where, "file", f"expected a path string, got {name!r}")
     path = input_path(name, base_dir)
     if path.suffix.lower() not in MESH_SUFFIXES:
+        got = path.suffix or "no suffix"
         raise _fail(where, "file", f"{path}: expected a mesh or model file "
-                    f"({', '.join(MESH_SUFFIXES)}), got {path.suffix or 'no suffix'!r}")  # fmt: skip
+                    f"({', '.join(MESH_SUFFIXES)}), got {got!r}")  # fmt: skip
     missing = missing_file(path, "part file")
     if missing:
         raise _fail(where, "file", missing)
@@ -131,7 +132,8 @@ def _part(raw: object, where: str, base_dir: Path | None) -> PartSpec:
                     f"got {pose_raw!r}")  # fmt: skip
     rough = raw.get("rough_cuts", 4)
     if isinstance(rough, bool) or not isinstance(rough, int) or not 0 <= rough <= 12:
-        raise _fail(where, "rough_cuts", f"expected an integer 0 <= rough_cuts <= 12, got {rough!r}")
+        raise _fail(where, "rough_cuts",
+                    f"expected an integer 0 <= rough_cuts <= 12, got {rough!r}")  # fmt: skip
     return PartSpec(file=path, units=units, pose=se3.pose_from_ur_vector(pose_raw),
                     tolerance=_number(raw, "tolerance", where, 0.0005, 0.0),
                     rough_cuts=int(rough))  # fmt: skip
@@ -155,7 +157,8 @@ def parse_cell(doc: dict, where: str = "cell", base_dir: Path | None = None) -> 
     extra = sorted(set(doc) - set(_SECTIONS))
     if extra:
         raise ValueError(f"{where}: unknown section(s) {', '.join(extra)}; expected "
-                         f"{', '.join(_SECTIONS)} (a cell names its part, not its cuts)")  # fmt: skip
+                         f"{', '.join(_SECTIONS)} (a cell names its part, not its "
+                         "cuts)")  # fmt: skip
     if isinstance(doc.get("cut"), list):
         raise ValueError(f"{where}: [[cut]]: a cell file has one [cut] table (the defaults of "
                          "every cut carve makes), not a list of cuts")  # fmt: skip

@@ -1,10 +1,10 @@
 """Points against the part: exact distance to its triangles and inside/outside.
 
 * :meth:`MeshQuery.distance`: the distance [m] from points (N, 3) to the nearest triangle,
-  exact (point-triangle closest points, Ericson's regions) over the triangles whose
-  samples are nearest (a KD-tree of points spread over every triangle, at least its
-  corners and centroid): a candidate set that holds the nearest triangle whenever the
-  samples are denser than the distance is small, which is where exactness matters.
+  exact (point-triangle closest points, Ericson's regions) over candidate triangles: the
+  owners of the nearest samples (a KD-tree of points spread over every triangle) and
+  every triangle sharing a corner with the nearest one, which holds the nearest triangle
+  for points near a surface smoother than its triangles.
 * :meth:`MeshQuery.inside`: the parity of a ray's crossings (direction :data:`RAY`,
   slanted so that it meets no edge of an axis-aligned mesh exactly), with the triangles
   bucketed on a grid normal to the ray.
@@ -104,6 +104,17 @@ class MeshQuery:
         object.__setattr__(self, "_coarse", cKDTree(pick))
         object.__setattr__(self, "_coarse_gap", float(2.0 * np.sqrt(area / len(pick))))
         self._build_ray_grid()
+        # the triangles sharing a corner with each triangle (padded with itself)
+        f = self.mesh.faces
+        vf = np.argsort(f.ravel(), kind="stable") // 3
+        start = np.searchsorted(np.sort(f.ravel()), np.arange(len(self.mesh.vertices) + 1))
+        rings = [np.unique(np.concatenate([vf[start[v]:start[v + 1]] for v in tri_v]))
+                 for tri_v in f]  # fmt: skip
+        width = max(len(r) for r in rings)
+        ring = np.repeat(np.arange(len(f))[:, None], width, axis=1)
+        for k, r in enumerate(rings):
+            ring[k, : len(r)] = r
+        object.__setattr__(self, "_ring", ring)
 
     def distance(self, points: FloatArray, chunk: int = 20_000) -> FloatArray:
         """(N,) distance [m] from ``points`` (N, 3) to the part's surface: exact within
@@ -119,7 +130,8 @@ class MeshQuery:
             near = np.flatnonzero(d < NEAR + self._coarse_gap)
             if len(near):
                 _, idx = self._tree.query(p[near], k=CANDIDATES)
-                t = tri[self._owner[idx]]
+                own = self._owner[idx]
+                t = tri[np.concatenate([own, self._ring[own[:, 0]]], axis=1)]
                 dn = point_triangle_distance(p[near, None, :], t[..., 0, :], t[..., 1, :],
                                              t[..., 2, :])  # fmt: skip
                 d[near] = dn.min(axis=1)
@@ -165,7 +177,8 @@ class MeshQuery:
         t = uv[fi]  # (M, 3, 2)
         x = q[pi]
         a, b, cc = t[:, 0], t[:, 1], t[:, 2]
-        den = (b[:, 1] - cc[:, 1]) * (a[:, 0] - cc[:, 0]) + (cc[:, 0] - b[:, 0]) * (a[:, 1] - cc[:, 1])
+        den = ((b[:, 1] - cc[:, 1]) * (a[:, 0] - cc[:, 0])
+               + (cc[:, 0] - b[:, 0]) * (a[:, 1] - cc[:, 1]))  # fmt: skip
         with np.errstate(divide="ignore", invalid="ignore"):
             l1 = ((b[:, 1] - cc[:, 1]) * (x[:, 0] - cc[:, 0])
                   + (cc[:, 0] - b[:, 0]) * (x[:, 1] - cc[:, 1])) / den  # fmt: skip

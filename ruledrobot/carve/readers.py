@@ -119,7 +119,8 @@ def read_triangles(path: Path) -> tuple[FloatArray, np.ndarray, str | None]:
         try:
             m = trimesh.load(str(path), force="mesh", process=False)
         except Exception as exc:  # trimesh raises many kinds on a broken file
-            raise ValueError(f"{path}: cannot read the mesh ({type(exc).__name__}: {exc})") from None
+            raise ValueError(f"{path}: cannot read the mesh "
+                             f"({type(exc).__name__}: {exc})") from None  # fmt: skip
         if not hasattr(m, "faces") or len(m.faces) == 0:
             raise ValueError(f"{path}: no triangles in the file")
         v, f, units = np.asarray(m.vertices, np.float64), np.asarray(m.faces, np.int64), None
@@ -151,7 +152,8 @@ def read_part(spec: PartSpec) -> PartMesh:
         if nonmanifold:
             what.append(f"{nonmanifold} non-manifold edge(s) (in three or more triangles)")
         raise ValueError(f"{path}: not a closed 2-manifold mesh: {' and '.join(what)}; "
-                         "expected a closed solid (repair it in CAD, e.g. close holes)")  # fmt: skip
+                         "expected a closed solid (repair it in CAD: close its "
+                         "holes)")  # fmt: skip
     v = v * spec.scale
     v = v @ spec.pose[:3, :3].T + spec.pose[:3, 3]
     part = PartMesh(v, f, path)

@@ -64,7 +64,7 @@ def segment(mesh: PartMesh, sharp: float = SHARP) -> list[Region]:
     a, b = o[:-1][same], o[1:][same]
     smooth = np.einsum("ij,ij->i", normals[a], normals[b]) > np.cos(sharp)
     g = coo_matrix((np.ones(int(smooth.sum())), (a[smooth], b[smooth])), shape=(nf, nf))
-    count, labels = connected_components(g, directed=False)
+    _, labels = connected_components(g, directed=False)
     regions = []
     for lab in np.argsort(-np.bincount(labels, weights=areas)):
         faces = np.flatnonzero(labels == lab)

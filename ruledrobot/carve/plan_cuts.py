@@ -1,0 +1,125 @@
+"""From a part to its cuts: the faces cut exactly, the rest roughed, the baseline beside.
+
+:func:`find_cuts` segments the part (:mod:`.segment`), fits every region
+(:mod:`.quadric`), cuts the ruled ones exactly (:mod:`.exact`; faces of the block need
+no cut), and when any face is left — not ruled, too small to fit, or a cut that would
+gouge the part elsewhere — roughs the part by ``rough_cuts`` loops (:mod:`.rough`) and
+the baseline (the visual hull of as many parallel directions) for comparison.  Open
+cuts come first and closed loops last: a loop that keeps its inside frees the part,
+and every later loop needs the piece clamped again (a setup of its own).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..geometry.box import Box
+from ..geometry.checks import FloatArray
+from .exact import block_face, exact_cut
+from .measure import measure_cut
+from .meshquery import MeshQuery
+from .model import CarveCut, CutMeasure
+from .quadric import fit_region
+from .readers import PartMesh
+from .rough import Loop, choose_loops, loop_lines
+from .segment import MIN_FACES, Region, segment
+
+__all__ = ["CutPlan", "find_cuts", "prefer_direction"]
+
+
+@dataclass(frozen=True)
+class CutPlan:
+    """The cuts in the order they are made with their measures, the roughing loops and the
+    baseline's (great circles), the regions and what became of each (``faces``: region
+    index -> ``"block face"``, ``"exact"``, or why it was roughed), notes, the voxel
+    estimates of the block kept after the roughing loops [m^3] (``kept_voxel``,
+    ``baseline_kept_voxel``)."""
+
+    cuts: tuple[CarveCut, ...]
+    measures: tuple[CutMeasure, ...]
+    loops: tuple[Loop, ...] = field(repr=False)
+    baseline: tuple[Loop, ...] = field(repr=False)
+    regions: tuple[Region, ...] = field(repr=False)
+    faces: dict[int, str] = field(default_factory=dict)
+    notes: tuple[str, ...] = ()
+    kept_voxel: float = float("nan")
+    baseline_kept_voxel: float = float("nan")
+
+
+def prefer_direction(stock: Box) -> FloatArray:
+    """The horizontal direction across the line from the robot base to the block: the
+    wire held sideways in front of the arm, as in the demo jobs."""
+    c = np.array([stock.centre[0], stock.centre[1], 0.0])
+    if np.linalg.norm(c) < 1e-6:
+        return np.array([0.0, 1.0, 0.0])
+    d = np.cross([0.0, 0.0, 1.0], c)
+    return d / np.linalg.norm(d)
+
+
+def find_cuts(part: PartMesh, stock: Box, query: MeshQuery, tolerance: float,
+              rough_cuts: int, lead: float = 0.02,
+              progress=lambda msg: None) -> CutPlan:  # fmt: skip
+    """The cuts of a part in a block (module doc)."""
+    regions = segment(part)
+    prefer = prefer_direction(stock)
+    faces: dict[int, str] = {}
+    exact: list[tuple[CarveCut, CutMeasure]] = []
+    notes: list[str] = []
+    progress(f"fitting {len(regions)} regions")
+    for r in regions:
+        if len(r.faces) < MIN_FACES:
+            faces[r.index] = f"too small to fit ({len(r.faces)} triangles)"
+            continue
+        fit = fit_region(r, tolerance)
+        if fit.kind == "plane" and block_face(fit, stock, tolerance):
+            faces[r.index] = "block face"
+            continue
+        if fit.kind not in ("plane", "ruled"):
+            faces[r.index] = ("not ruled (a quadric with no lines on it)" if fit.kind == "curved"
+                              else f"not a ruled quadric within tolerance "
+                                   f"({fit.residual * 1e3:.3g} mm)")  # fmt: skip
+            continue
+        got = exact_cut(fit, r, stock, query, prefer, f"face{r.index}", lead)
+        if isinstance(got, str):
+            faces[r.index] = got
+            notes.append(got)
+            continue
+        m = measure_cut(got, stock, query, tolerance, r)
+        if m.gouge > 0.0:
+            why = (f"region {r.index}: its rulings run {m.gouge * 1e3:.2f} mm into the part "
+                   "beyond the face: roughed instead")  # fmt: skip
+            faces[r.index] = why
+            notes.append(why)
+            continue
+        faces[r.index] = "exact"
+        exact.append((got, m))
+    rough_needed = any(v not in ("exact", "block face") for v in faces.values())
+    loops: list[Loop] = []
+    base: list[Loop] = []
+    kept = base_kept = float("nan")
+    rough: list[tuple[CarveCut, CutMeasure]] = []
+    if rough_needed and rough_cuts > 0:
+        from scipy.spatial import ConvexHull
+
+        hull = part.vertices[ConvexHull(part.vertices).vertices]
+        standoff = 0.5 * tolerance
+        progress(f"choosing {rough_cuts} roughing loops")
+        loops, k1 = choose_loops(hull, stock, rough_cuts, standoff, seams=True)
+        progress("choosing the baseline's directions")
+        base, k2 = choose_loops(hull, stock, rough_cuts, standoff, seams=False)
+        kept = k1[-1] if k1 else kept
+        base_kept = k2[-1] if k2 else base_kept
+        centre = part.vertices.mean(axis=0)
+        for k, loop in enumerate(loops):
+            cut = CarveCut(f"rough{k + 1}", "rough", loop_lines(loop, centre), True, "inside",
+                           loop.describe())  # fmt: skip
+            rough.append((cut, measure_cut(cut, stock, query, tolerance)))
+    elif rough_needed:
+        notes.append("faces are left uncut (rough_cuts = 0)")
+    ordered = ([c for c in exact if not c[0].closed] + [c for c in exact if c[0].closed]
+               + rough)  # fmt: skip
+    return CutPlan(tuple(c for c, _ in ordered), tuple(m for _, m in ordered), tuple(loops),
+                   tuple(base), tuple(regions), faces, tuple(notes), kept,
+                   base_kept)  # fmt: skip

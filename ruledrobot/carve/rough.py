@@ -1,0 +1,158 @@
+"""Roughing a part by closed loops of rulings that never enter it, and the foam cutter's baseline.
+
+A plane ``n . x = h(n) + standoff`` with ``h`` the support function of the part's
+convex hull never cuts the part.  A closed curve ``gamma`` of normals on the unit
+sphere gives a closed sequence of such planes, and consecutive planes meet in a line:
+the loop of those lines is a developable that wraps the part, touching its hull along
+a curve, and keeps ``K(gamma)``, the points on the inner side of every plane.  Its
+rulings lie in supporting planes, so no ruling enters the part (each is still measured,
+:mod:`.measure`).
+
+* ``gamma`` a great circle (normals normal to an axis ``a``): the rulings are all
+  parallel to ``a`` and the loop is the part's silhouette seen along ``a`` extruded —
+  what a foam cutter's parallel wire cuts (with a turntable, along several directions:
+  the visual hull).
+* ``gamma`` a seam ``normalise(cos s e1 + sin s e2 + A sin(k s + phase) a)``: normals
+  that rise and fall round the loop, so that one loop bounds the part from above and
+  below too; its rulings are not parallel (they tilt with the seam).  A foam cutter's
+  wire cannot follow it; the robot's can.
+
+The loops are chosen greedily (:func:`choose_loops`): each removes the most of what is
+still kept of the block, counted on a voxel grid (only voxels outside the part's hull
+count: the others are kept by every loop).  The baseline is the same greedy choice
+among great circles only, over the same axes: the visual hull of as many directions.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..geometry.box import Box
+from ..geometry.checks import FloatArray
+from ..geometry.lines import Lines
+
+__all__ = ["Loop", "choose_loops", "fibonacci_axes", "loop_lines", "seam_normals"]
+
+SAMPLES = 96
+AMPLITUDES = (0.0, 0.3, 0.6, 0.9)
+WAVES = (2, 3)
+PHASES = (0.0, 0.5)  # fractions of a half wave
+#: voxels on the block for the choice (the grid step follows)
+VOXELS = 30_000
+
+
+@dataclass(frozen=True)
+class Loop:
+    """A loop's curve of normals: ``axis`` (3,), ``amplitude`` (0: a great circle),
+    ``waves`` round the loop, ``phase`` (fraction of a half wave); ``normals``
+    (SAMPLES, 3) and ``support`` (SAMPLES,) [m] the planes' offsets (standoff added)."""
+
+    axis: FloatArray = field(repr=False)
+    amplitude: float
+    waves: int
+    phase: float
+    normals: FloatArray = field(repr=False)
+    support: FloatArray = field(repr=False)
+
+    @property
+    def parallel(self) -> bool:
+        return self.amplitude == 0.0
+
+    def describe(self) -> str:
+        a = ", ".join(f"{x:+.2f}" for x in self.axis)
+        if self.parallel:
+            return f"silhouette along ({a})"
+        return f"seam about ({a}), amplitude {self.amplitude:g}, {self.waves} waves"
+
+
+def fibonacci_axes(n: int) -> FloatArray:
+    """``n`` (n, 3) unit vectors spread evenly over the upper half sphere (z >= 0)."""
+    k = np.arange(n) + 0.5
+    z = k / n
+    phi = np.pi * (1 + 5**0.5) * k
+    r = np.sqrt(1 - z * z)
+    return np.stack([r * np.cos(phi), r * np.sin(phi), z], axis=1)
+
+
+def seam_normals(axis: FloatArray, amplitude: float, waves: int, phase: float,
+                 samples: int = SAMPLES) -> FloatArray:  # fmt: skip
+    """(samples, 3) unit normals of a seam about ``axis`` (module doc)."""
+    a = axis / np.linalg.norm(axis)
+    e1 = np.cross(a, [1.0, 0.0, 0.0] if abs(a[0]) < 0.9 else [0.0, 1.0, 0.0])
+    e1 /= np.linalg.norm(e1)
+    e2 = np.cross(a, e1)
+    s = np.linspace(0.0, 2 * np.pi, samples, endpoint=False)
+    g = (np.cos(s)[:, None] * e1 + np.sin(s)[:, None] * e2
+         + amplitude * np.sin(waves * s + phase * np.pi / max(waves, 1))[:, None] * a)  # fmt: skip
+    return g / np.linalg.norm(g, axis=1)[:, None]
+
+
+def loop_lines(loop: Loop, centre: FloatArray) -> Lines:
+    """The loop's rulings: consecutive planes' lines of intersection (point nearest
+    ``centre``), oriented alike."""
+    n0, n1 = loop.normals, np.roll(loop.normals, -1, axis=0)
+    h0, h1 = loop.support, np.roll(loop.support, -1)
+    d = np.cross(n0, n1)
+    d /= np.linalg.norm(d, axis=1)[:, None]
+    M = np.stack([n0, n1, d], axis=1)  # (K, 3, 3)
+    rhs = np.stack([h0, h1, d @ centre], axis=1)
+    p = np.linalg.solve(M, rhs[..., None])[..., 0]
+    if np.mean(d @ loop.axis) < 0.0:
+        d = -d
+    return Lines.from_point_direction(p, d)
+
+
+def _candidates(hull: FloatArray, standoff: float, axes: FloatArray, seams: bool
+                ) -> list[Loop]:  # fmt: skip
+    out = []
+    for a in axes:
+        shapes = [(0.0, 2, 0.0)]
+        if seams:
+            shapes += [(A, k, ph) for A in AMPLITUDES[1:] for k in WAVES for ph in PHASES]
+        for A, k, ph in shapes:
+            n = seam_normals(a, A, k, ph)
+            h = (hull @ n.T).max(axis=0) + standoff
+            out.append(Loop(a, A, k, ph, n, h))
+    return out
+
+
+def _voxels(stock: Box, count: int) -> tuple[FloatArray, float]:
+    h = float((np.prod(stock.size) / count) ** (1 / 3))
+    axes = [np.arange(0.5 * h, s, h) - 0.5 * s for s in stock.size]
+    X, Y, Z = np.meshgrid(*axes, indexing="ij")
+    local = np.stack([X, Y, Z], axis=-1).reshape(-1, 3)
+    return local @ stock.rotation.T + stock.centre, h
+
+
+def choose_loops(hull: FloatArray, stock: Box, count: int, standoff: float,
+                 seams: bool = True, axes: FloatArray | None = None
+                 ) -> tuple[list[Loop], list[float]]:  # fmt: skip
+    """``count`` loops about the part's hull vertices ``hull`` (H, 3) [m], chosen greedily
+    (module doc); with ``seams=False`` great circles only (the baseline).  Also the
+    block's kept volume [m^3] on the voxel grid after each loop."""
+    from scipy.spatial import ConvexHull
+
+    axes = fibonacci_axes(24) if axes is None else axes
+    pts, h = _voxels(stock, VOXELS)
+    eq = ConvexHull(hull).equations
+    in_hull = np.all(pts @ eq[:, :3].T + eq[:, 3] <= 0.0, axis=1)
+    alive = (pts[~in_hull] - stock.centre).astype(np.float32)
+    cands = _candidates(hull, standoff, axes, seams)
+    planes = [(c.normals.T.astype(np.float32), (c.support - c.normals @ stock.centre)
+               .astype(np.float32)) for c in cands]  # fmt: skip
+    chosen, kept = [], []
+    for _ in range(count):
+        best, best_gain, best_keep = None, -1, None
+        for c, (nt, sup) in zip(cands, planes, strict=True):
+            keep = np.all(alive @ nt <= sup, axis=1)
+            gain = len(alive) - int(keep.sum())
+            if gain > best_gain:
+                best, best_gain, best_keep = c, gain, keep
+        if best is None or best_gain <= 0:
+            break
+        chosen.append(best)
+        alive = alive[best_keep]
+        kept.append(float((len(alive) + in_hull.sum()) * h**3))
+    return chosen, kept

@@ -1,0 +1,195 @@
+"""``ruledrobot carve``: a cell file in, the cuts, the jobs, the carved block and the report out.
+
+:func:`carve` reads the cell and the part, checks that the part fits the block, finds
+the cuts (:mod:`.plan_cuts`), meshes the carved block and the baseline's, and writes
+into a staged output folder (swapped in whole, :class:`ruledrobot.io.outdir.StagedFolder`):
+``job.toml`` (or ``setupN/job.toml``) with its lines files, ``carve.json``,
+``carved.stl`` and ``carve.png``.  Its verdict: every check holds — no cut enters the
+part, every exact cut reproduces its face within the tolerance, the carved block is a
+closed mesh that holds the part.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..io.atomic import atomic_write_text
+from ..io.mesh import write_stl
+from ..io.outdir import StagedFolder
+from .carved import carved_mesh
+from .cell import Cell, load_cell
+from .jobs import setups_of, write_jobs
+from .meshquery import MeshQuery
+from .plan_cuts import CutPlan, find_cuts
+from .readers import PartMesh, edge_counts, read_part
+
+__all__ = ["CarveResult", "carve", "check_fits"]
+
+FORMAT = "ruledrobot.carve/1"
+
+
+@dataclass(frozen=True)
+class CarveResult:
+    """What :func:`carve` did: ``report`` (the content of ``carve.json``), the cut plan,
+    ``files`` (name -> path) and ``ok`` (every check holds)."""
+
+    report: dict[str, Any] = field(repr=False)
+    plan: CutPlan = field(repr=False)
+    files: dict[str, Path] = field(default_factory=dict)
+
+    @property
+    def ok(self) -> bool:
+        return bool(self.report["ok"])
+
+
+def check_fits(part: PartMesh, cell: Cell) -> None:
+    """ValueError naming the part file when the part does not fit in the block."""
+    local = cell.stock.to_box(part.vertices)
+    over = np.abs(local) - 0.5 * cell.stock.size
+    if over.max() > 1e-6:
+        k = int(np.argmax(over.max(axis=0)))
+        raise ValueError(f"{cell.where}: [part] {part.source}: the part does not fit the block: "
+                         f"{int(np.sum(over.max(axis=1) > 1e-6))} vertices outside [stock], up "
+                         f"to {over.max() * 1e3:.2f} mm along the block's axis {'xyz'[k]} "
+                         "(check [part] units and pose, and [stock] size)")  # fmt: skip
+
+
+def _checks(plan: CutPlan, carved, part_volume: float, closed_ok: bool, tol: float,
+            spread: float) -> list[dict[str, Any]]:  # fmt: skip
+    gouge = max((m.gouge for m in plan.measures), default=0.0)
+    exact = [m.deviation for c, m in zip(plan.cuts, plan.measures, strict=True)
+             if c.kind == "exact"]  # fmt: skip
+    dev = max(exact, default=0.0)
+    out = [
+        {"name": "no_gouge", "ok": gouge == 0.0, "value_mm": round(gouge * 1e3, 4),
+         "limit_mm": 0.0, "what": "no ruling enters the part beyond the tolerance"},
+        {"name": "exact_faces", "ok": dev <= tol, "value_mm": round(dev * 1e3, 4),
+         "limit_mm": round(tol * 1e3, 4),
+         "what": "every ruled face within the tolerance of its cut"},
+        {"name": "carved_closed", "ok": closed_ok, "what": "carved.stl is a closed 2-manifold"},
+        {"name": "holds_part", "ok": carved is not None and spread <= tol + 0.002,
+         "value_mm": round(spread * 1e3, 3), "limit_mm": round((tol + 0.002) * 1e3, 3),
+         "what": "the part lies within the carved block (its vertices at most the "
+                 "tolerance plus the mesh's 2 mm grid outside it)"},
+    ]  # fmt: skip
+    if not exact:
+        out.pop(1)
+    return out
+
+
+def carve(cell_path: str | os.PathLike[str], out: str | os.PathLike[str],
+          progress=lambda msg: None) -> CarveResult:  # fmt: skip
+    """Carve the part of a cell file into ``out`` (module doc); ValueError on bad input."""
+    times: dict[str, float] = {}
+    t = time.perf_counter()
+    cell = load_cell(cell_path)
+    part = read_part(cell.part)
+    check_fits(part, cell)
+    staged = StagedFolder(out)  # refuses a folder of the user's own files at once
+    times["read"] = time.perf_counter() - t
+    with staged:
+        t = time.perf_counter()
+        query = MeshQuery(part)
+        lead = float(cell.tables.get("cut", {}).get("lead_in", 0.02))
+        plan = find_cuts(part, cell.stock, query, cell.part.tolerance, cell.part.rough_cuts,
+                         lead, progress)  # fmt: skip
+        times["cuts"] = time.perf_counter() - t
+        t = time.perf_counter()
+        progress("meshing the carved block")
+        exact = tuple(c for c in plan.cuts if c.kind == "exact")
+        carved = carved_mesh(exact, cell.stock, plan.loops) if plan.cuts else None
+        base = carved_mesh(exact, cell.stock, plan.baseline) if plan.baseline else None
+        times["carved"] = time.perf_counter() - t
+        t = time.perf_counter()
+        files = _write(staged.path, cell, part, plan, carved)
+        report = _report(cell, part, plan, carved, base, query, times)
+        atomic_write_text(staged.path / "carve.json", json.dumps(report, indent=1) + "\n")
+        progress("drawing")
+        from .plot import draw
+
+        draw(staged.path / "carve.png", part, plan, carved, cell.stock, report)
+        report["timings_s"]["write"] = round(time.perf_counter() - t, 3)
+        atomic_write_text(staged.path / "carve.json", json.dumps(report, indent=1) + "\n")
+        target = staged.commit({"command": "carve", "cell": str(cell.source)})
+    files = {k: target / v.relative_to(staged.path) for k, v in files.items()}
+    files["report"], files["picture"] = target / "carve.json", target / "carve.png"
+    return CarveResult(report, plan, files)
+
+
+def _write(folder: Path, cell: Cell, part: PartMesh, plan: CutPlan, carved) -> dict[str, Path]:
+    files: dict[str, Path] = {}
+    if plan.cuts:
+        for k, p in enumerate(write_jobs(folder, cell.tables, plan.cuts, part.source.name
+                                         if part.source else "the part")):  # fmt: skip
+            files[f"job{k + 1}" if p.parent != folder else "job"] = p
+    if carved is not None:
+        files["carved"] = write_stl(folder / "carved.stl", carved.vertices, carved.faces,
+                                    header="ruledrobot carve: the block after the cuts, "
+                                    "m")  # fmt: skip
+    return files
+
+
+def _report(cell: Cell, part: PartMesh, plan: CutPlan, carved, base, query: MeshQuery,
+            times: dict[str, float]) -> dict[str, Any]:  # fmt: skip
+    from ..wirecut import signed_volume
+
+    vp = part.volume
+    vc = signed_volume(carved.vertices, carved.faces) if carved is not None else cell_volume(cell)
+    vb = signed_volume(base.vertices, base.faces) if base is not None else None
+    closed_ok = carved is not None and edge_counts(carved.faces) == (0, 0)
+    far = 0.0
+    spread = 0.0
+    if carved is not None:
+        v = carved.vertices[:: max(1, len(carved.vertices) // 20000)]
+        far = float(query.distance(v).max())
+        from .meshquery import MeshQuery as _MQ
+        from .readers import PartMesh as _PM
+
+        cq = _MQ(_PM(carved.vertices, carved.faces))
+        pv = part.vertices[:: max(1, len(part.vertices) // 20000)]
+        outside = ~cq.inside(pv)
+        spread = float(cq.distance(pv[outside]).max()) if outside.any() else 0.0
+    setups = setups_of(plan.cuts) if plan.cuts else []
+    setup_of = {c.name: k + 1 for k, g in enumerate(setups) for c in g}
+    tol = cell.part.tolerance
+    checks = _checks(plan, carved, vp, closed_ok, tol, spread)
+    cuts = [{"name": c.name, "kind": c.kind, "what": c.what, "rulings": len(c.lines),
+             "closed": c.closed, "keep": c.keep if isinstance(c.keep, str)
+             else [round(float(x), 6) for x in c.keep], "setup": setup_of.get(c.name),
+             **m.as_dict()} for c, m in zip(plan.cuts, plan.measures, strict=True)]  # fmt: skip
+    rough = [c for c in plan.cuts if c.kind == "rough"]
+    return {
+        "format": FORMAT,
+        "cell": str(cell.source),
+        "part": {"file": str(part.source), "units": cell.part.units,
+                 "triangles": len(part.faces), "regions": len(plan.regions),
+                 "faces": {str(k): v for k, v in sorted(plan.faces.items())}},
+        "cuts": cuts,
+        "whole": {"part_volume_l": round(vp * 1e3, 5), "carved_volume_l": round(vc * 1e3, 5),
+                  "excess": round(vc / vp - 1.0, 5), "largest_distance_mm": round(far * 1e3, 3),
+                  "cuts": len(plan.cuts), "exact_cuts": len(plan.cuts) - len(rough),
+                  "rough_cuts": len(rough), "setups": len(setups)},
+        "baseline": None if vb is None else {
+            "what": f"visual hull of {len(plan.baseline)} parallel directions (a foam "
+                    "cutter's parallel wire with a turntable), chosen the same way",
+            "directions": [[round(float(x), 4) for x in lp.axis] for lp in plan.baseline],
+            "carved_volume_l": round(vb * 1e3, 5), "excess": round(vb / vp - 1.0, 5),
+            "rough_excess_voxel": round(plan.kept_voxel / vp - 1.0, 5),
+            "baseline_excess_voxel": round(plan.baseline_kept_voxel / vp - 1.0, 5)},
+        "notes": list(plan.notes),
+        "checks": checks,
+        "ok": all(c["ok"] for c in checks),
+        "timings_s": {k: round(v, 3) for k, v in times.items()},
+    }  # fmt: skip
+
+
+def cell_volume(cell: Cell) -> float:
+    """The block's volume [m^3]."""
+    return float(np.prod(cell.stock.size))

@@ -1,0 +1,106 @@
+"""Parts made from closed forms, in the tests themselves (not the product's meshes).
+
+Each returns ``(vertices (V, 3), faces (F, 3))`` in metres in the part's own frame,
+closed, faces turned outwards (every part here is star-shaped about its origin), and
+the closed form to check cuts against (a function of points giving the first-order
+distance to the ruled surface in metres, in the same frame).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def _weld(tris: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """A triangle soup (T, 3, 3) as shared vertices and faces turned outwards (star-shaped
+    about the origin)."""
+    n = np.cross(tris[:, 1] - tris[:, 0], tris[:, 2] - tris[:, 0])
+    flip = np.einsum("ij,ij->i", n, tris.mean(axis=1)) < 0
+    tris = np.where(flip[:, None, None], tris[:, ::-1], tris)
+    v, inv = np.unique(np.round(tris.reshape(-1, 3), 10), axis=0, return_inverse=True)
+    f = inv.reshape(-1, 3)
+    good = (f[:, 0] != f[:, 1]) & (f[:, 1] != f[:, 2]) & (f[:, 0] != f[:, 2])
+    return v, f[good]
+
+
+def _grid(P: np.ndarray, closed_u: bool = False) -> np.ndarray:
+    """Triangles (T, 3, 3) of a grid of points P (nu, nv, 3)."""
+    if closed_u:
+        P = np.concatenate([P, P[:1]], axis=0)
+    a, b, c, d = P[:-1, :-1], P[1:, :-1], P[1:, 1:], P[:-1, 1:]
+    return np.concatenate([np.stack([a, b, c], -2).reshape(-1, 3, 3),
+                           np.stack([a, c, d], -2).reshape(-1, 3, 3)])
+
+
+def hyperboloid_column(a=0.06, c=0.3, h=0.1, nu=96, nz=24):
+    """``x^2 + y^2 = a^2 (1 + z^2 / c^2)`` for ``|z| <= h``, capped (axis z)."""
+    u = np.linspace(0, 2 * np.pi, nu, endpoint=False)
+    z = np.linspace(-h, h, nz)
+    r = a * np.sqrt(1 + z**2 / c**2)
+    P = np.stack([np.cos(u)[:, None] * r, np.sin(u)[:, None] * r, np.broadcast_to(z, (nu, nz))], -1)
+    side = _grid(P, closed_u=True)
+    caps = []
+    for k in (0, -1):
+        ring = P[:, k]
+        centre = np.broadcast_to([0.0, 0.0, z[k]], ring.shape)
+        caps.append(np.stack([centre, ring, np.roll(ring, -1, axis=0)], 1))
+    v, f = _weld(np.concatenate([side, *caps]))
+
+    def distance(x):
+        F = x[:, 0] ** 2 + x[:, 1] ** 2 - a**2 * (1 + x[:, 2] ** 2 / c**2)
+        g = np.stack([2 * x[:, 0], 2 * x[:, 1], -2 * a**2 * x[:, 2] / c**2], 1)
+        return np.abs(F) / np.linalg.norm(g, axis=1)
+
+    return v, f, distance
+
+
+def saddle_block(size=(0.2, 0.2, 0.15), z0=0.035, c=0.4, n=25):
+    """The block ``|x|, |y| <= size/2``, from its bottom to the saddle ``z = z0 + x y / c``."""
+    hx, hy, hz = 0.5 * np.asarray(size)
+    x, y = np.linspace(-hx, hx, n), np.linspace(-hy, hy, n)
+    X, Y = np.meshgrid(x, y, indexing="ij")
+    top = np.stack([X, Y, z0 + X * Y / c], -1)
+    bot = np.stack([X, Y, np.full_like(X, -hz)], -1)
+    walls = []
+    for edge_top, edge_bot in ((top[0], bot[0]), (top[-1], bot[-1]),
+                               (top[:, 0], bot[:, 0]), (top[:, -1], bot[:, -1])):
+        walls.append(_grid(np.stack([edge_bot, edge_top], 1)))
+    v, f = _weld(np.concatenate([_grid(top), _grid(bot), *walls]))
+
+    def distance(p):
+        F = p[:, 2] - z0 - p[:, 0] * p[:, 1] / c
+        g = np.stack([-p[:, 1] / c, -p[:, 0] / c, np.ones(len(p))], 1)
+        return np.abs(F) / np.linalg.norm(g, axis=1)
+
+    return v, f, distance
+
+
+def ellipsoid(axes=(0.09, 0.06, 0.045), nu=64, nv=32):
+    """The ellipsoid of semi-axes ``axes``."""
+    u = np.linspace(0, 2 * np.pi, nu, endpoint=False)
+    t = np.linspace(0, np.pi, nv)
+    P = np.stack([np.cos(u)[:, None] * np.sin(t), np.sin(u)[:, None] * np.sin(t),
+                  np.broadcast_to(np.cos(t), (nu, nv))], -1) * np.asarray(axes)
+    v, f = _weld(_grid(P, closed_u=True))
+    return v, f, None
+
+
+def write_stl_ascii(path, v, f, scale=1.0):
+    """An ASCII STL of the mesh (coordinates divided by ``scale``: 0.001 writes mm)."""
+    lines = ["solid part"]
+    for tri in v[f] / scale:
+        n = np.cross(tri[1] - tri[0], tri[2] - tri[0])
+        n = n / (np.linalg.norm(n) or 1.0)
+        lines += [f"facet normal {n[0]:.9g} {n[1]:.9g} {n[2]:.9g}", "outer loop"]
+        lines += [f"vertex {p[0]:.12g} {p[1]:.12g} {p[2]:.12g}" for p in tri]
+        lines += ["endloop", "endfacet"]
+    lines.append("endsolid part")
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+def write_obj(path, v, f, scale=1.0):
+    text = "".join(f"v {x:.12g} {y:.12g} {z:.12g}\n" for x, y, z in v / scale)
+    text += "".join(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in f)
+    path.write_text(text)
+    return path
