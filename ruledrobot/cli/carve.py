@@ -1,0 +1,80 @@
+"""``ruledrobot carve``: a part (mesh or 3DM) and a block in, the ruled cuts that make it out."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import typer
+
+from ._common import app, console, err, fail
+
+
+@app.command(epilog="Example:  ruledrobot carve cell.toml --out out/carve   then  ruledrobot "
+             "plan out/carve/job.toml --out out/carve-plan   (docs/carve.md)")  # fmt: skip
+def carve(
+    cell: Path = typer.Argument(..., help="Cell file (.toml): [part] file, units, pose, "
+                                "tolerance, and the [stock], [robot], [tool], [cut] of a job."),
+    out: Path = typer.Option(Path("out/carve"), "--out", "-o", help="Output folder."),
+) -> None:
+    """Turn a part (a closed STL, OBJ, PLY mesh or a 3DM model) into the ruled cuts that
+    make it from the block: its ruled faces cut exactly along their own rulings, the rest
+    roughed by loops that never enter it (compared with the visual hull of as many
+    parallel directions).  Writes job.toml (or setupN/job.toml) with its lines files,
+    carve.json, carved.stl and carve.png.  Exits 1 when a check fails, 2 on bad input."""
+    from ..carve import carve as run_carve
+
+    try:
+        with console.status("carving") as status:
+            res = run_carve(cell, out, progress=lambda msg: status.update(msg))
+    except ValueError as exc:
+        raise fail(str(exc)) from None
+    print_carve(res.report)
+    for name, path in res.files.items():
+        console.print(f"wrote {path}  ({name})", highlight=False, markup=False)
+    if not res.ok:
+        raise typer.Exit(code=1)
+
+
+def print_carve(report: dict[str, Any]) -> None:
+    """The cuts and the whole as tables, the checks, and the verdict line."""
+    from rich.table import Table
+    from rich.text import Text
+
+    table = Table(title="cuts (mm)", title_justify="left", show_edge=False, pad_edge=False)
+    for col in ("cut", "kind", "rulings", "setup", "face within", "closest", "loosest",
+                "gouge", "what"):  # fmt: skip
+        table.add_column(col, justify="left" if col in ("cut", "kind", "what") else "right")
+
+    def mm(v) -> str:
+        return "-" if v is None else f"{v:.3f}"
+
+    for c in report["cuts"]:
+        table.add_row(c["name"], c["kind"], str(c["rulings"]), str(c["setup"]),
+                      mm(c["deviation_mm"]), mm(c["closest_mm"]), mm(c["farthest_mm"]),
+                      mm(c["gouge_mm"]), c["what"])  # fmt: skip
+    console.print(table)
+    w, b = report["whole"], report.get("baseline")
+    whole = Table(title="the whole", title_justify="left", show_edge=False, pad_edge=False)
+    for col in ("", "volume L", "excess %", "largest distance to the part mm"):
+        whole.add_column(col, justify="right" if col else "left")
+    whole.add_row("part", f"{w['part_volume_l']:.4f}", "", "")
+    whole.add_row(f"carved ({w['cuts']} cuts, {w['setups']} setups)",
+                  f"{w['carved_volume_l']:.4f}", f"{100 * w['excess']:.2f}",
+                  f"{w['largest_distance_mm']:.2f}")  # fmt: skip
+    if b:
+        whole.add_row(f"visual hull, {len(b['directions'])} parallel directions",
+                      f"{b['carved_volume_l']:.4f}", f"{100 * b['excess']:.2f}", "")  # fmt: skip
+    console.print(whole)
+    for note in report["notes"]:
+        console.print(f"note: {note}", highlight=False, markup=False)
+    for c in report["checks"]:
+        if not c["ok"]:
+            value = f" ({c['value_mm']} mm, limit {c['limit_mm']} mm)" if "value_mm" in c else ""
+            err.print(Text(f"  {c['name']}: ", style="bold red") + Text(c["what"] + value),
+                      highlight=False)  # fmt: skip
+    ok = report["ok"]
+    failed = [c["name"] for c in report["checks"] if not c["ok"]]
+    console.print(Text(f"verdict: {'PASS' if ok else 'FAIL'} — "
+                       + ("every check holds" if ok else "failed: " + ", ".join(failed)),
+                       style="bold green" if ok else "bold red"), highlight=False)  # fmt: skip
