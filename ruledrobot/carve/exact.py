@@ -127,7 +127,11 @@ def _open(fit: Fit, region: Region, stock: Box, d0: FloatArray, p0: FloatArray,
 def exact_cut(fit: Fit, region: Region, stock: Box, query: MeshQuery, prefer: FloatArray,
               name: str, lead: float = 0.02) -> CarveCut | str:  # fmt: skip
     """The cut of a ruled region (module doc), or why there is none (a note)."""
-    i = int(np.argmin(np.linalg.norm(region.points - region.centroid, axis=1)))
+    # the vertex nearest the region's centre; of several alike (a column's waist), the first
+    # in coordinate order, so that the cut does not hang on the file's vertex order
+    r = np.round(region.points, 7)
+    dist = np.round(np.linalg.norm(region.points - region.centroid, axis=1), 6)
+    i = int(np.lexsort((r[:, 2], r[:, 1], r[:, 0], dist))[0])
     p0, n0 = region.points[i], region.normals[i]
     dirs = fit.line_directions(p0, n0)
     if not np.all(np.isfinite(dirs)):
@@ -137,7 +141,12 @@ def exact_cut(fit: Fit, region: Region, stock: Box, query: MeshQuery, prefer: Fl
         if np.linalg.norm(pr) < 0.2:
             pr = np.array([0.0, 0.0, 1.0]) - n0[2] * n0
         dirs = np.stack([pr, pr]) / np.linalg.norm(pr)
-    d0 = _pick(dirs, prefer)
+    # the family most nearly along prefer; of two alike (a hyperboloid about prefer), the
+    # one turning positively about the normal, so that the choice does not hang on rounding
+    score = [round(abs(d @ prefer), 3) + 1e-6 * np.sign(np.linalg.det(np.stack([n0, d, prefer]))
+                                                        * (d @ prefer)) for d in dirs]  # fmt: skip
+    d0 = dirs[int(np.argmax(score))]
+    d0 = d0 if d0 @ prefer >= 0.0 else -d0
     what = f"region {region.index}: {'plane' if fit.kind == 'plane' else 'ruled quadric'}"
     try:
         loop = None if fit.kind == "plane" else _closed(fit, region, d0)
