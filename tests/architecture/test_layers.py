@@ -24,8 +24,10 @@ ALLOWED: dict[str, set[str]] = {
     "wirecut": {"algorithms", "geometry", "io", "robot", "sim", "subdivision"},
     "view": {"geometry", "io", "robot", "sim", "wirecut"},
     "batch": {"geometry", "io", "robot", "wirecut"},
+    # from a part to its cuts: the planner's top-level names only (tests/carve/test_layer.py)
+    "carve": {"geometry", "io", "robot", "subdivision", "wirecut"},
     "cli": {
-        "algorithms", "batch", "export", "gallery", "geometry", "io", "protocol", "robot",
+        "algorithms", "batch", "carve", "export", "gallery", "geometry", "io", "protocol", "robot",
         "sim", "subdivision", "ursim", "view", "wirecut",
     },
     # the package root re-exports the light lower layers only (``rr.Lines``, ``rr.refine``)
