@@ -78,7 +78,8 @@ def place(
                               "setups: z90, z180 (about the vertical), x90, y180 (tipped "
                               "over a bottom edge)...; '' for none."),
     rulings: int = typer.Option(48, min=2, help="Rulings sampled per pass and candidate."),
-    rolls: int = typer.Option(24, min=4, help="Rolls of the wire over a turn."),
+    rolls: int = typer.Option(36, min=4, help="Rolls of the wire over a turn (36: the "
+                              "planner's own grid)."),
     tries: int = typer.Option(3, min=1, help="Candidates verified by the planner at most."),
     verify: bool = typer.Option(True, "--verify/--no-verify",
                                 help="Plan the best with MuJoCo verification."),
@@ -171,9 +172,8 @@ def _print_place(res: PlaceOutcome) -> None:
         console.print(step, highlight=False, markup=False)
     for name, path in res.files.items():
         console.print(f"wrote {path}  ({name})", highlight=False, markup=False)
-    if not res.ok:
-        err.print("nothing found passes the planner (place.json says what was tried)",
-                  highlight=False, markup=False)  # fmt: skip
+    if not res.ok and res.closing:
+        err.print(res.closing, highlight=False, markup=False)
 
 
 

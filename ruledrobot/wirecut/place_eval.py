@@ -36,11 +36,20 @@ from .margins import (
     kinematic_margins,
     limit_levers,
 )
-from .reach import job_cell
-from .reach_grid import RowBoxes, directions_needed, pass_poses, planner_slide, sample_rulings
+from .reach_grid import (
+    ROLLS,
+    RULINGS,
+    RowBoxes,
+    directions_needed,
+    job_cell,
+    pass_poses,
+    planner_slides,
+    sample_rulings,
+)
 from .spec import Job
 
-__all__ = ["TIE", "Evaluator", "PassSample", "Scores"]
+__all__ = ["TIE", "ColumnDetail", "Evaluator", "PassSample", "Scores", "constant_rolls",
+           "constant_words", "details"]
 
 #: weight of the kinematic margin in the score (ties of the quantised clearance)
 TIE = 1e-3
@@ -63,6 +72,15 @@ class PassSample:
     P0: FloatArray = field(repr=False)
     bow_ok: np.ndarray = field(repr=False)
     too_long: float
+    #: rulings of the pass (the sample's indices count into them)
+    rulings: int = 0
+    #: the planner's other slides (near both ends of the common interval), tried when
+    #: nothing works at the first: ``(P0, bow_ok)`` each
+    ends: tuple = field(default=(), repr=False)
+
+    def slide(self, j: int) -> tuple[FloatArray, np.ndarray]:
+        """``(P0, bow_ok)`` of slide option ``j`` (0: the planner's first)."""
+        return (self.P0, self.bow_ok) if j == 0 else self.ends[j - 1]
 
 
 @dataclass(frozen=True, eq=False)
@@ -100,8 +118,8 @@ class Evaluator:
     verification plans on the calibration.
     """
 
-    def __init__(self, job: Job, passes: list[CutPath], model=None, rulings: int = 48,
-                 rolls: int = 24, rules: Rules = DEFAULT_RULES, per_round: int = 8,
+    def __init__(self, job: Job, passes: list[CutPath], model=None, rulings: int = RULINGS,
+                 rolls: int = ROLLS, rules: Rules = DEFAULT_RULES, per_round: int = 8,
                  max_rounds: int | None = None) -> None:  # fmt: skip
         self.job = job
         self.model = (job.robot_model() if model is None else model).nominal
@@ -115,12 +133,16 @@ class Evaluator:
         self.samples: list[PassSample] = []
         for cp in passes:
             F = cp.frames
-            slide, too_long = planner_slide(F, job.stock, job.tool)
+            slides, too_long = planner_slides(F, job.stock, job.tool)
             idx = sample_rulings(len(F), rulings)
-            P0 = pass_poses(self.cell.W, F[idx], slide[idx], self.rolls, self.directions)
-            bow = clearance(self.cell, np.zeros((*P0.shape[:-2], 6)), P0)["bow hits the stock"]
-            self.samples.append(PassSample(names.index(cp.name), cp.name, idx, P0, ~bow,
-                                           float(np.max(too_long))))  # fmt: skip
+            opts = []
+            for slide in slides:
+                P0 = pass_poses(self.cell.W, F[idx], slide[idx], self.rolls, self.directions)
+                bow = clearance(self.cell, np.zeros((*P0.shape[:-2], 6)), P0)
+                opts.append((P0, ~bow["bow hits the stock"]))
+            self.samples.append(PassSample(names.index(cp.name), cp.name, idx, *opts[0],
+                                           float(np.max(too_long)), len(F),
+                                           tuple(opts[1:])))  # fmt: skip
 
     def subset(self, cuts: list[int]) -> Evaluator:
         """This evaluator for the passes of ``cuts`` only (indices into the job's cuts);
@@ -172,13 +194,32 @@ class Evaluator:
     def _pass(
         self, T: FloatArray, s: PassSample
     ) -> tuple[FloatArray, FloatArray, np.ndarray, np.ndarray]:
+        """The best column of pass ``s`` per candidate: at the planner's first slide, and
+        where nothing works there, at its slides near either end of the interval (as the
+        planner tries them); a column index counts on over the slides."""
+        best, score, arg, exact = self._columns(T, *s.slide(0), s)
+        n = len(self.directions) * len(self.rolls) * 8
+        for j in range(1, len(s.ends) + 1):
+            need = np.flatnonzero(best < 0.0)
+            if not need.size:
+                break
+            b2, s2, a2, e2 = self._columns(T[need], *s.slide(j), s)
+            better = s2 > score[need]
+            w = need[better]
+            best[w], score[w], arg[w] = b2[better], s2[better], a2[better] + j * n
+            exact[need] &= e2
+        return best, score, arg, exact
+
+    def _columns(
+        self, T: FloatArray, P0: FloatArray, bow_ok: np.ndarray, s: PassSample
+    ) -> tuple[FloatArray, FloatArray, np.ndarray, np.ndarray]:
         model, rules = self.model, self.rules
         C, K, R = len(T), len(self.rolls), s.idx.size
         D = len(self.directions)
-        P = T[:, None, None, None] @ s.P0[None]  # (C, D, K, R, 4, 4)
+        P = T[:, None, None, None] @ P0[None]  # (C, D, K, R, 4, 4)
         q = model.ik(P, check=False)  # (C, D, K, R, 8, 6)
         km, kr = kinematic_margins(model, q, P, rules)
-        bow = s.bow_ok[None, ..., None]
+        bow = bow_ok[None, ..., None]
         km = np.where(bow, km, np.minimum(km, -rules.margin))
         if s.too_long > 0.0:
             km = np.minimum(km, -s.too_long)
@@ -238,10 +279,14 @@ class Evaluator:
 
 @dataclass(frozen=True, eq=False)
 class ColumnDetail:
-    """One pass of one placement in detail: its best column (``reverse``, ``roll`` rad,
-    IK ``branch``), per sampled ruling (R,) the margin (m) and the reason it fails
+    """One pass of one placement in detail: its best column — the **best constant roll**
+    (``reverse``, ``roll`` rad, IK ``branch``: the one with the largest worst margin, the
+    search's choice) —, per sampled ruling (R,) the margin (m) and the reason it fails
     (:class:`~.margins.Reason`), and which part of the margin is the least there
-    (``limit``: "reach", "joint limits", "singularity", "clearance" or a reason)."""
+    (``limit``: "reach", "joint limits", "singularity", "clearance" or a reason).
+    ``worst`` (m) is the column's value as the search scores it: the least of the
+    rulings' margins and of ``travel`` (the joints' travel along the pass centred in
+    their limits, m); ``rulings`` the rulings of the pass."""
 
     name: str
     idx: np.ndarray
@@ -252,10 +297,61 @@ class ColumnDetail:
     reason: np.ndarray = field(repr=False)
     limit: tuple[str, ...] = field(repr=False)
     q: FloatArray = field(repr=False)
+    worst: float = 0.0
+    travel: float = np.inf
+    rulings: int = 0
+    #: the slide option (:func:`~.reach_grid.planner_slides`, 0: the planner's first)
+    slide: int = 0
+
+    @property
+    def served(self) -> np.ndarray:
+        """(R,) whether the column keeps each sampled ruling within the rules."""
+        return self.margin >= 0.0
+
+    @property
+    def share(self) -> float:
+        """The share of the sampled rulings the column serves."""
+        return float(self.served.mean())
+
+    @property
+    def roll_deg(self) -> int:
+        """The roll in whole degrees, in (-180, 180]."""
+        deg = round(float(np.degrees(self.roll))) % 360
+        return deg - 360 if deg > 180 else deg
+
+    def label(self) -> str:
+        """``-150 deg, along the ruling, IK branch 3``."""
+        return (f"{self.roll_deg} deg, {'wire reversed' if self.reverse else 'along the ruling'}"
+                f", IK branch {self.branch}")
+
+    def percent(self) -> str:
+        """The share served in whole percent, ``100`` only when every sampled ruling is
+        served and ``0`` only when none is."""
+        p = 100.0 * self.share
+        return str(int(min(max(round(p), 1), 99)) if 0.0 < p < 100.0 else int(p))
+
+    def words(self) -> str:
+        """The best constant roll of the pass in words (the same sentence wherever it is
+        said: a failed plan, ``reach``, ``place``)."""
+        k = int(np.argmin(self.margin))
+        where = (f"worst margin {self.worst * 1e3:.0f} mm at ruling {int(self.idx[k])}: "
+                 f"{self.limit[k]}")
+        n = self.idx.size
+        if self.worst >= 0.0:
+            return (f"a constant roll of the wire ({self.label()}) serves all {n} sampled "
+                    f"rulings (worst margin {self.worst * 1e3:.0f} mm)")
+        if self.served.all():
+            return (f"the best constant roll ({self.label()}) keeps all {n} sampled rulings "
+                    f"within the rules, but the joints' travel along the pass leaves "
+                    f"{self.travel * 1e3:.0f} mm to their limits")
+        return (f"the best constant roll ({self.label()}) serves {self.percent()} % of the "
+                f"{n} sampled rulings ({where})")
 
 
 def details(ev: Evaluator, T: FloatArray) -> list[ColumnDetail]:
-    """The best column of every pass for the placement T (4, 4), ruling by ruling."""
+    """The best column of every pass for the placement T (4, 4), ruling by ruling: the
+    same margins the search scores (:meth:`Evaluator.__call__`), the bow's gate and a
+    chord longer than the wire included."""
     from ..robot.workspace import reach_margin
     from .margins import REASON_TEXT, joint_limit_margin, limit_levers
 
@@ -266,12 +362,16 @@ def details(ev: Evaluator, T: FloatArray) -> list[ColumnDetail]:
     out = []
     K = len(ev.rolls)
     for k, s in enumerate(ev.samples):
-        d, kk, b = np.unravel_index(sc.column[0, k], (len(ev.directions), K, 8))
-        P = T @ s.P0[d, kk]  # (R, 4, 4)
-        q = model.ik(P, check=False)[:, b]  # (R, 6)
-        km, kr = kinematic_margins(model, q[:, None], P, rules)
-        km, kr = km[:, 0], kr[:, 0]
+        j, d, kk, b = np.unravel_index(sc.column[0, k], (len(s.ends) + 1, len(ev.directions),
+                                                         K, 8))  # fmt: skip
+        P0, bow_ok = s.slide(int(j))
+        P = T @ P0[d, kk]  # (R, 4, 4)
+        qs = model.ik(P, check=False)  # (R, 8, 6)
+        q = qs[:, b]
+        km, kr = kinematic_margins(model, qs, P, rules)  # every branch: each its own excess
+        km, kr = km[:, b], kr[:, b]
         ok = ~np.isnan(q[:, 0])
+        bow = bow_ok[d, kk]
         parts = {
             "reach": np.where(ok, reach_margin(model, np.nan_to_num(q)), -np.inf),
             "joint limits": joint_limit_margin(model, np.nan_to_num(q), limit_levers(model)),
@@ -280,19 +380,71 @@ def details(ev: Evaluator, T: FloatArray) -> list[ColumnDetail]:
         }
         clear = np.full(len(P), np.inf)
         creason = np.zeros(len(P), np.int8)
-        use = ok & s.bow_ok[d, kk] & (kr != Reason.JOINT_LIMIT)
+        use = ok & bow & (kr != Reason.JOINT_LIMIT)
         if use.any():
             cell = dataclasses.replace(ev.cell, stock=RowBoxes(ev.job.stock, np.repeat(
                 T[None], int(use.sum()), axis=0)))
-            clear[use], creason[use] = clearance_margins(cell, q[use], P[use], rules)
-        parts["clearance"] = np.where(s.bow_ok[d, kk], clear, -rules.margin)
-        margin = np.minimum(km, clear)
+            clear[use], creason[use] = clearance_margins(cell, q[use], P[use], rules,
+                                                         depth=False)
+        parts["clearance"] = np.where(bow, clear, np.minimum(clear, -rules.margin))
+        margin = np.minimum(km, parts["clearance"])
         reason = np.where(kr != 0, kr, np.where(margin < 0, creason, 0))
-        reason = np.where(~s.bow_ok[d, kk] & (reason == 0), Reason.BOW_STOCK, reason)
+        reason = np.where(~bow & (reason == 0), Reason.BOW_STOCK, reason)
+        if s.too_long > 0.0:  # a chord longer than the wire: no column serves
+            margin = np.minimum(margin, -s.too_long)
+            reason = np.where(reason == 0, Reason.CHORD, reason)
         names = list(parts)
         stack = np.stack([parts[n] for n in names])
         limit = tuple(REASON_TEXT[Reason(r)] if r else names[int(i)]
                       for r, i in zip(reason, stack.argmin(axis=0), strict=True))  # fmt: skip
+        travel = float(ev._travel_margin(q[None])[0])
         out.append(ColumnDetail(s.name, s.idx, bool(ev.directions[d]), float(ev.rolls[kk]),
-                                int(b), margin, reason.astype(np.int8), limit, q))  # fmt: skip
+                                int(b), margin, reason.astype(np.int8), limit, q,
+                                float(sc.pass_margin[0, k]), travel, s.rulings,
+                                int(j)))  # fmt: skip
     return out
+
+
+def constant_rolls(job: Job, passes: list[CutPath], model=None, rules: Rules = DEFAULT_RULES
+                   ) -> list[ColumnDetail]:  # fmt: skip
+    """The best constant roll of every pass of ``job`` where the job places its block:
+    the one model's fact (docs/place.md, "One model") that a failed plan's explanation,
+    ``ruledrobot reach`` and ``ruledrobot place`` all report — :class:`Evaluator` on its
+    default grid (:data:`~.reach_grid.RULINGS` rulings x :data:`~.reach_grid.ROLLS`
+    rolls), at the identity placement."""
+    ev = Evaluator(job, list(passes), model, rules=rules)
+    return details(ev, np.eye(4))
+
+
+#: the planner's joint step threshold between rulings (rad; ``solve_redundancy``)
+JUMP = 0.5
+
+
+def constant_words(job: Job, model, cp: CutPath, col: ColumnDetail) -> str:
+    """The best constant roll ``col`` of a pass in words; of a pass the planner could not
+    solve (:mod:`.reach_explain`) never "serves all" without what fails between the samples (the
+    planner's own check of every ruling at that roll), so that it never stands beside the
+    planner's "no constant roll works" as a contradiction."""
+    if cp.feasible or (col.worst < 0.0 and not col.served.all()):
+        return col.words()
+    from .reach_grid import planner_slides
+    from .redundancy import _failures, _ranges
+
+    F = cp.frames
+    slide = planner_slides(F, job.stock, job.tool)[0][col.slide]
+    q0 = col.q[0] if not np.isnan(col.q[0]).any() else None
+    cell = dataclasses.replace(job_cell(job, model, DEFAULT_RULES), q_start=q0)
+    _, _, masks = _failures(cell, F, np.full(len(F), col.roll), slide, col.reverse, JUMP)
+    fails = "; ".join(f"{why} at rulings {_ranges(v)}" for why, v in masks.items() if v.any())
+    n = col.idx.size
+    head = (f"the best constant roll ({col.label()}) keeps all {n} sampled rulings within the "
+            f"rules (worst margin {col.worst * 1e3:.0f} mm)")
+    if col.worst < 0.0:
+        head = (f"the best constant roll ({col.label()}) keeps all {n} sampled rulings within "
+                f"the rules, but the joints' travel along the pass leaves "
+                f"{col.travel * 1e3:.0f} mm to their limits")
+    if fails:
+        return (f"{head}, but not every ruling between them: the planner's check of all "
+                f"{len(F)} rulings at that roll fails: {fails}")
+    return (f"{head}, and the planner's check of all {len(F)} rulings at that roll on that IK "
+            "branch holds: the search, which follows the branch nearest its start, missed it")

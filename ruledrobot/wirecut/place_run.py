@@ -29,6 +29,7 @@ from .place_eval import Evaluator, details
 from .place_plot import plot_place
 from .placement import Region, Turn, transforms
 from .plan import job_reference
+from .reach_grid import ROLLS, RULINGS
 from .setups import MAX_SETUPS, SetupPlan, operator_steps, plan_setups
 from .spec import Job
 
@@ -51,21 +52,20 @@ class PlaceOutcome:
     files: dict[str, Path] = field(default_factory=dict)
     ok: bool = False
     lines: tuple[str, ...] = ()
+    #: the last word when nothing passes: whether the planner ran and what it found
+    closing: str = ""
 
 
 def limiting(ev: Evaluator, T: np.ndarray) -> str:
-    """Where and why the placement T (4, 4) has its worst margin, in words."""
-    worst = None
-    for d in details(ev, T):
-        k = int(np.argmin(d.margin))
-        if worst is None or d.margin[k] < worst[0]:
-            worst = (float(d.margin[k]), d, k)
-    if worst is None:
+    """Where and why the placement T (4, 4) has its worst margin, in words: the best
+    constant roll of its worst pass (:meth:`~.place_eval.ColumnDetail.words`, the
+    sentence a failed plan and ``ruledrobot reach`` say of the same pass)."""
+    cols = details(ev, T)
+    if not cols:
         return ""
-    _, d, k = worst
-    where = f"cut '{d.name}', " if len(ev.job.cuts) > 1 else ""
-    return (f"{where}ruling {int(d.idx[k])}: {d.limit[k]} (roll {np.degrees(d.roll):.0f} deg, "
-            f"{'reversed' if d.reverse else 'along'}, IK branch {d.branch})")
+    d = min(cols, key=lambda c: c.worst)
+    where = f"cut '{d.name}': " if len(ev.job.cuts) > 1 else ""
+    return f"{where}{d.words()}"
 
 
 def _cand_line(c: Candidate) -> str:
@@ -81,8 +81,8 @@ def run_place(
     refine: int = 2,
     turns: tuple[Turn, ...] = (),
     tries: int = 3,
-    rulings: int = 48,
-    rolls: int = 24,
+    rulings: int = RULINGS,
+    rolls: int = ROLLS,
     verify: bool = True,
     progress: Callable[[str], None] | None = None,
     program: Callable[[object, Path], Path] | None = None,
@@ -155,11 +155,19 @@ def run_place(
                     lines += [f"setup {s.number} verified: {t}" for t in c.tried]
         if not res.feasible and setups is None:
             lines.append(f"no placement in the region serves the job: the best worst margin "
-                         f"found is {res.best.margin * 1e3:.0f} mm")  # fmt: skip
+                         f"found is {res.best.margin * 1e3:.0f} mm (a constant roll of the "
+                         "wire on every sampled ruling, the planner's first choice; a "
+                         "varying roll is not scored)")  # fmt: skip
         ok = single_ok if setups is None else (
             not verify or all(c.candidate is not None for c in checks))  # fmt: skip
         if single_ok and verify:
             ok = True
+        ran = bool(verified is not None and verified.tried) or any(c.tried for c in checks)
+        closing = ""
+        if not ok:
+            closing = ("nothing found passes the planner (place.json says what was tried)"
+                       if ran else "the planner was not run: no placement found has a worst "
+                       "margin >= 0 (place.json has the best ones found)")  # fmt: skip
         b = res.best.placement
         yaws = np.linspace(*region.yaw, 37) if region.yaw[1] > region.yaw[0] else None
         sweep = None
@@ -170,6 +178,7 @@ def run_place(
                    [s.candidate for s in setups.setups] if setups else None, sweep)  # fmt: skip
         lines += list(ev.notes)  # a scorer's notes (chunks scored here)
         doc = _document(job, res, verified, setups, checks, steps, ev, lines, ok)
+        doc["closing"] = closing or None
         atomic_write_text(stage.path / "place.json", json.dumps(doc, indent=1) + "\n")
         target = stage.commit({"kind": "place", "ok": ok})
     files = {"place": target / "place.json", "margin": target / "margin.png"}
@@ -181,7 +190,7 @@ def run_place(
         files["setups"] = target / "setups.txt"
         for s in setups.setups:
             files[f"setup{s.number}"] = target / f"setup{s.number}"
-    return PlaceOutcome(res, verified, setups, checks, steps, files, ok, tuple(lines))
+    return PlaceOutcome(res, verified, setups, checks, steps, files, ok, tuple(lines), closing)
 
 
 def _document(job: Job, res: PlaceResult, verified: Verified | None, setups: SetupPlan | None,

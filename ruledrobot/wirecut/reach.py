@@ -12,6 +12,7 @@ the clearance rules run only on the branch that can still be the best of its cel
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
@@ -30,16 +31,18 @@ from .margins import (
     kinematic_margins,
 )
 from .path import cut_paths
-from .reach_grid import directions_needed, pass_poses, planner_slide, sample_rulings
+from .reach_grid import (
+    directions_needed,
+    job_cell,
+    pass_poses,
+    planner_slide,
+    planner_slides,
+    sample_rulings,
+)
 from .spec import Job, ToolSpec
 from .toolpath import chords, flange_poses, slide_bounds, wire_poses
 
 __all__ = ["PassMap", "ReachMap", "classify", "job_cell", "map_pass", "reach_map"]
-
-
-def job_cell(job: Job, model, rules: Rules) -> Cell:
-    """The planner's cell of ``job`` (table top at z = 0, the planner's thresholds)."""
-    return Cell.of(model, job.tool, job.stock, 0.0, rules.margin, rules.singular_min, None)
 
 
 def classify(
@@ -110,6 +113,12 @@ class PassMap:
     path_reason: np.ndarray | None = field(repr=False)
     slides: FloatArray | None = field(default=None, repr=False)
     slide_index: np.ndarray | None = field(default=None, repr=False)
+    #: the best constant roll of the pass (:func:`~.place_eval.constant_rolls`: the one
+    #: model's, on its own grid, the same a failed plan and ``place`` report); None when
+    #: not computed
+    constant: object | None = field(default=None, repr=False)
+    #: it in words (:func:`~.place_eval.constant_words`)
+    constant_words: str | None = field(default=None, repr=False)
 
     @property
     def shown(self) -> int:
@@ -118,11 +127,6 @@ class PassMap:
             return int(self.chosen_reverse)
         return int(np.argmax((self.margin >= 0).sum(axis=(1, 2))))
 
-    def best_constant(self, direction: int) -> tuple[int, float]:
-        """The grid roll (index) whose worst margin over the rulings is largest, and it."""
-        worst = self.margin[direction].min(axis=1)
-        k = int(np.argmax(worst))
-        return k, float(worst[k])
 
 
 @dataclass(frozen=True, eq=False)
@@ -149,7 +153,9 @@ def map_pass(
     ``rulings`` sampled evenly (ends included), ``rolls`` evenly over a turn, and
     ``slides`` slides per ruling: the planner's, then ``slides - 1`` spread over the
     interval in which the wire covers the ruling's chord (the common interval of the
-    pass for rulings outside the stock); each cell keeps its best slide."""
+    pass for rulings outside the stock); each cell keeps its best slide.  A pass the
+    planner could not solve is mapped, with ``slides = 1``, at every slide the planner
+    tried (:func:`~.reach_grid.planner_slides`)."""
     F = cp.frames
     M = len(F)
     slide, too_long = planner_slide(F, cell.stock, tool)
@@ -157,7 +163,10 @@ def map_pass(
         slide = cp.motion.slide
     idx = sample_rulings(M, rulings)
     grid = np.linspace(-np.pi, np.pi, rolls, endpoint=False)
-    options = _slide_options(F[idx], slide[idx], cell.stock, tool, slides)  # (S, R)
+    if slides <= 1 and not cp.feasible:  # every slide the planner tried
+        options = np.stack([sl[idx] for sl in planner_slides(F, cell.stock, tool)[0]])
+    else:
+        options = _slide_options(F[idx], slide[idx], cell.stock, tool, slides)  # (S, R)
     dirs = directions_needed(cell.W)
     best = None
     for s, sl in enumerate(options):
@@ -225,8 +234,17 @@ def reach_map(
         for cut in job.cuts:
             say(f"the planner's passes of {cut.name}")
             passes += cut_paths(job, cut, model)
+    from .place_eval import constant_rolls, constant_words
+
+    say("the best constant roll of every pass")
+    try:
+        cols: list = constant_rolls(job, passes, model, rules)
+    except ValueError:  # a pass that cannot be scored (no chord): the map says why
+        cols = [None] * len(passes)
     maps = []
     for k, cp in enumerate(passes):
         say(f"mapping pass {k + 1} of {len(passes)} ({cp.name})")
-        maps.append(map_pass(cell, job.tool, cp, k, rules, rulings, rolls, slides))
+        pm = map_pass(cell, job.tool, cp, k, rules, rulings, rolls, slides)
+        words = None if cols[k] is None else constant_words(job, model, cp, cols[k])
+        maps.append(dataclasses.replace(pm, constant=cols[k], constant_words=words))
     return ReachMap(job, tuple(maps), rules, time.perf_counter() - t0)

@@ -1,13 +1,20 @@
 """Why a plan found no path, in numbers a fabricator can act on: how far out of reach
 and which rulings, which rule, and which way to move the block.
 
-For every pass the redundancy search could not solve, a coarse reachability map
-(:func:`~.reach.map_pass`) gives per ruling the best cell over every roll and wire
-direction: the rulings no roll serves, grouped by reason, and by how much they miss
-the arm's reach (:func:`~ruledrobot.robot.workspace.reach_excess`).  Then the block
-is tried moved along eight horizontal directions (towards and away from the robot,
-to either side and between) by 2.5 to 50 cm (:class:`~.place_eval.Evaluator`, the
-whole job): the shortest move with a worst margin >= 0 is suggested.
+Every figure is the one margin model's (docs/place.md, "One model"):
+
+* which rulings no roll serves, and by how much they miss the arm's reach: a coarse
+  reachability map (:func:`~.reach.map_pass`, 60 rulings x the planner's 36 rolls) of
+  every pass the redundancy search could not solve;
+* the best constant roll and the share of the sampled rulings it serves: the
+  placement search's column (:func:`~.place_eval.details`, the same function
+  ``ruledrobot reach`` and ``ruledrobot place`` report); when it serves every sampled
+  ruling although the planner found no constant roll, the planner's own check of every
+  ruling at that roll says what fails between the samples;
+* the move: the block moved along eight horizontal directions (towards and away from
+  the robot, to either side and between) by 2.5 to 50 cm, scored by the same
+  :class:`~.place_eval.Evaluator`; the shortest move after which a constant roll
+  serves every sampled ruling of every pass is suggested.
 """
 
 from __future__ import annotations
@@ -24,10 +31,12 @@ from .cutpath import CutPath
 from .margins import DEFAULT_RULES, REASON_TEXT, Reason
 from .placement import mm
 from .reach import PassMap, job_cell, map_pass
+from .reach_grid import ROLLS
 from .reach_report import ruling_ranges
 
 if TYPE_CHECKING:
     from ..robot.model import RobotModel
+    from .place_eval import Evaluator
     from .plan import Plan
     from .spec import Job
 
@@ -42,14 +51,16 @@ _NAMES = ("towards the robot", "towards the robot and to its left", "to the robo
 
 
 def suggest_move(
-    job: Job, passes: list[CutPath], model: RobotModel | None = None
-) -> tuple[str, float, FloatArray] | None:
-    """The shortest horizontal move of the block that gives every sampled ruling of every
-    pass a configuration with margin >= 0: ``(direction in words, distance m, new block
-    centre (3,))``, or None when none of the moves tried does."""
+    job: Job, passes: list[CutPath], model: RobotModel | None = None,
+    evaluator: Evaluator | None = None,
+) -> tuple[str, float, FloatArray, float] | None:
+    """The shortest horizontal move of the block after which one constant roll serves
+    every sampled ruling of every pass (the placement search's margin >= 0, on its
+    default grid, or ``evaluator``'s): ``(direction in words, distance m, new block
+    centre (3,), worst margin m)``, or None when none of the moves tried does."""
     from .place_eval import Evaluator
 
-    ev = Evaluator(job, list(passes), model, rulings=24, rolls=12)
+    ev = Evaluator(job, list(passes), model) if evaluator is None else evaluator
     base = ev.model.base[:3, 3]
     u = job.stock.centre - base
     u[2] = 0.0
@@ -65,7 +76,7 @@ def suggest_move(
     if not ok.size:
         return None
     k = ok[0]  # shifts ascending: the first that works is the shortest
-    return _NAMES[k % 8], float(SHIFTS[k // 8]), job.stock.centre + moves[k]
+    return _NAMES[k % 8], float(SHIFTS[k // 8]), job.stock.centre + moves[k], float(sc.margin[k])
 
 
 def _excess_words(cell: Cell, cp: CutPath, pm: PassMap, ruling: int) -> str:
@@ -74,7 +85,10 @@ def _excess_words(cell: Cell, cp: CutPath, pm: PassMap, ruling: int) -> str:
     k = int(np.argmax(pm.margin[d, :, ruling]))
     from .reach_grid import pass_poses
 
-    P = pass_poses(cell.W, cp.frames[pm.idx[ruling:ruling + 1]], pm.slide[ruling:ruling + 1],
+    slide = pm.slide[ruling:ruling + 1]
+    if pm.slides is not None and pm.slide_index is not None:  # the cell's best slide
+        slide = pm.slides[pm.slide_index[d, k, ruling], ruling:ruling + 1]
+    P = pass_poses(cell.W, cp.frames[pm.idx[ruling:ruling + 1]], slide,
                    pm.rolls[k:k + 1], ((False, True)[d],))[0, 0, 0]  # fmt: skip
     e, kind = reach_excess(cell.model, P, check=False)
     b = int(np.argmin(e))
@@ -100,14 +114,22 @@ def _joints_out(model: RobotModel, pm: PassMap, d: int, mask: np.ndarray) -> str
 def reach_reasons(plan: Plan) -> tuple[str, ...]:
     """Extra reasons for a plan some pass of which is infeasible (module doc); () when
     every pass is feasible."""
+    from .place_eval import Evaluator, constant_words, details
+
     bad = [(k, cp) for k, cp in enumerate(plan.passes) if not cp.feasible]
     if not bad:
         return ()
     job = plan.job
     cell = job_cell(job, plan.model, DEFAULT_RULES)
     out = []
+    try:
+        ev = Evaluator(job, list(plan.passes), plan.model)
+        cols = details(ev, np.eye(4))
+    except ValueError as exc:  # a pass that cannot be scored (no chord, say)
+        ev, cols = None, None
+        out.append(f"no constant roll or move scored: {exc}")
     for k, cp in bad:
-        pm = map_pass(cell, job.tool, cp, k, DEFAULT_RULES, rulings=60, rolls=24)
+        pm = map_pass(cell, job.tool, cp, k, DEFAULT_RULES, rulings=60, rolls=ROLLS)
         d = pm.shown
         head = f"{cp.name}: " if len(job.cuts) > 1 else ""
         best = pm.margin[d].max(axis=0)
@@ -125,23 +147,19 @@ def reach_reasons(plan: Plan) -> tuple[str, ...]:
                 text += (f"; out of reach by up to {_excess_words(cell, cp, pm, worst)} "
                          f"(ruling {pm.idx[worst]})")
             out.append(text)
-        kc, worst = pm.best_constant(d)
-        share = float((pm.margin[d, kc] >= 0).mean())
-        out.append(f"{head}the best constant roll ({np.degrees(pm.rolls[kc]):.0f} deg) serves "
-                   f"{100 * share:.0f} % of the rulings (ruledrobot reach draws the map)")
-    try:
-        move = suggest_move(job, plan.passes, plan.model)
-    except ValueError as exc:  # a pass that cannot be scored (no chord, say)
-        move = None
-        out.append(f"no move suggested: {exc}")
+        if cols is not None:
+            out.append(f"{head}{constant_words(job, plan.model, cp, cols[k])} "
+                       "(ruledrobot reach draws the map)")
+    move = None if ev is None else suggest_move(job, plan.passes, plan.model, ev)
     if move is not None:
-        words, dist, centre = move
+        words, dist, centre, margin = move
         out.append(f"moving the block {mm(dist)} mm {words} (block centre to x = "
-                   f"{mm(centre[0])} mm, y = {mm(centre[1])} mm, surfaces with it) "
-                   "gives every sampled ruling a configuration within the rules; "
-                   "ruledrobot place searches position and yaw")
-    else:
-        out.append("no move of the block by up to 50 cm in any horizontal direction makes "
-                   "every ruling reachable; try ruledrobot place (position and yaw), setups, "
-                   "or another robot")
+                   f"{mm(centre[0])} mm, y = {mm(centre[1])} mm, surfaces with it) lets one "
+                   "constant roll of the wire serve every sampled ruling of every pass "
+                   f"(worst margin {margin * 1e3:.0f} mm); ruledrobot place searches "
+                   "position and yaw")
+    elif ev is not None:
+        out.append("no move of the block by up to 50 cm in any horizontal direction lets a "
+                   "constant roll of the wire serve every sampled ruling; try ruledrobot "
+                   "place (position and yaw), setups, or another robot")
     return tuple(out)

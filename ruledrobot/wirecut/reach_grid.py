@@ -11,20 +11,38 @@ import numpy as np
 
 from ..geometry.box import Box
 from ..geometry.checks import FloatArray
-from .spec import ToolSpec
+from .clearance import Cell
+from .margins import Rules
+from .spec import Job, ToolSpec
 from .toolpath import chords, flange_poses, slide_bounds, wire_poses
 
 __all__ = [
     "DIRECTIONS",
+    "ROLLS",
+    "RULINGS",
     "RowBoxes",
     "directions_needed",
+    "job_cell",
     "pass_poses",
     "planner_slide",
+    "planner_slides",
     "sample_rulings",
 ]
 
 #: the two wire directions, in the order of every grid's first axis
 DIRECTIONS = (False, True)
+#: rolls over a turn of the constant-roll model (the planner's own grid: the default
+#: ``rolls`` of :func:`~.redundancy.solve_redundancy`, so every roll it scores is
+#: scored here): the placement search, the best constant roll of ``reach`` and of a
+#: failed plan's explanation, and the move it suggests (docs/place.md, "One model")
+ROLLS = 36
+#: rulings sampled per pass by the constant-roll model (ends included)
+RULINGS = 48
+
+
+def job_cell(job: Job, model, rules: Rules) -> Cell:
+    """The planner's cell of ``job`` (table top at z = 0, the planner's thresholds)."""
+    return Cell.of(model, job.tool, job.stock, 0.0, rules.margin, rules.singular_min, None)
 
 
 def directions_needed(W: FloatArray) -> tuple[bool, ...]:
@@ -63,6 +81,24 @@ def planner_slide(frames: FloatArray, stock: Box, tool: ToolSpec) -> tuple[Float
         return np.full(len(frames), 0.5 * (L + H)), too_long
     centre = 0.5 * (np.median(lo[hit]) + np.median(hi[hit]))
     return np.clip(np.full(len(frames), centre), np.minimum(lo, hi), np.maximum(lo, hi)), too_long
+
+
+def planner_slides(frames: FloatArray, stock: Box, tool: ToolSpec
+                   ) -> tuple[list[FloatArray], FloatArray]:  # fmt: skip
+    """The slides (each (M,) m) the redundancy search tries, in its order: the first
+    (:func:`planner_slide`), then, when one slide covers every chord, slides a tenth of
+    the common interval in from either end of it (tried when nothing works at the
+    first); and ``too_long`` as :func:`planner_slide`."""
+    first, too_long = planner_slide(frames, stock, tool)
+    c0, c1, hit = chords(frames, stock)
+    if not hit.any():
+        return [first], too_long
+    lo, hi, _ = slide_bounds(c0, c1, hit, tool)
+    L, H = lo[hit].max(), hi[hit].min()
+    if not (L <= H and H - L > 1e-6):
+        return [first], too_long
+    m = len(frames)
+    return [first, np.full(m, L + 0.1 * (H - L)), np.full(m, H - 0.1 * (H - L))], too_long
 
 
 def pass_poses(

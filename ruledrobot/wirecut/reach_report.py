@@ -86,12 +86,17 @@ def pass_summary(pm: PassMap) -> dict:
             "worst_at_ruling": int(pm.idx[w]),
             "rulings_failing_on_the_map": ruling_ranges(pm, pm.path_margin < 0),
         }
-    k, worst = pm.best_constant(d)
-    out["best_constant_roll"] = {
-        "roll_deg": float(np.degrees(pm.rolls[k])),
-        "worst_margin_mm": float(worst * 1e3),
-        "reachable_fraction": float((pm.margin[d, k] >= 0).mean()),
-    }
+    c = pm.constant
+    if c is not None:  # the one model's best constant roll (docs/place.md, "One model")
+        out["best_constant_roll"] = {
+            "roll_deg": float(c.roll_deg),
+            "reversed": c.reverse,
+            "ik_branch": c.branch,
+            "worst_margin_mm": float(c.worst * 1e3),
+            "reachable_fraction": c.share,
+            "sampled_rulings": int(c.idx.size),
+            "words": pm.constant_words or c.words(),
+        }
     return out
 
 
@@ -198,13 +203,13 @@ def plot_reach(path: str | Path, rm: ReachMap) -> Path:
                 w = int(np.argmin(pm.path_margin))
                 words.append(f"planned: roll {_roll_text(pm.chosen_roll)}, worst margin "
                              f"{pm.path_margin[w] * 1e3:.0f} mm at ruling {pm.idx[w]}")
-            else:
-                k, _ = pm.best_constant(d)
-                ax.plot([x0 + x[0], x0 + x[-1]], [np.degrees(pm.rolls[k])] * 2, color="k",
+            elif pm.constant is not None:
+                c = pm.constant
+                ax.plot([x0 + x[0], x0 + x[-1]], [c.roll_deg] * 2, color="k",
                         lw=1.0, ls="--")  # fmt: skip
-                share = (pm.margin[d, k] >= 0).mean()
-                words.append(f"no path found; dashed: best constant roll "
-                             f"{np.degrees(pm.rolls[k]):.0f} deg ({100 * share:.0f} % of rulings)")
+                words.append(f"no path found; dashed: best constant roll {c.roll_deg} deg "
+                             f"({c.percent()} % of {c.idx.size} sampled rulings)")
+            if pm.chosen_roll is None:
                 out = (pm.reason[d] == Reason.OUT_OF_REACH).all(axis=0)
                 if out.any():
                     far = float(-pm.margin[d][:, out].max(axis=0).min())
@@ -282,10 +287,10 @@ def summary_lines(rm: ReachMap) -> list[str]:
             p = s["planned"]
             text += (f"; planned path: worst margin {p['worst_margin_mm']:.0f} mm at ruling "
                      f"{p['worst_at_ruling']}")
+        elif pm.constant is not None:
+            text += f"; no feasible path: {pm.constant_words or pm.constant.words()}"
         else:
-            b = s["best_constant_roll"]
-            text += (f"; no feasible path: the best constant roll ({b['roll_deg']:.0f} deg) "
-                     f"reaches {100 * b['reachable_fraction']:.0f} % of the rulings")
+            text += "; no feasible path"
         if s["rulings_without_any_roll"]:
             text += f"; no roll works at rulings {s['rulings_without_any_roll']}"
         if "out_of_reach_by_up_to_mm" in s:
