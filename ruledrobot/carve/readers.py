@@ -8,8 +8,9 @@ from the file's unit to metres and placed by the part's pose in the robot base f
 
 A part must be a closed 2-manifold: every edge in exactly two triangles.  An open mesh
 (edges of one triangle: holes, a surface and not a solid) or a non-manifold one (edges
-of three or more) is refused, naming the file and how many edges of each kind it has.
-Faces are turned outwards (positive volume) when the whole mesh is inside out.
+of three or more) is refused, naming the file and how many edges of each kind it has;
+so is one whose triangles disagree in orientation (an edge run the same way by both
+its triangles).  Faces are turned outwards when the whole mesh is inside out.
 """
 
 from __future__ import annotations
@@ -22,7 +23,7 @@ import numpy as np
 from ..geometry.checks import FloatArray
 from .cell import PartSpec
 
-__all__ = ["PartMesh", "edge_counts", "read_part", "read_triangles"]
+__all__ = ["PartMesh", "edge_counts", "misoriented_edges", "read_part", "read_triangles"]
 
 
 @dataclass(frozen=True)
@@ -52,6 +53,14 @@ def edge_counts(faces: np.ndarray) -> tuple[int, int]:
     e = np.sort(np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]]), axis=1)
     _, counts = np.unique(e, axis=0, return_counts=True)
     return int(np.sum(counts == 1)), int(np.sum(counts > 2))
+
+
+def misoriented_edges(faces: np.ndarray) -> int:
+    """How many edges two triangles run the same way (their orientations disagree; a
+    closed manifold whose faces agree runs every edge once each way)."""
+    e = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]])
+    _, counts = np.unique(e, axis=0, return_counts=True)
+    return int(np.sum(counts > 1))
 
 
 def _read_3dm(path: Path) -> tuple[FloatArray, np.ndarray, str | None]:
@@ -154,6 +163,11 @@ def read_part(spec: PartSpec) -> PartMesh:
         raise ValueError(f"{path}: not a closed 2-manifold mesh: {' and '.join(what)}; "
                          "expected a closed solid (repair it in CAD: close its "
                          "holes)")  # fmt: skip
+    wrong = misoriented_edges(f)
+    if wrong:
+        raise ValueError(f"{path}: the triangles' orientations disagree across {wrong} edge(s) "
+                         "(some faces turned inside out); expected every face counter-"
+                         "clockwise seen from outside (repair the normals in CAD)")  # fmt: skip
     v = v * spec.scale
     v = v @ spec.pose[:3, :3].T + spec.pose[:3, 3]
     part = PartMesh(v, f, path)

@@ -46,8 +46,12 @@ def test_open_and_non_manifold_meshes_are_refused(tmp_path):
     fin = np.vstack([v, [[0.0, 0.0, 0.3]]])
     e = f[0, :2]
     write_stl_ascii(tmp_path / "fin.stl", fin, np.vstack([f, [[e[0], e[1], len(v)]]]), scale=0.001)
+    flipped = f.copy()
+    flipped[5] = flipped[5, ::-1]
+    write_obj(tmp_path / "flipped.obj", v, flipped, scale=0.001)
     pose = [0.5, 0.0, 0.3, float(np.pi / 2), 0.0, 0.0]
-    for name, words in (("open.stl", "boundary edge"), ("fin.stl", "non-manifold edge")):
+    for name, words in (("open.stl", "boundary edge"), ("fin.stl", "non-manifold edge"),
+                        ("flipped.obj", "orientations disagree across 3 edge")):
         cell = write_cell(tmp_path, name, pose, name=f"{name}.toml")
         res, _ = run_carve(cell, tmp_path / f"out-{name}")
         assert res.exit_code == 2, res.output
