@@ -30,8 +30,8 @@ import time
 from pathlib import Path
 
 from ruledrobot.batch import Engine, run_batch
-from ruledrobot.wirecut.demo import DEMO_JOB
-from ruledrobot.wirecut.job import load_job
+from ruledrobot.wirecut.job.demo import DEMO_JOB
+from ruledrobot.wirecut.job.load import load_job
 from ruledrobot.wirecut.planner import plan
 
 FAST = DEMO_JOB.replace("steps = 4", "steps = 2")

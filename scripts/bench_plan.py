@@ -23,12 +23,12 @@ from pathlib import Path
 import numpy as np
 
 from ruledrobot.robot import load
-from ruledrobot.wirecut.demo import DEMO_JOB, PART_JOB
-from ruledrobot.wirecut.job import load_job
-from ruledrobot.wirecut.path import cut_path, refine_for_job
+from ruledrobot.wirecut.cut.passes import cut_path, refine_for_job
+from ruledrobot.wirecut.cut.wire_geometry import speed_factor
+from ruledrobot.wirecut.job.demo import DEMO_JOB, PART_JOB
+from ruledrobot.wirecut.job.load import load_job
+from ruledrobot.wirecut.motion.timing import time_path
 from ruledrobot.wirecut.planner import plan
-from ruledrobot.wirecut.timing import time_path
-from ruledrobot.wirecut.toolpath import speed_factor
 
 
 def main() -> None:
@@ -82,8 +82,8 @@ def main() -> None:
 
 def _part(tmp: Path) -> None:
     """The built-in part: stages of the plan against the duration of the motion."""
-    from ruledrobot.wirecut.outcome import plan_outcome
     from ruledrobot.wirecut.plan import make_plan
+    from ruledrobot.wirecut.report.outcome import plan_outcome
     from ruledrobot.wirecut.verify import verify_plan
 
     p = tmp / "part.toml"
@@ -115,9 +115,9 @@ def _part(tmp: Path) -> None:
 def bench_place() -> None:
     """Candidates scored per minute (issue 13): the demo surface refined to 2,051 rulings,
     a 9 x 9 x 9 grid over a region that holds good, marginal and unreachable places."""
-    from ruledrobot.wirecut.place import job_passes
-    from ruledrobot.wirecut.place_eval import Evaluator
-    from ruledrobot.wirecut.placement import Region, transforms
+    from ruledrobot.place.regions import Region, transforms
+    from ruledrobot.place.search import job_passes
+    from ruledrobot.wirecut.reach.evaluate import Evaluator
 
     print("\nplacement search (ruledrobot place): candidates scored per minute")
     print(f"{'bow':>10} {'rulings':>8} {'per cand.':>22} {'candidates':>10} {'time':>8} "
@@ -155,9 +155,9 @@ def _place_on_workers() -> None:
     except ImportError:
         print("dask not installed: the cluster comparison is skipped (the batch extra)")
         return
-    from ruledrobot.wirecut.place import job_passes
-    from ruledrobot.wirecut.place_eval import Evaluator
-    from ruledrobot.wirecut.placement import Region, transforms
+    from ruledrobot.place.regions import Region, transforms
+    from ruledrobot.place.search import job_passes
+    from ruledrobot.wirecut.reach.evaluate import Evaluator
 
     with tempfile.TemporaryDirectory() as tmp:
         p = Path(tmp) / "job.toml"

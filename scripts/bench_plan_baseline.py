@@ -22,8 +22,8 @@ ROOT = Path(__file__).resolve().parent.parent
 
 CHILD = r"""
 import sys, time, tempfile, pathlib
-from ruledrobot.wirecut.demo import DEMO_JOB, PART_JOB
-from ruledrobot.wirecut.job import load_job
+from ruledrobot.wirecut.job.demo import DEMO_JOB, PART_JOB
+from ruledrobot.wirecut.job.load import load_job
 from ruledrobot.wirecut.plan import make_plan
 text = {"demo": DEMO_JOB, "part": PART_JOB}[sys.argv[1]]
 with tempfile.TemporaryDirectory() as tmp:

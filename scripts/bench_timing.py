@@ -1,4 +1,4 @@
-"""Benchmark of the time law (ruledrobot.wirecut.timing) against plain toppra.
+"""Benchmark of the time law (ruledrobot.wirecut.motion.timing) against plain toppra.
 
 Run:  .venv/bin/python scripts/bench_timing.py [--n 2000] [--repeat 7] [--dt 0.002]
 
@@ -18,7 +18,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from ruledrobot.wirecut.timing import (
+from ruledrobot.wirecut.motion.timing import (
     concatenate,
     joint_move,
     time_path,

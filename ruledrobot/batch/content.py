@@ -6,7 +6,7 @@ The hash (SHA-256 of a canonical JSON document) covers
 * the job's effective text (the file's bytes, or its document with the job list's
   overrides merged in, written back as TOML);
 * every input file the job names (``[surface] file``, a G-code, airfoil, DXF or 3DM
-  file, ``[robot] calibration``; :func:`ruledrobot.wirecut.job.file_fields`): the
+  file, ``[robot] calibration``; :func:`ruledrobot.wirecut.job.load.file_fields`): the
   path as written and the SHA-256 of the bytes (or ``null``: missing);
 * the code: ruledrobot's version and the SHA-256 of the sources that make a plan
   (:data:`PLANNING_CODE`: an uncommitted change counts too), and the plan's options.
@@ -26,7 +26,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..io.paths import input_path
-from ..wirecut.job import file_fields, job_document
+from ..wirecut.job.load import file_fields, job_document
 from .jobs import BatchInputError, JobEntry, merge_overrides
 
 __all__ = ["HASH_FORMAT", "CodeIdentity", "InputFile", "JobContent", "code_identity",

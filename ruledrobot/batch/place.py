@@ -27,7 +27,7 @@ from typing import Any
 
 import numpy as np
 
-from ..wirecut.place_eval import Evaluator, Scores
+from ..wirecut.reach.evaluate import Evaluator, Scores
 from .engine import Engine
 
 __all__ = ["DistributedEvaluator"]
@@ -44,7 +44,7 @@ def _score(ev: Evaluator, T: np.ndarray) -> Scores:
 
 
 class DistributedEvaluator:
-    """An :class:`~ruledrobot.wirecut.place_eval.Evaluator` whose calls score the
+    """An :class:`~ruledrobot.wirecut.reach.evaluate.Evaluator` whose calls score the
     candidates on the workers of ``engine`` (an open :class:`.engine.Engine`); every
     other attribute is the evaluator's own.  ``notes`` collects what went wrong on the
     way (chunks scored here instead)."""

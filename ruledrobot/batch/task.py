@@ -40,7 +40,7 @@ from pathlib import Path
 from typing import Any
 
 from ..io.outdir import MANIFEST, read_manifest
-from ..wirecut.job import Job, file_fields, job_document, parse_job
+from ..wirecut.job.load import Job, file_fields, job_document, parse_job
 from .content import code_identity, resolve_input
 
 __all__ = ["KILL_HOOK", "KILL_LOG", "JobTask", "TaskResult", "run_task"]

@@ -20,7 +20,7 @@ def simulate(
     Exits 1 when a check fails (collision, joint range, speed, torque)."""
     from ..sim import RenderUnavailable
     from ..sim import simulate as do_simulate
-    from ..wirecut.cell import scene_of_trajectory
+    from ..wirecut.job.scene import scene_of_trajectory
 
     try:
         scene, where = scene_of_trajectory(trajectory)
@@ -57,7 +57,7 @@ def _run_plan(job_path: Path, out: Path, video: bool = False):
     Exit 2 on bad input (nothing written), 1 when a check fails (report and plots
     written, no trajectory); returns the :class:`~ruledrobot.wirecut.planner.PlanResult`.
     """
-    from ..wirecut.job import load_job
+    from ..wirecut.job.load import load_job
     from ..wirecut.planner import plan as do_plan
 
     try:
@@ -124,7 +124,7 @@ def demo(
     from ..export.urscript import MAX_MOTION_LINES
     from ..io.atomic import atomic_write_text
     from ..io.outdir import check_replaceable
-    from ..wirecut.demo import DEMO_JOB, PART_JOB
+    from ..wirecut.job.demo import DEMO_JOB, PART_JOB
     from .robot import say_program_size
     from .robot import stream as stream_run
 

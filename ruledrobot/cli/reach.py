@@ -11,7 +11,7 @@ import typer
 from ._common import app, console, err, fail
 
 if TYPE_CHECKING:
-    from ..wirecut.place_run import PlaceOutcome
+    from ..place.run import PlaceOutcome
 
 
 @app.command(epilog="Example:  ruledrobot reach job.toml --out out/reach   (docs/place.md)")
@@ -28,8 +28,8 @@ def reach(
     about the wire, the margin or why not (out of reach, joint limit, singularity, which
     collision).  Writes reach.png (one panel per cut, the planner's path drawn on it) and
     reach.json.  Exits 1 when some pass has no feasible path."""
-    from ..wirecut.job import load_job
-    from ..wirecut.reach_report import summary_lines, write_reach
+    from ..wirecut.job.load import load_job
+    from ..wirecut.reach.report import summary_lines, write_reach
 
     try:
         spec = load_job(job)
@@ -100,9 +100,9 @@ def place(
     import math
 
     from ..batch.engine import EngineUnavailable  # Dask itself is imported when used
-    from ..wirecut.job import load_job
-    from ..wirecut.place_run import run_place
-    from ..wirecut.placement import Region, parse_range, parse_turns
+    from ..place.regions import Region, parse_range, parse_turns
+    from ..place.run import run_place
+    from ..wirecut.job.load import load_job
 
     def program(trajectory, folder: Path) -> Path | None:
         """URScript for the pendant (servoj; movep when servoj would be too long; none when
@@ -150,7 +150,7 @@ def place(
 def _print_place(res: PlaceOutcome) -> None:
     from rich.table import Table
 
-    from ..wirecut.placement import mm
+    from ..io.words import mm
 
     for line in res.lines:
         console.print(line, highlight=False, markup=False)

@@ -6,7 +6,7 @@ intermediate a scalar in a register instead of a 32 kB temporary.  It is bit for
 numpy path: no fused multiply-adds (no ``fastmath``), ``sqrt`` and division are exact
 IEEE operations, and ``sin``, ``cos`` and ``atan2`` are the C library's on both sides
 (numpy's float64 ``sin``/``cos``/``arctan2`` call libm on CPUs without AVX-512; the test
-``tests/test_se3_kernel.py`` checks the identity on this machine's libraries).  Where the
+``tests/geometry/test_se3_kernel.py`` checks the identity on this machine's libraries).  Where the
 numpy chunk selects with ``np.where`` the kernel branches; both select the same value.
 
 Imported by the first geodesic of more than ``se3.NUMPY_PAIRS`` pairs (or

@@ -400,9 +400,6 @@ class Lines:
         """The lines moved by the rigid motion T (4, 4) (or one pose per line (N, 4, 4))."""
         return Lines(plucker_transform(T, self.plucker))
 
-    def reversed_orientation(self) -> Lines:
-        """The same lines with opposite orientation ``[-l, -m]``."""
-        return Lines(-self.plucker)
 
     def __len__(self) -> int:
         return self.plucker.shape[0]

@@ -248,11 +248,6 @@ class Calibration:
             calibration_status=2 if self.status is None else self.status,
         )  # fmt: skip
 
-    def with_source(self, source: str) -> Calibration:
-        """The same calibration with another ``source``."""
-        return Calibration(self.model, self.theta_offset, self.a, self.d, self.alpha,
-                           checksum=self.checksum, source=source, status=self.status,
-                           bounds=self.bounds)  # fmt: skip
 
     def __repr__(self) -> str:
         kind = "nominal" if self.is_nominal else "calibrated"

@@ -66,7 +66,7 @@ class BowTool:
     @classmethod
     def from_spec(cls, spec: Any, **overrides: Any) -> BowTool:
         """From any object with ``wire_start``, ``wire_end`` (and optionally ``mass``),
-        e.g. the ``[tool]`` of a cut job (``ruledrobot.wirecut.job.ToolSpec``)."""
+        e.g. the ``[tool]`` of a cut job (``ruledrobot.wirecut.job.load.ToolSpec``)."""
         kw: dict[str, Any] = {"wire_start": spec.wire_start, "wire_end": spec.wire_end}
         if getattr(spec, "mass", None) is not None:
             kw["mass"] = spec.mass
@@ -91,7 +91,7 @@ class BowTool:
 
     def segments(self) -> FloatArray:
         """The bow's rods (3, 2, 3) in the flange frame: arm at the start, arm at the end,
-        crossbar (the same rods as ``ruledrobot.wirecut.redundancy.bow_segments``)."""
+        crossbar (the same rods as ``ruledrobot.wirecut.cut.wire_pose.bow_segments``)."""
         x = self.depth_direction()
         a = self.wire_start - (self.wire_start @ x) * x
         b = self.wire_end - (self.wire_end @ x) * x

@@ -112,7 +112,7 @@ class Scene:
     ``width`` x ``height`` the video resolution (sets the offscreen buffer);
     ``camera`` ``(position, target)`` in the base frame or None
     (:func:`default_camera`); ``part`` the kept part's mesh (``vertices`` (V, 3) m and
-    ``faces`` (F, 3) in the base frame, e.g. :func:`ruledrobot.wirecut.part.part_mesh`)
+    ``faces`` (F, 3) in the base frame, e.g. :func:`ruledrobot.wirecut.report.part_mesh.part_mesh`)
     or None — drawn in green inside a fainter stock, for looking only (no contacts).
     """
 
@@ -128,7 +128,7 @@ class Scene:
 
     @classmethod
     def from_job(cls, job: Any, robot: RobotModel | None = None, **kw: Any) -> Scene:
-        """The cell of a cut job (``ruledrobot.wirecut.job.Job``, read by attribute):
+        """The cell of a cut job (``ruledrobot.wirecut.job.load.Job``, read by attribute):
         ``job.robot_model()`` (model, calibration; unless ``robot`` is given) placed at the
         job's ``[robot] base``, the bow of ``job.tool`` (:meth:`BowTool.from_spec`) and
         ``job.stock`` (in the robot base frame, like every pose of a job)."""

@@ -341,10 +341,3 @@ class RTDEServer(TcpServer):
         self.delay = max(0.0, float(delay))
         self.jitter = max(0.0, float(jitter))
 
-    def stream_stats(self) -> list[tuple[str, int, int]]:
-        """(peer, packages sent, bytes sent) per connection."""
-        return [
-            (c.peer, c.stats.packages, c.stats.bytes)
-            for c in self.connections()
-            if isinstance(c, RTDEConnection)
-        ]

@@ -55,7 +55,7 @@ class NotAPlanFolder(ValueError):
 class PlanFolder:
     """The files of a plan folder, read and checked (see the module doc).
 
-    ``job`` is a :class:`ruledrobot.wirecut.job.Job`; ``trajectory`` the planned
+    ``job`` is a :class:`ruledrobot.wirecut.job.load.Job`; ``trajectory`` the planned
     motion or None; ``rulings`` the refined rulings (``Lines``, robot base frame)
     or None; ``meshes`` name -> :class:`~ruledrobot.geometry.mesh.Mesh` (m, robot
     base frame) of ``surface*``, ``part``, ``removed``; ``simulation`` the
@@ -110,7 +110,7 @@ def _job(folder: Path, report: dict[str, Any], notes: list[str]) -> Any:
     exists, else in the folder.  The viewer does not refine, so a lines file that
     cannot be found any more is replaced by the plan's own ``refined.json`` (noted).
     """
-    from ..wirecut.job import file_fields, parse_job
+    from ..wirecut.job.load import file_fields, parse_job
 
     p, text = read_user_text(folder / "job.toml", "job file")
     try:

@@ -6,9 +6,9 @@ Usage::
     result = plan(load_job("job.toml"), "out/cut")
 """
 
-from .job import Job, load_job, parse_job
-from .part import part_mesh, part_sdf, signed_volume
+from .job.load import Job, load_job, parse_job
 from .planner import PlanResult, plan
+from .report.part_mesh import part_mesh, part_sdf, signed_volume
 
 __all__ = ["Job", "PlanResult", "load_job", "parse_job", "part_mesh", "part_sdf", "plan",
            "signed_volume"]

@@ -22,12 +22,12 @@ from ..robot.rates import trajectory_limits_report
 from ..robot.tool import BowTool
 from ..robot.trajectory import Heat, Trajectory, phases_from_labels, runs
 from ..robot.wire_cut import FeedWindow, WireCut
-from .densify import target_frames
-from .motion import Motion, assemble_motion
-from .order import check_cut_order
-from .path import CutPath, cut_paths
-from .spec import Job
-from .toolpath import distance_from_rulings
+from .cut.order import check_cut_order
+from .cut.passes import CutPath, cut_paths
+from .cut.wire_geometry import distance_from_rulings
+from .job.spec import Job
+from .motion.assemble import Motion, assemble_motion
+from .motion.densify import target_frames
 
 __all__ = [
     "SINGULARITY_MARGIN", "Plan", "PlannedMeasures", "make_plan", "wire_cut", "wire_deviation",
@@ -67,11 +67,8 @@ class Plan:
 
     @property
     def reachable(self) -> bool:
+        """Every pass has a feasible wire motion (``motion`` is not None)."""
         return self.motion is not None
-
-    def cut_of_pass(self, k: int):
-        """The :class:`~.job.CutSpec` pass ``k`` belongs to."""
-        return next(c for c in self.job.cuts if c.name == self.passes[k].name)
 
 
 def job_reference(job: Job) -> dict[str, str] | None:

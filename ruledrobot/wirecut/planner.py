@@ -28,13 +28,13 @@ from pathlib import Path
 from ..io.outdir import StagedFolder
 from ..robot.trajectory import Trajectory
 from ..robot.verdict import Verdict
-from .motion import LIFT
-from .outcome import plan_outcome
-from .path import CutPath
+from .cut.passes import CutPath
+from .job.spec import Job
+from .motion.assemble import LIFT
 from .plan import Plan, make_plan
-from .spec import Job
+from .report.files import write_plan
+from .report.outcome import plan_outcome
 from .verify import verify_plan
-from .write import write_plan
 
 __all__ = ["LIFT", "PlanResult", "plan"]
 

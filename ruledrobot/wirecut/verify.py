@@ -11,8 +11,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..geometry.checks import FloatArray
-from .checks import collision_sentence
 from .plan import Plan, wire_deviation
+from .report.verdict import collision_sentence
 
 __all__ = ["Verification", "verify_plan"]
 

@@ -17,8 +17,8 @@ from pathlib import Path
 os.environ.setdefault("MUJOCO_GL", "egl")
 
 from ruledrobot.io.lines import save_lines
-from ruledrobot.wirecut.demo import DEMO_JOB
-from ruledrobot.wirecut.job import job_document, parse_job
+from ruledrobot.wirecut.job.demo import DEMO_JOB
+from ruledrobot.wirecut.job.load import job_document, parse_job
 
 FAST_JOB = DEMO_JOB.replace("steps = 4", "steps = 2").replace(
     "feed_speed = 0.01 ", "feed_speed = 0.04 "

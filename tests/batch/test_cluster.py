@@ -22,7 +22,7 @@ import pytest
 from ruledrobot.batch import local_cluster, run_batch
 from ruledrobot.batch.task import KILL_HOOK, KILL_LOG
 from ruledrobot.io.outdir import read_manifest
-from ruledrobot.wirecut.job import load_job
+from ruledrobot.wirecut.job.load import load_job
 from ruledrobot.wirecut.planner import plan
 
 from .conftest import (

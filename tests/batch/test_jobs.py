@@ -17,7 +17,7 @@ from ruledrobot.batch.manifest import (
     resumable,
     write_manifest,
 )
-from ruledrobot.wirecut.job import file_fields, job_document
+from ruledrobot.wirecut.job.load import file_fields, job_document
 
 from .conftest import FAST_JOB, file_job, write_rulings
 

@@ -14,12 +14,12 @@ from typer.testing import CliRunner
 from ruledrobot.batch.engine import WORKER_MALLOC, Engine
 from ruledrobot.batch.place import DistributedEvaluator
 from ruledrobot.cli import app
-from ruledrobot.wirecut.demo import DEMO_JOB
-from ruledrobot.wirecut.job import load_job
-from ruledrobot.wirecut.margins import Rules
-from ruledrobot.wirecut.place import job_passes
-from ruledrobot.wirecut.place_eval import Evaluator
-from ruledrobot.wirecut.placement import AS_CLAMPED, Region, transforms
+from ruledrobot.place.regions import AS_CLAMPED, Region, transforms
+from ruledrobot.place.search import job_passes
+from ruledrobot.wirecut.job.demo import DEMO_JOB
+from ruledrobot.wirecut.job.load import load_job
+from ruledrobot.wirecut.reach.evaluate import Evaluator
+from ruledrobot.wirecut.reach.margins import Rules
 
 from .conftest import deadline
 

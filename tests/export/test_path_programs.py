@@ -24,8 +24,8 @@ from ruledrobot.io.trajectory import write_trajectory
 from ruledrobot.robot import load
 from ruledrobot.robot.trajectory import Heat, Phase, Trajectory
 from ruledrobot.ursim.program import parse_call
-from ruledrobot.wirecut.demo import DEMO_JOB
-from ruledrobot.wirecut.job import load_job
+from ruledrobot.wirecut.job.demo import DEMO_JOB
+from ruledrobot.wirecut.job.load import load_job
 from ruledrobot.wirecut.planner import plan
 from tests.support.emulators import smooth_trajectory, start_emulator
 from tests.support.rawclient import RawRTDEClient

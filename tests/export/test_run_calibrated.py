@@ -16,8 +16,8 @@ from ruledrobot.export.fetch_calibration import fetch_calibration
 from ruledrobot.io.calibration import save_calibration
 from ruledrobot.io.trajectory import read_trajectory, write_trajectory
 from ruledrobot.robot import load, random_calibration
-from ruledrobot.wirecut.demo import DEMO_JOB
-from ruledrobot.wirecut.job import load_job
+from ruledrobot.wirecut.job.demo import DEMO_JOB
+from ruledrobot.wirecut.job.load import load_job
 from ruledrobot.wirecut.planner import plan
 from tests.support.emulators import start_emulator
 

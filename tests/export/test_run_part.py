@@ -18,8 +18,8 @@ import pytest
 from ruledrobot.export import run_trajectory
 from ruledrobot.robot import model_for
 from ruledrobot.robot.tool import BowTool
-from ruledrobot.wirecut.demo import PART_JOB
-from ruledrobot.wirecut.job import load_job
+from ruledrobot.wirecut.job.demo import PART_JOB
+from ruledrobot.wirecut.job.load import load_job
 from ruledrobot.wirecut.planner import plan
 from tests.support.emulators import start_emulator
 

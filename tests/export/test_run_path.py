@@ -21,8 +21,8 @@ from ruledrobot.export.run_program import plan_path_run, run_slice
 from ruledrobot.io.trajectory import write_trajectory
 from ruledrobot.robot.trajectory import Heat, Phase, Trajectory
 from ruledrobot.robot.wire_cut import FeedWindow, WireCut
-from ruledrobot.wirecut.demo import DEMO_JOB
-from ruledrobot.wirecut.job import load_job
+from ruledrobot.wirecut.job.demo import DEMO_JOB
+from ruledrobot.wirecut.job.load import load_job
 from ruledrobot.wirecut.planner import plan
 from tests.support.emulators import smooth_trajectory, start_emulator
 

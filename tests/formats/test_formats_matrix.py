@@ -1,6 +1,6 @@
 """One wing, four formats (issue 22, "Done when"): a tapered panel of two NACA profiles
 with its entry and exit moves — as two airfoil files (the planner adds the moves,
-:mod:`ruledrobot.wirecut.profile_entry`), as XYUV G-code, as a DXF profile pair and as
+:mod:`ruledrobot.wirecut.cut.entry`), as XYUV G-code, as a DXF profile pair and as
 two curves in a 3DM model (the moves drawn in) — plans to the same verdict, run from
 another working folder, and the refined rulings of every plan lie within 0.1 mm of
 every other's on the panel's root and tip faces.

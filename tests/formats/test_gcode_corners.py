@@ -14,8 +14,8 @@ from typer.testing import CliRunner
 
 from ruledrobot.cli import app
 from ruledrobot.io.formats.gcode import GcodeReadOptions, read_gcode
-from ruledrobot.wirecut.job import load_job
-from ruledrobot.wirecut.path import refine_cut
+from ruledrobot.wirecut.cut.passes import refine_cut
+from ruledrobot.wirecut.job.load import load_job
 
 DATA = Path(__file__).parent / "data"
 runner = CliRunner()

@@ -16,8 +16,8 @@ from ruledrobot.cli import app
 from ruledrobot.geometry import se3
 from ruledrobot.io.formats import kind_of
 from ruledrobot.io.formats.gcode import GcodeReadOptions, read_gcode
-from ruledrobot.wirecut.demo import DEMO_JOB
-from ruledrobot.wirecut.job import load_job
+from ruledrobot.wirecut.job.demo import DEMO_JOB
+from ruledrobot.wirecut.job.load import load_job
 
 from .naca import naca4, selig_text
 

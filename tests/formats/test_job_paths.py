@@ -13,7 +13,7 @@ from typer.testing import CliRunner
 from ruledrobot.cli import app
 from ruledrobot.io.calibration import save_calibration
 from ruledrobot.robot import random_calibration
-from ruledrobot.wirecut.job import load_job
+from ruledrobot.wirecut.job.load import load_job
 
 from .naca import naca4, selig_text
 from .test_job_cli import DATA, WEDGE_POSE, job_with

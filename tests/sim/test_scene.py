@@ -29,8 +29,8 @@ def _contacts(m, d, q) -> set[tuple[str, str]]:
 
 
 def test_bow_tool_geometry_matches_the_cut_planner():
-    from ruledrobot.wirecut.job import ToolSpec
-    from ruledrobot.wirecut.redundancy import bow_segments
+    from ruledrobot.wirecut.cut.wire_pose import bow_segments
+    from ruledrobot.wirecut.job.load import ToolSpec
 
     for a, b in (
         ([-0.2, 0.0, 0.25], [0.2, 0.0, 0.25]),
@@ -134,7 +134,7 @@ def test_offscreen_buffer_and_options():
 
 
 def test_scene_from_job():
-    from ruledrobot.wirecut.job import parse_job
+    from ruledrobot.wirecut.job.load import parse_job
 
     job = parse_job(
         {

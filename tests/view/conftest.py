@@ -14,8 +14,8 @@ os.environ.setdefault("MUJOCO_GL", "egl")
 
 import pytest
 
-from ruledrobot.wirecut.demo import DEMO_JOB
-from ruledrobot.wirecut.job import load_job
+from ruledrobot.wirecut.job.demo import DEMO_JOB
+from ruledrobot.wirecut.job.load import load_job
 from ruledrobot.wirecut.planner import plan
 
 FAST_JOB = DEMO_JOB.replace("steps = 4", "steps = 2").replace(

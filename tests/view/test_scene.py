@@ -17,7 +17,7 @@ from ruledrobot.sim._mujoco import mujoco
 from ruledrobot.view import NotAPlanFolder, build_scene, read_plan_folder
 from ruledrobot.view.clearance import contacts_along, near_misses
 from ruledrobot.view.geoms import geom_meshes
-from ruledrobot.wirecut.job import load_job
+from ruledrobot.wirecut.job.load import load_job
 
 
 def _model(folder):

@@ -9,7 +9,7 @@ from ruledrobot.io.trajectory import read_trajectory
 from ruledrobot.sim import Renderer, RenderUnavailable, Scene
 from ruledrobot.sim.annotate import CutAnnotator
 from ruledrobot.sim.render import frame_times
-from ruledrobot.wirecut.job import load_job
+from ruledrobot.wirecut.job.load import load_job
 
 
 def test_annotated_frames_show_the_cut_growing(plan_folder, tmp_path):

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from ruledrobot.wirecut.demo import DEMO_JOB
+from ruledrobot.wirecut.job.demo import DEMO_JOB
 
 
 def demo_at(x: float, steps: int = 3, robot: str = "ur5e") -> str:

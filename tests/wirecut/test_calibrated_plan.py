@@ -7,8 +7,8 @@ import pytest
 
 from ruledrobot.io.calibration import save_calibration
 from ruledrobot.robot import load, model_for, random_calibration
-from ruledrobot.wirecut.demo import DEMO_JOB
-from ruledrobot.wirecut.job import load_job
+from ruledrobot.wirecut.job.demo import DEMO_JOB
+from ruledrobot.wirecut.job.load import load_job
 from ruledrobot.wirecut.planner import plan
 
 

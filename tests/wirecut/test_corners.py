@@ -9,8 +9,8 @@ from hypothesis import strategies as st
 from ruledrobot.algorithms import refine
 from ruledrobot.geometry.lines import Lines
 from ruledrobot.geometry.ruled import RuledSurface
-from ruledrobot.wirecut.corners import corner_nodes, corner_stop_mask, polygon_corners
-from ruledrobot.wirecut.toolpath import anchored_frames
+from ruledrobot.wirecut.cut.wire_geometry import anchored_frames
+from ruledrobot.wirecut.motion.corners import corner_nodes, corner_stop_mask, polygon_corners
 
 
 def _frames(o: np.ndarray, z: np.ndarray) -> np.ndarray:

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from ruledrobot.wirecut.job import load_job
+from ruledrobot.wirecut.job.load import load_job
 
 EXAMPLE = """
 [surface]

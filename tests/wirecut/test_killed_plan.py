@@ -19,7 +19,7 @@ import numpy as np
 
 from ruledrobot.io.outdir import read_manifest
 from ruledrobot.io.trajectory import read_trajectory
-from ruledrobot.wirecut.demo import DEMO_JOB
+from ruledrobot.wirecut.job.demo import DEMO_JOB
 
 TRIALS = 10
 

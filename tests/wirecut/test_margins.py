@@ -11,18 +11,18 @@ import pytest
 
 from ruledrobot.geometry.box import Box
 from ruledrobot.robot import load
-from ruledrobot.wirecut.branch_bound import best_of
-from ruledrobot.wirecut.clearance import Cell, clearance
-from ruledrobot.wirecut.margins import (
+from ruledrobot.wirecut.cut.clearance import Cell, clearance
+from ruledrobot.wirecut.cut.wire_pose import solve_redundancy
+from ruledrobot.wirecut.job.spec import ToolSpec
+from ruledrobot.wirecut.reach.branch_bound import best_of
+from ruledrobot.wirecut.reach.grid import RowBoxes, directions_needed
+from ruledrobot.wirecut.reach.margins import (
     DEFAULT_RULES,
     GATES,
     clearance_margins,
     joint_limit_margin,
     limit_levers,
 )
-from ruledrobot.wirecut.reach_grid import RowBoxes, directions_needed
-from ruledrobot.wirecut.redundancy import solve_redundancy
-from ruledrobot.wirecut.spec import ToolSpec
 
 TOOL = ToolSpec(np.array([-0.2, 0.0, 0.25]), np.array([0.2, 0.0, 0.25]))
 

@@ -14,8 +14,8 @@ from hypothesis import strategies as st
 
 from ruledrobot.geometry.box import Box
 from ruledrobot.robot.wire_cut import feed_measures
-from ruledrobot.wirecut.demo import DEMO_JOB
-from ruledrobot.wirecut.job import job_document, parse_job
+from ruledrobot.wirecut.job.demo import DEMO_JOB
+from ruledrobot.wirecut.job.load import job_document, parse_job
 from ruledrobot.wirecut.plan import make_plan
 
 SURFACE = DEMO_JOB[DEMO_JOB.index("[surface]") : DEMO_JOB.index("[stock]")]

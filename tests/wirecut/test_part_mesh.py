@@ -19,10 +19,10 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
 from ruledrobot.io.mesh import write_stl
-from ruledrobot.wirecut.demo import PART_JOB
-from ruledrobot.wirecut.job import load_job
-from ruledrobot.wirecut.part import part_mesh
-from ruledrobot.wirecut.path import cut_paths
+from ruledrobot.wirecut.cut.passes import cut_paths
+from ruledrobot.wirecut.job.demo import PART_JOB
+from ruledrobot.wirecut.job.load import load_job
+from ruledrobot.wirecut.report.part_mesh import part_mesh
 
 #: a part of our own: a block with a saddle top and a column cut all the way round it
 COLUMN_JOB = """\
@@ -81,7 +81,7 @@ def _column_litres(a: float, c: float = 0.25, step: float = 0.0005) -> float:
 
 
 def _two_passes(cp):
-    """The one pass round a loop as :mod:`ruledrobot.wirecut.closed` splits a loop no
+    """The one pass round a loop as :mod:`ruledrobot.wirecut.cut.closed` splits a loop no
     single pass can cut: two passes from the slit ruling, each out to the ruling
     opposite and back along its own kerf (the wide column of the issue was cut so)."""
     S = cp.target_frames

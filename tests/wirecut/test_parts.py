@@ -14,10 +14,10 @@ from ruledrobot.cli import app
 from ruledrobot.geometry.surfaces import hyperbolic_paraboloid_residual
 from ruledrobot.io.mesh import read_stl
 from ruledrobot.robot.tool import BowTool
-from ruledrobot.wirecut.demo import DEMO_JOB, PART_JOB
-from ruledrobot.wirecut.job import load_job, parse_job
-from ruledrobot.wirecut.part import signed_volume
+from ruledrobot.wirecut.job.demo import DEMO_JOB, PART_JOB
+from ruledrobot.wirecut.job.load import load_job, parse_job
 from ruledrobot.wirecut.planner import plan
+from ruledrobot.wirecut.report.part_mesh import signed_volume
 
 runner = CliRunner()
 
@@ -152,7 +152,7 @@ def test_a_cut_through_a_freed_part_is_refused_naming_both_cuts(tmp_path):
     doc = __import__("tomllib").loads(PART_JOB)
     doc["cut"] = [doc["cut"][2], doc["cut"][0], doc["cut"][1]]  # plug first
     with pytest.raises(ValueError, match=r"cut 'top' comes after cut 'plug'.*list 'top' before"):
-        from ruledrobot.wirecut.order import check_cut_order
+        from ruledrobot.wirecut.cut.order import check_cut_order
 
         check_cut_order(parse_job(doc, "order.toml"))
 
@@ -160,7 +160,7 @@ def test_a_cut_through_a_freed_part_is_refused_naming_both_cuts(tmp_path):
 def test_a_hole_is_refused(tmp_path):
     doc = __import__("tomllib").loads(PART_JOB)
     doc["cut"][2]["keep"] = "outside"
-    from ruledrobot.wirecut.order import check_cut_order
+    from ruledrobot.wirecut.cut.order import check_cut_order
 
     with pytest.raises(ValueError, match=r"cut 'plug': keep = \"outside\" \(a hole\)"):
         check_cut_order(parse_job(doc, "hole.toml"))

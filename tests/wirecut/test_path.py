@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 
 from ruledrobot.geometry.box import Box
-from ruledrobot.wirecut.job import load_job
-from ruledrobot.wirecut.path import chord_ends_in_flange, cut_path, refine_for_job
-from ruledrobot.wirecut.toolpath import chords
+from ruledrobot.wirecut.cut.passes import chord_ends_in_flange, cut_path, refine_for_job
+from ruledrobot.wirecut.cut.wire_geometry import chords
+from ruledrobot.wirecut.job.load import load_job
 
 from .test_job import EXAMPLE
 

@@ -11,9 +11,9 @@ from typer.testing import CliRunner
 from ruledrobot.cli import app
 from ruledrobot.geometry import se3
 from ruledrobot.io.trajectory import read_trajectory
-from ruledrobot.wirecut.job import load_job
-from ruledrobot.wirecut.jobfile import write_job_file
-from ruledrobot.wirecut.placement import Placement, moved_job
+from ruledrobot.place.job_file import write_job_file
+from ruledrobot.place.regions import Placement, moved_job
+from ruledrobot.wirecut.job.load import load_job
 from ruledrobot.wirecut.planner import plan
 
 from .reach_jobs import LONG_JOB, demo_at
@@ -169,7 +169,7 @@ def test_job_files_keep_comments_rebase_paths_and_drop_cuts(tmp_path):
 
 
 def test_region_edges_name_the_option_to_widen():
-    from ruledrobot.wirecut.placement import Region
+    from ruledrobot.place.regions import Region
 
     r = Region((0.5, 1.0), (-0.2, 0.2), (-1.0, 1.0))
     assert r.edges(np.array([0.7, 0.0, 0.0])) == ""

@@ -12,8 +12,8 @@ from ruledrobot.cli import app
 from ruledrobot.geometry.surfaces import hyperbolic_paraboloid_residual
 from ruledrobot.io.trajectory import read_trajectory
 from ruledrobot.robot import load
-from ruledrobot.wirecut.demo import DEMO_JOB
-from ruledrobot.wirecut.job import load_job
+from ruledrobot.wirecut.job.demo import DEMO_JOB
+from ruledrobot.wirecut.job.load import load_job
 from ruledrobot.wirecut.planner import plan
 
 runner = CliRunner()
@@ -66,7 +66,7 @@ def test_trajectory_respects_limits_and_period(demo):
     assert (np.abs(qdd) / model.max_acceleration).max() <= 1.01  # CSV rounding: 10 digits
     assert model.within_limits(traj.q).all()
     # the TCP columns are the forward kinematics of the joint columns (wire frame)
-    from ruledrobot.wirecut.toolpath import wire_frame
+    from ruledrobot.wirecut.cut.wire_geometry import wire_frame
 
     np.testing.assert_allclose(model.fk(traj.q) @ wire_frame(job.tool), traj.tcp_poses(), atol=1e-7)
     np.testing.assert_allclose(traj.meta.tcp_offset, wire_frame(job.tool), atol=1e-12)

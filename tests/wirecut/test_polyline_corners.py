@@ -16,9 +16,9 @@ import pytest
 
 from ruledrobot.io.formats.convert import convert
 from ruledrobot.robot.wire_cut import feed_measures
-from ruledrobot.wirecut.corners import corner_nodes
-from ruledrobot.wirecut.job import load_job
-from ruledrobot.wirecut.path import refine_cut
+from ruledrobot.wirecut.cut.passes import refine_cut
+from ruledrobot.wirecut.job.load import load_job
+from ruledrobot.wirecut.motion.corners import corner_nodes
 from ruledrobot.wirecut.plan import make_plan
 
 DATA = Path(__file__).parents[1] / "formats" / "data"

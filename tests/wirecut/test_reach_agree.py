@@ -26,16 +26,16 @@ import pytest
 from typer.testing import CliRunner
 
 from ruledrobot.cli import app
-from ruledrobot.wirecut.job import load_job
-from ruledrobot.wirecut.place import job_passes
-from ruledrobot.wirecut.place_eval import Evaluator
-from ruledrobot.wirecut.place_run import run_place
-from ruledrobot.wirecut.placement import Region
+from ruledrobot.place.regions import Region
+from ruledrobot.place.run import run_place
+from ruledrobot.place.search import job_passes
+from ruledrobot.wirecut.cut.wire_pose import solve_redundancy
+from ruledrobot.wirecut.job.load import load_job
 from ruledrobot.wirecut.plan import make_plan
-from ruledrobot.wirecut.reach import reach_map
-from ruledrobot.wirecut.reach_explain import reach_reasons
-from ruledrobot.wirecut.reach_report import summary_lines
-from ruledrobot.wirecut.redundancy import solve_redundancy
+from ruledrobot.wirecut.reach.evaluate import Evaluator
+from ruledrobot.wirecut.reach.explain import reach_reasons
+from ruledrobot.wirecut.reach.map import reach_map
+from ruledrobot.wirecut.reach.report import summary_lines
 
 from .reach_jobs import demo_at
 
@@ -110,7 +110,7 @@ def _ur3e(tmp_path: Path, x: float) -> Path:
 def test_the_constant_roll_grid_is_the_planners():
     import inspect
 
-    from ruledrobot.wirecut.reach_grid import ROLLS
+    from ruledrobot.wirecut.reach.grid import ROLLS
 
     assert inspect.signature(solve_redundancy).parameters["rolls"].default == ROLLS
 

@@ -10,12 +10,12 @@ import pytest
 from typer.testing import CliRunner
 
 from ruledrobot.cli import app
-from ruledrobot.wirecut.clearance import clearance
-from ruledrobot.wirecut.job import load_job
-from ruledrobot.wirecut.margins import DEFAULT_RULES, Reason
-from ruledrobot.wirecut.path import cut_paths
-from ruledrobot.wirecut.reach import job_cell, reach_map
-from ruledrobot.wirecut.toolpath import flange_poses, wire_poses
+from ruledrobot.wirecut.cut.clearance import clearance
+from ruledrobot.wirecut.cut.passes import cut_paths
+from ruledrobot.wirecut.cut.wire_geometry import flange_poses, wire_poses
+from ruledrobot.wirecut.job.load import load_job
+from ruledrobot.wirecut.reach.map import job_cell, reach_map
+from ruledrobot.wirecut.reach.margins import DEFAULT_RULES, Reason
 
 from .reach_jobs import demo_at
 

@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 
 import ruledrobot as rr
-from ruledrobot.wirecut import redundancy as red
-from ruledrobot.wirecut.clearance import Cell
-from ruledrobot.wirecut.job import load_job
+from ruledrobot.wirecut.cut import wire_pose as red
+from ruledrobot.wirecut.cut.clearance import Cell
+from ruledrobot.wirecut.job.load import load_job
 
 from .test_job import EXAMPLE
 

@@ -11,10 +11,10 @@ import numpy as np
 import pytest
 
 from ruledrobot.geometry import se3
-from ruledrobot.wirecut.demo import DEMO_JOB
-from ruledrobot.wirecut.job import load_job
-from ruledrobot.wirecut.outcome import plan_outcome
+from ruledrobot.wirecut.job.demo import DEMO_JOB
+from ruledrobot.wirecut.job.load import load_job
 from ruledrobot.wirecut.plan import make_plan
+from ruledrobot.wirecut.report.outcome import plan_outcome
 from ruledrobot.wirecut.verify import verify_plan
 
 BASE = [0.3, 0.2, 0.1, 0.0, 0.0, 0.7]  # UR pose vector: metres, rotation vector

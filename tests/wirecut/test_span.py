@@ -14,10 +14,10 @@ from typer.testing import CliRunner
 
 import ruledrobot as rr
 from ruledrobot.cli import app
-from ruledrobot.wirecut.demo import DEMO_JOB, PART_JOB
-from ruledrobot.wirecut.job import load_job
-from ruledrobot.wirecut.path import cut_paths, refine_for_job
-from ruledrobot.wirecut.toolpath import chords
+from ruledrobot.wirecut.cut.passes import cut_paths, refine_for_job
+from ruledrobot.wirecut.cut.wire_geometry import chords
+from ruledrobot.wirecut.job.demo import DEMO_JOB, PART_JOB
+from ruledrobot.wirecut.job.load import load_job
 
 #: the demo's hyperbolic paraboloid stops in the middle of the block (x = 0.5 of 0.4..0.6)
 SHORT = "u = [-0.12, 0.0]"

@@ -18,8 +18,8 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from ruledrobot.wirecut import timing
-from ruledrobot.wirecut.timing import (
+from ruledrobot.wirecut.motion import timing
+from ruledrobot.wirecut.motion.timing import (
     FEED_TOL,
     RATIO_TOL,
     TimedPath,

@@ -8,8 +8,8 @@ from hypothesis import strategies as st
 
 from ruledrobot.geometry import se3
 from ruledrobot.geometry.box import Box
-from ruledrobot.wirecut import toolpath as tp
-from ruledrobot.wirecut.job import ToolSpec
+from ruledrobot.wirecut.cut import wire_geometry as tp
+from ruledrobot.wirecut.job.load import ToolSpec
 
 TOOL = ToolSpec(np.array([-0.2, 0.05, 0.25]), np.array([0.2, 0.05, 0.25]), clearance=0.03)
 

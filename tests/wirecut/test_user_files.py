@@ -14,7 +14,7 @@ from ruledrobot.cli import app
 from ruledrobot.export import recording_path_for
 from ruledrobot.io.outdir import read_manifest
 from ruledrobot.io.trajectory import read_trajectory, sidecar_path, write_trajectory
-from ruledrobot.wirecut.demo import DEMO_JOB
+from ruledrobot.wirecut.job.demo import DEMO_JOB
 
 runner = CliRunner()
 

@@ -16,9 +16,9 @@ from ruledrobot.cli import app
 from ruledrobot.geometry.lines import Lines
 from ruledrobot.io.lines import save_lines
 from ruledrobot.io.outdir import read_manifest
-from ruledrobot.wirecut.demo import DEMO_JOB
-from ruledrobot.wirecut.job import load_job
-from ruledrobot.wirecut.path import refine_for_job
+from ruledrobot.wirecut.cut.passes import refine_for_job
+from ruledrobot.wirecut.job.demo import DEMO_JOB
+from ruledrobot.wirecut.job.load import load_job
 
 runner = CliRunner()
 

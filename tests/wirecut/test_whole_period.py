@@ -7,9 +7,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from ruledrobot.wirecut.demo import PART_JOB
-from ruledrobot.wirecut.job import load_job
-from ruledrobot.wirecut.path import cut_paths
+from ruledrobot.wirecut.cut.passes import cut_paths
+from ruledrobot.wirecut.job.demo import PART_JOB
+from ruledrobot.wirecut.job.load import load_job
 
 PLUG = '''builtin = "hyperboloid"
 params = { a = 0.06, c = 0.3 }

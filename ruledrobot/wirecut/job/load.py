@@ -1,0 +1,264 @@
+"""Cut job files (TOML): what to cut, from what, with which robot and tool.
+
+A job holds one stock, one robot, one tool and one or more cuts.  A single cut
+is written as ``[surface]`` and ``[cut]`` tables (in the robot base frame;
+metres, radians, seconds)::
+
+    [surface]                  # the ruled surface to cut
+    builtin = "hyperbolic_paraboloid"   # or: file = "rulings.json" (lines file), or a file of
+                               # the field: gcode = "wing.ngc", airfoil, dxf, rhino -- a path, or
+                               # a table of the reader's options with the path under file
+                               # (airfoil: root, tip): [surface.gcode] file = "wing.ngc"
+                               # tower_distance = 0.8 (docs/formats.md)
+    params = { c = 0.4 }       # parameters of the built-in surface
+    u = [-0.12, 0.12]          # its parameter range
+    rulings = 9                # input rulings sampled over u
+    pose = [0.5, 0.0, 0.3, 0.0, 0.0, 0.0]   # surface frame in the base frame (UR pose vector)
+    algorithm = "dh"           # projection | combined | dh (G-code: projection by default)
+    scheme = "four_point"      # linear | chaikin | bspline3 | four_point | six_point | ...
+    steps = 4                  # or: spacing = 0.002 (m, largest gap between refined rulings)
+    # closed = true            # a closed sequence of rulings (a column, a band)
+
+    [stock]                    # the block, a box
+    centre = [0.5, 0.0, 0.3]
+    size = [0.2, 0.2, 0.15]
+    rotvec = [0.0, 0.0, 0.0]
+
+    [robot]
+    model = "ur5e"
+    base = [0.0, 0.0, 0.0, 0.0, 0.0, 0.0]   # the cell in the simulation's world; plans ignore it
+    speed_scale = 1.0          # fraction of the catalogue joint speed limits
+    acceleration = 1.4         # rad/s^2, one value or six
+    # home = [3.14, -1.57, 1.57, -1.57, -1.57, 0.0]   # optional (rad): start and end here
+    # calibration = "robot.calib.json"   # the robot's own kinematics (ruledrobot calibration fetch)
+
+    [tool]                     # the hot-wire bow, in the flange frame
+    wire_start = [-0.2, 0.0, 0.25]
+    wire_end = [0.2, 0.0, 0.25]
+    clearance = 0.02           # wire kept this far beyond the stock at each end
+    mass = 1.0
+    # heat = { output = "standard:0", preheat = 2.0 }   # switch the wire's heat (robot IO)
+
+    [cut]
+    feed_speed = 0.01          # m/s, wire speed inside the stock
+    lead_in = 0.02             # m before the first chord
+    lead_out = 0.02
+    approach_speed = 0.3       # fraction of joint speed limits for approach/retract/transit
+    kerf = 0.0008              # m, the width of the slot the wire melts
+    # keep = [0.5, 0.0, 0.2]   # a point of the part (or "inside"/"outside" for a closed
+    #                          # surface): the wire runs kerf/2 off the surface, in the waste
+    wire_tolerance = 0.0005    # m, largest wire deviation from the rulings (a check)
+    feed_tolerance = 0.05      # fraction: feed inside the stock within +-5 % (a check)
+    # extend = true            # an open surface that stops short of the block is cut on
+    #                          # through it along its extrapolation (noted); default: refused
+
+A part with several cuts lists them in order as ``[[cut]]`` tables, each with a
+``name`` and its own ``[cut.surface]`` table (the fields of ``[surface]``), and
+the ``[cut]`` fields above; there is then no top-level ``[surface]``::
+
+    [[cut]]
+    name = "top"
+    keep = [0.5, 0.0, 0.2]
+    [cut.surface]
+    builtin = "hyperbolic_paraboloid"
+    ...
+
+:func:`load_job` validates every field and raises ValueError naming the file,
+the section and the field.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from ...io.text import read_user_text
+from .sections import (
+    FOREIGN_KINDS,
+    Section,
+    parse_heat,
+    parse_robot,
+    parse_stock,
+    parse_surface,
+)
+from .spec import CutSpec, HeatSpec, Job, RobotSpec, SurfaceSpec, ToolSpec
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover
+    import tomli as tomllib
+
+__all__ = [
+    "CutSpec",
+    "HeatSpec",
+    "Job",
+    "RobotSpec",
+    "SurfaceSpec",
+    "ToolSpec",
+    "file_fields",
+    "job_document",
+    "load_job",
+    "parse_job",
+]
+
+
+def _tool(t: Section) -> ToolSpec:
+    w0, w1 = t.vector("wire_start", 3), t.vector("wire_end", 3)
+    length = float(np.linalg.norm(w1 - w0))
+    if length < 1e-3:
+        raise t.fail("wire_end", f"wire must be at least 1 mm long, got {length * 1e3:.3g} mm")
+    heat = None
+    if t.get("heat") is not None:
+        heat = parse_heat(Section(t.raw, "heat", t.where, title=f"{t.title}.heat"))
+    tool = ToolSpec(w0, w1, clearance=t.number("clearance", 0.02, lo=0.0),
+                    mass=t.number("mass", 1.0, lo=0.0), heat=heat)  # fmt: skip
+    if 2 * tool.clearance >= length:
+        raise t.fail(
+            "clearance",
+            f"2 x clearance ({2 * tool.clearance:g} m) must be shorter "
+            f"than the wire ({length:g} m)",
+        )
+    t.done()
+    return tool
+
+
+def _keep(c: Section, closed: bool | None) -> str | np.ndarray | None:
+    value = c.get("keep")
+    if value is None:
+        return None
+    if isinstance(value, str):
+        if value not in ("inside", "outside"):
+            raise c.fail("keep",
+                         f'expected "inside", "outside" or a point [x, y, z], got {value!r}')
+        if closed is False:
+            raise c.fail("keep", f'"{value}" needs a closed surface; give a point [x, y, z] of '
+                         "the part instead")  # fmt: skip
+        return value
+    return c.vector("keep", 3)
+
+
+def _cut(c: Section, name: str, surface: SurfaceSpec, surface_title: str = "surface") -> CutSpec:
+    closed = surface.closed
+    if closed is None:  # the rulings decide: a closed file, a periodic built-in surface
+        try:
+            closed = bool(surface.document().closed)
+        except (OSError, ValueError) as exc:  # the surface's table and field, then the file's
+            field_ = "file" if surface.kind in (None, "lines") and surface.file else "builtin"
+            raise ValueError(f"{c.where}: [{surface_title}] {field_}: {exc}") from None
+    cut = CutSpec(
+        name=name,
+        surface=surface,
+        feed_speed=c.number("feed_speed", 0.01, lo=0.0, hi=1.0, strict_lo=True),
+        lead_in=c.number("lead_in", 0.02, lo=0.0),
+        lead_out=c.number("lead_out", 0.02, lo=0.0),
+        approach_speed=c.number("approach_speed", 0.3, lo=0.0, hi=1.0, strict_lo=True),
+        kerf=c.number("kerf", 0.0008, lo=0.0),
+        keep=_keep(c, closed),
+        wire_tolerance=c.number("wire_tolerance", 0.0005, lo=0.0, strict_lo=True),
+        feed_tolerance=c.number("feed_tolerance", 0.05, lo=0.0, hi=1.0, strict_lo=True),
+        extend=c.flag("extend", False),
+    )
+    if cut.extend and closed:
+        raise c.fail("extend", "only for an open surface (a closed one is entered through a "
+                     "slit, never extended)")  # fmt: skip
+    c.done()
+    return cut
+
+
+def _cuts(doc: dict, where: str, base_dir: Path | None) -> tuple[CutSpec, ...]:
+    raw = doc.get("cut")
+    if isinstance(raw, list):  # [[cut]]: a part with several cuts
+        if "surface" in doc:
+            raise ValueError(f"{where}: [surface] with [[cut]] tables: give each cut its own "
+                             "[cut.surface] table and no top-level [surface]")  # fmt: skip
+        if not raw:
+            raise ValueError(f"{where}: [[cut]] is empty; expected at least one cut")
+        cuts: list[CutSpec] = []
+        for i, entry in enumerate(raw):
+            if not isinstance(entry, dict):
+                raise ValueError(f"{where}: [[cut]] entry {i + 1} must be a table")
+            name = entry.get("name", f"cut{i + 1}")
+            if not isinstance(name, str) or not name.strip():
+                raise ValueError(f"{where}: [[cut]] entry {i + 1}: name: expected a non-empty "
+                                 f"string, got {name!r}")  # fmt: skip
+            if name in [c.name for c in cuts]:
+                raise ValueError(f"{where}: [[cut]] entry {i + 1}: name {name!r} is used by an "
+                                 "earlier cut; names must be unique")  # fmt: skip
+            title = f"cut '{name}'"
+            c = Section.of(entry, title, where)
+            c.get("name")
+            surface = parse_surface(Section(entry, "surface", where, title=f"{title}.surface"),
+                                    base_dir)  # fmt: skip
+            c.get("surface")
+            cuts.append(_cut(c, name, surface, f"{title}.surface"))
+        return tuple(cuts)
+    surface = parse_surface(Section(doc, "surface", where), base_dir)
+    c = Section(doc, "cut", where, required=False)
+    return (_cut(c, "cut", surface),)
+
+
+def parse_job(doc: dict, where: str = "job", base_dir: Path | None = None) -> Job:
+    """Validate a job given as a TOML-like dict (see the module doc)."""
+    known = {"surface", "stock", "robot", "tool", "cut"}
+    extra = sorted(set(doc) - known)
+    if extra:
+        raise ValueError(
+            f"{where}: unknown section(s) {', '.join(extra)}; expected {sorted(known)}"
+        )
+    cuts = _cuts(doc, where, base_dir)
+    stock = parse_stock(Section(doc, "stock", where))
+    robot = parse_robot(Section(doc, "robot", where), base_dir)
+    tool = _tool(Section(doc, "tool", where))
+    return Job(cuts, stock, robot, tool)
+
+
+def job_document(text: str, where: str) -> dict:
+    """The TOML document of a job file's text; ValueError naming ``where`` when it is not
+    valid TOML (the fields are checked by :func:`parse_job`)."""
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ValueError(f"{where}: not valid TOML ({exc})") from None
+
+
+#: the fields of a ``[surface]`` table that name a file: ``kind -> keys`` of its option
+#: table (a plain string is the first key's path)
+_SURFACE_FILES = {"file": ()} | {k: ("root", "tip") if k == "airfoil" else ("file",)
+                                 for k in FOREIGN_KINDS}  # fmt: skip
+
+
+def file_fields(doc: dict) -> list[tuple[tuple[str | int, ...], str]]:
+    """Every field of a job document that names an input file, as ``(location, path)``:
+    ``location`` the keys from the document's root (``("cut", 0, "surface", "file")``),
+    ``path`` as written (relative paths are taken from the job file's folder).  Fields
+    of the wrong type are left out (:func:`parse_job` reports them)."""
+    found: list[tuple[tuple[str | int, ...], str]] = []
+    surfaces: list[tuple[tuple[str | int, ...], object]] = [(("surface",), doc.get("surface"))]
+    if isinstance(doc.get("cut"), list):
+        surfaces += [(("cut", i, "surface"), c.get("surface"))
+                     for i, c in enumerate(doc["cut"]) if isinstance(c, dict)]  # fmt: skip
+    for where, table in surfaces:
+        if not isinstance(table, dict):
+            continue
+        for kind, keys in _SURFACE_FILES.items():
+            value = table.get(kind)
+            if isinstance(value, str):
+                found.append(((*where, kind), value))
+            elif isinstance(value, dict):
+                found += [((*where, kind, k), value[k]) for k in keys
+                          if isinstance(value.get(k), str)]  # fmt: skip
+    robot = doc.get("robot")
+    if isinstance(robot, dict) and isinstance(robot.get("calibration"), str):
+        found.append((("robot", "calibration"), robot["calibration"]))
+    return found
+
+
+def load_job(path: str | os.PathLike[str]) -> Job:
+    """Read and validate a TOML job file; ValueError names the file, section and field."""
+    p, text = read_user_text(path, "job file")
+    doc = job_document(text, str(p))
+    job = parse_job(doc, str(p), base_dir=p.parent)
+    return Job(job.cuts, job.stock, job.robot, job.tool, source=p)

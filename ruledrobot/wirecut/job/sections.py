@@ -1,0 +1,312 @@
+"""Parsing the tables of a job file: typed fields, errors naming file, section and field.
+
+Each ``parse_*`` function reads one table (a TOML dict) into a value type of
+:mod:`.job`.  Every error is a ``ValueError`` whose message starts with the file
+and the section, then the field and what was expected, e.g.
+``job.toml: [cut 'top'] feed_speed: expected a number > 0, got -1``.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ...geometry import se3
+from ...geometry.box import Box
+from ...io.paths import input_path, missing_file
+from ...robot.calibration import Calibration
+from ...subdivision.schemes import SCHEME_NAMES
+from .spec import HeatSpec, RobotSpec, SurfaceSpec
+
+__all__ = ["Section", "parse_heat", "parse_robot", "parse_stock", "parse_surface"]
+
+ALGORITHMS = ("projection", "combined", "dh")
+#: the files of the field a surface can be read from (:mod:`ruledrobot.io.formats`)
+FOREIGN_KINDS = ("gcode", "airfoil", "dxf", "rhino")
+#: where the wire's heat is switched: UR standard, configurable and tool digital outputs,
+#: and the standard analog outputs (a current or voltage set as a fraction of the range)
+HEAT_OUTPUTS = {"standard": 8, "configurable": 8, "tool": 2, "analog": 2}
+
+
+class Section:
+    """Typed access to one TOML table with errors naming file, section and field."""
+
+    def __init__(
+        self, doc: dict, name: str, where: str, required: bool = True, title: str | None = None
+    ) -> None:
+        self.where = where
+        self.name = name
+        self.title = title or name
+        raw = doc.get(name) if isinstance(doc, dict) else None
+        if raw is None:
+            if required:
+                raise ValueError(f"{where}: missing section [{self.title}]")
+            raw = {}
+        if not isinstance(raw, dict):
+            raise ValueError(f"{where}: [{self.title}] must be a table")
+        self.raw = raw
+        self.used: set[str] = set()
+
+    @classmethod
+    def of(cls, raw: dict, title: str, where: str) -> Section:
+        """A section over an already extracted table (``[[cut]]`` entries)."""
+        return cls({"_": raw}, "_", where, title=title)
+
+    def fail(self, key: str, msg: str) -> ValueError:
+        return ValueError(f"{self.where}: [{self.title}] {key}: {msg}")
+
+    def get(self, key: str, default: Any = None) -> Any:
+        self.used.add(key)
+        return self.raw.get(key, default)
+
+    def number(
+        self,
+        key: str,
+        default: float | None = None,
+        lo: float | None = None,
+        hi: float | None = None,
+        strict_lo: bool = False,
+    ) -> float:
+        v = self.get(key, default)
+        if v is None:
+            raise self.fail(key, "missing; expected a number")
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or not np.isfinite(v):
+            raise self.fail(key, f"expected a finite number, got {v!r}")
+        if lo is not None and (v < lo or (strict_lo and v == lo)):
+            rel = ">" if strict_lo else ">="
+            raise self.fail(key, f"expected a number {rel} {lo:g}, got {v!r}")
+        if hi is not None and v > hi:
+            raise self.fail(key, f"expected a number <= {hi:g}, got {v!r}")
+        return float(v)
+
+    def vector(self, key: str, n: int, default: Any = None) -> np.ndarray:
+        v = self.get(key, default)
+        if v is None:
+            raise self.fail(key, f"missing; expected a list of {n} numbers")
+        if (
+            not isinstance(v, list)
+            or len(v) != n
+            or any(isinstance(x, bool) or not isinstance(x, (int, float)) for x in v)
+        ):
+            raise self.fail(key, f"expected a list of {n} numbers, got {v!r}")
+        arr = np.asarray(v, dtype=np.float64)
+        if not np.all(np.isfinite(arr)):
+            raise self.fail(key, "contains NaN or infinity")
+        return arr
+
+    def choice(self, key: str, options: tuple[str, ...], default: str) -> str:
+        v = self.get(key, default)
+        if v not in options:
+            raise self.fail(key, f"expected one of {', '.join(options)}, got {v!r}")
+        return str(v)
+
+    def flag(self, key: str, default: bool) -> bool:
+        """``key`` as true or false (``default`` when absent)."""
+        v = self.get(key, default)
+        if not isinstance(v, bool):
+            raise self.fail(key, f"expected true or false, got {v!r}")
+        return v
+
+    def done(self) -> None:
+        extra = sorted(set(self.raw) - self.used)
+        if extra:
+            raise ValueError(
+                f"{self.where}: [{self.title}] unknown field(s) {', '.join(extra)}; "
+                f"expected some of {', '.join(sorted(self.used))}"
+            )
+
+
+def pose(sec: Section, key: str) -> np.ndarray:
+    """A UR pose vector field ``[x, y, z, rx, ry, rz]`` as a 4x4 pose (identity if absent)."""
+    return se3.pose_from_ur_vector(sec.vector(key, 6, [0.0] * 6))
+
+
+def parse_surface(s: Section, base_dir: Path | None) -> SurfaceSpec:
+    """``[surface]`` (or a cut's ``surface`` table) -> :class:`.spec.SurfaceSpec`."""
+    builtin, file = s.get("builtin"), s.get("file")
+    foreign = [k for k in FOREIGN_KINDS if s.get(k) is not None]
+    if (builtin is not None) + (file is not None) + len(foreign) != 1:
+        raise s.fail("builtin/file/gcode/airfoil/dxf/rhino",
+                     'give exactly one of builtin = "name", file = "path" (a lines file), or '
+                     'gcode/airfoil/dxf/rhino = "path" (or a table of options; '
+                     "docs/formats.md)")  # fmt: skip
+    read = None
+    if foreign:
+        from ...io.formats import parse_read_spec, read_rulings
+
+        kind = foreign[0]
+        spec = parse_read_spec(kind, s.get(kind), f"{s.where}: [{s.title}.{kind}]", base_dir)
+        try:
+            read = read_rulings(spec)
+        except ValueError as exc:
+            raise s.fail(kind, str(exc)) from None
+        file = str(spec.path)
+    params = s.get("params", {})
+    if not isinstance(params, dict):
+        raise s.fail("params", f"expected a table of parameters, got {params!r}")
+    u = None
+    path = None
+    if builtin is not None:
+        from ...geometry.surfaces import SURFACES
+
+        if builtin not in SURFACES:
+            raise s.fail(
+                "builtin",
+                f"unknown surface {builtin!r}; expected one of {', '.join(sorted(SURFACES))}",
+            )
+        try:
+            SURFACES[builtin].params(**params)
+        except ValueError as exc:
+            raise s.fail("params", str(exc)) from None
+        if s.get("u") is not None:
+            uu = s.vector("u", 2)
+            if not uu[1] > uu[0]:
+                raise s.fail("u", f"expected [start, stop] with stop > start, got {uu.tolist()}")
+            u = (float(uu[0]), float(uu[1]))
+    else:
+        if not isinstance(file, str):
+            raise s.fail("file", f"expected a path string, got {file!r}")
+        if foreign:  # resolved and checked by the format's options (parse_read_spec)
+            path = Path(file)
+        else:
+            path = input_path(file, base_dir)
+            missing = missing_file(path, "lines")
+            if missing:
+                raise s.fail("file", missing)
+        if "u" in s.raw:
+            raise s.fail("u", "only for a builtin surface")
+        if params:
+            raise s.fail("params", "only for a builtin surface")
+    rulings = s.get("rulings", 9)
+    if isinstance(rulings, bool) or not isinstance(rulings, int) or not 4 <= rulings <= 10_000:
+        raise s.fail("rulings", f"expected an integer 4 <= rulings <= 10000, got {rulings!r}")
+    steps = s.get("steps")
+    spacing = s.get("spacing")
+    if steps is not None and spacing is not None:
+        raise s.fail("steps/spacing", "give steps or spacing, not both")
+    if spacing is not None:
+        spacing = s.number("spacing", lo=0.0, strict_lo=True)
+    elif steps is None:
+        steps = 4
+    if steps is not None and (
+        isinstance(steps, bool) or not isinstance(steps, int) or not 0 <= steps <= 12
+    ):
+        raise s.fail("steps", f"expected an integer 0 <= steps <= 12, got {steps!r}")
+    closed = s.get("closed")
+    if closed is not None and not isinstance(closed, bool):
+        raise s.fail("closed", f"expected true or false, got {closed!r}")
+    # a foam cutter's moves: the projection algorithm by default, whose geodesic
+    # midpoints keep the towers' straight moves (the dh frames swing round a corner
+    # of parallel rulings); refined between its corners (docs/formats.md)
+    polyline = bool(foreign) and foreign[0] == "gcode"
+    surface = SurfaceSpec(
+        builtin=builtin,
+        file=path,
+        params=dict(params),
+        u=u,
+        rulings=int(rulings),
+        pose=pose(s, "pose"),
+        algorithm=s.choice("algorithm", ALGORITHMS, "projection" if polyline else "dh"),
+        scheme=s.choice("scheme", SCHEME_NAMES, "four_point"),
+        steps=steps,
+        spacing=spacing,
+        closed=closed,
+        read_lines=None if read is None else read.lines,
+        read_closed=False if read is None else bool(read.closed),
+        read_planes=None if read is None else read.planes,
+        kind=foreign[0] if foreign else ("lines" if file is not None else None),
+    )
+    s.done()
+    return surface
+
+
+def parse_stock(st: Section) -> Box:
+    """``[stock]``: the block, an oriented box."""
+    centre, size = st.vector("centre", 3), st.vector("size", 3)
+    for k in range(3):
+        if size[k] <= 0:
+            raise st.fail("size", f"edge {k} must be positive, got {float(size[k])!r}")
+    rot = se3.pose_from_rotvec(st.vector("rotvec", 3, [0.0, 0.0, 0.0]))[:3, :3]
+    stock = Box(centre, size, rot)
+    st.done()
+    return stock
+
+
+def parse_robot(r: Section, base_dir: Path | None) -> RobotSpec:
+    """``[robot]`` -> :class:`.spec.RobotSpec` (the calibration file read and checked)."""
+    from ...robot import MODEL_NAMES
+    from ...robot.ur_tables import canonical_name
+
+    raw = r.get("model", "ur5e")
+    try:
+        model = canonical_name(raw)  # case-insensitive: "UR5e" is "ur5e"
+    except ValueError:
+        raise r.fail("model", f"unknown robot {raw!r}; expected one of {', '.join(MODEL_NAMES)} "
+                     "(any case)") from None  # fmt: skip
+    acc = r.get("acceleration")
+    acceleration = None
+    if acc is not None:
+        if isinstance(acc, list):
+            acceleration = r.vector("acceleration", 6)
+        else:
+            acceleration = np.full(6, r.number("acceleration"))
+        if np.any(acceleration <= 0):
+            raise r.fail("acceleration", "expected positive values (rad/s^2)")
+    robot = RobotSpec(
+        model=model,
+        base=pose(r, "base"),
+        speed_scale=r.number("speed_scale", 1.0, lo=0.0, hi=1.0, strict_lo=True),
+        acceleration=acceleration,
+        home=r.vector("home", 6) if r.get("home") is not None else None,
+        calibration=_calibration(r, model, base_dir),
+    )
+    r.done()
+    return robot
+
+
+def _calibration(sec: Section, model: str, base_dir: Path | None) -> Calibration | None:
+    """``[robot] calibration``: a calibration file of this robot, read and checked."""
+    value = sec.get("calibration")
+    if value is None:
+        return None
+    if not isinstance(value, str):
+        raise sec.fail("calibration", f"expected a path string, got {value!r}")
+    path = input_path(value, base_dir)
+    from ...io.calibration import load_calibration
+
+    try:
+        cal = load_calibration(path)
+    except (OSError, ValueError) as exc:
+        raise sec.fail("calibration", str(exc)) from None
+    if cal.model != model:
+        raise sec.fail("calibration", f"{path} is a calibration of a {cal.model}, the job's "
+                       f"robot is a {model}")  # fmt: skip
+    return cal
+
+
+def parse_heat(h: Section) -> HeatSpec:
+    """``[tool.heat]`` -> :class:`.spec.HeatSpec`: ``output = "standard:0"`` (kind:index),
+    ``preheat`` (s), ``value`` (analog outputs: the fraction of the range)."""
+    out = h.get("output")
+    if not isinstance(out, str) or ":" not in out:
+        raise h.fail("output", 'expected "KIND:N" with KIND one of '
+                     f"{', '.join(HEAT_OUTPUTS)} (e.g. \"standard:0\"), got {out!r}")  # fmt: skip
+    kind, _, index = out.partition(":")
+    if kind not in HEAT_OUTPUTS:
+        raise h.fail("output", f"unknown output kind {kind!r}; expected one of "
+                     f"{', '.join(HEAT_OUTPUTS)}")  # fmt: skip
+    if not index.isdigit() or not 0 <= int(index) < HEAT_OUTPUTS[kind]:
+        raise h.fail("output", f"{kind} outputs are numbered 0..{HEAT_OUTPUTS[kind] - 1}, "
+                     f"got {index!r}")  # fmt: skip
+    heat = HeatSpec(
+        kind=kind,
+        index=int(index),
+        preheat=h.number("preheat", 2.0, lo=0.0, hi=60.0),
+        value=h.number("value", 1.0, lo=0.0, hi=1.0) if kind == "analog" else 1.0,
+    )
+    if kind != "analog" and "value" in h.raw:
+        raise h.fail("value", "only for an analog output")
+    h.done()
+    return heat

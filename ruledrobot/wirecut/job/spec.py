@@ -1,0 +1,223 @@
+"""The value types of a cut job: surface, stock, robot, tool (with its heat), cuts.
+
+Built and validated by :mod:`.job` from a job file; every other module reads them.
+Units: metres, radians, seconds; poses in the robot base frame.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ...geometry.box import Box
+from ...geometry.lines import Lines
+from ...robot.calibration import Calibration
+
+__all__ = ["CutSpec", "HeatSpec", "Job", "RobotSpec", "SurfaceSpec", "ToolSpec"]
+
+
+@dataclass(frozen=True)
+class SurfaceSpec:
+    """Where the rulings come from and how they are refined.
+
+    ``closed``: None takes the lines file's own flag; a built-in surface is closed when
+    it is periodic (hyperboloid, Möbius band) and no ``u`` range is given.
+    """
+
+    builtin: str | None = None
+    file: Path | None = None
+    params: dict[str, Any] = field(default_factory=dict)
+    u: tuple[float, float] | None = None
+    rulings: int = 9
+    pose: np.ndarray = field(default_factory=lambda: np.eye(4), repr=False)
+    algorithm: str = "dh"
+    scheme: str = "four_point"
+    steps: int | None = 4
+    spacing: float | None = None
+    closed: bool | None = None
+    #: rulings read from a file of the field (gcode, airfoil, dxf, rhino) when the job
+    #: names one (``file`` is then that file), in the file's frame, and whether they close
+    read_lines: Lines | None = field(default=None, repr=False)
+    read_closed: bool = False
+    #: the file's two planes its rulings end on (towers, a panel's faces, the profiles'
+    #: planes; :class:`~ruledrobot.io.formats.rulings.Planes`), in the file's frame
+    read_planes: Any = None
+    kind: str | None = None
+
+    def document(self):
+        """The input rulings in the robot base frame and whether they close
+        (:class:`~ruledrobot.io.lines.LinesDocument`)."""
+        from ...io.lines import LinesDocument, read_lines_document
+
+        if self.read_lines is not None:
+            lines, closed = self.read_lines, self.read_closed
+        elif self.file is not None:
+            doc = read_lines_document(self.file)
+            lines, closed = doc.lines, doc.closed
+        else:
+            from ...geometry.surfaces import sample_surface
+
+            lo, hi = self.u if self.u is not None else (None, None)
+            if self.whole_period:  # sampled without its repeated end (u + period is u)
+                sample = sample_surface(self.builtin, n=self.rulings, start=lo, closed=True,
+                                        **self.params)  # fmt: skip
+            else:
+                sample = sample_surface(self.builtin, n=self.rulings, start=lo, stop=hi,
+                                        **self.params)  # fmt: skip
+            lines, closed = sample.lines, sample.closed
+        if self.closed is not None:
+            closed = self.closed
+        return LinesDocument(lines.transform(self.pose), closed)
+
+    @property
+    def whole_period(self) -> bool:
+        """A periodic built-in surface, ``closed = true``, whose ``u`` range is one whole
+        period (within 0.1 %: ``u = [0.0, 6.2832]`` for 2 pi): its ``rulings`` are spread
+        over the period and the end, the start again, is not repeated."""
+        if self.builtin is None or self.u is None or self.closed is not True:
+            return False
+        from ...geometry.surfaces import SURFACES
+
+        period = SURFACES[self.builtin].period
+        return period is not None and abs(self.u[1] - self.u[0] - period) <= 1e-3 * period
+
+    def planes(self) -> tuple[np.ndarray, float] | None:
+        """The file's planes ``z = 0`` and ``z = distance`` as their frame (4, 4) in the
+        robot base frame and the distance [m], or None (a file without, a built-in)."""
+        if self.read_planes is None:
+            return None
+        return self.pose @ self.read_planes.pose, float(self.read_planes.distance)
+
+    def lines(self) -> Lines:
+        """The input rulings in the robot base frame."""
+        return self.document().lines
+
+    @property
+    def label(self) -> str:
+        """What the rulings are, for messages: the file or the built-in surface's name."""
+        if self.file is None:
+            return str(self.builtin)
+        return str(self.file) if self.kind in (None, "lines") else f"{self.kind} {self.file}"
+
+
+@dataclass(frozen=True)
+class RobotSpec:
+    model: str = "ur5e"
+    base: np.ndarray = field(default_factory=lambda: np.eye(4), repr=False)
+    speed_scale: float = 1.0
+    acceleration: np.ndarray | None = None
+    home: np.ndarray | None = field(default=None, repr=False)
+    calibration: Calibration | None = None  #: read from the job's calibration file
+
+
+@dataclass(frozen=True)
+class HeatSpec:
+    """Where the wire's heat is switched (robot IO) and how long it heats before a cut.
+
+    ``kind``: ``"standard"``, ``"configurable"`` or ``"tool"`` digital output, or
+    ``"analog"`` (standard analog output ``index`` set to ``value``, a fraction of its
+    range: the wire's current); ``preheat``: seconds the wire heats, still, at the
+    start of each lead-in before it moves into the stock.
+    """
+
+    kind: str
+    index: int
+    preheat: float = 2.0
+    value: float = 1.0
+
+    @property
+    def output(self) -> str:
+        return f"{self.kind}:{self.index}"
+
+
+@dataclass(frozen=True)
+class ToolSpec:
+    """The bow: wire end points in the flange frame (m), clearance beyond the stock, mass,
+    and the wire's heat output (None: the heat is not switched by the robot)."""
+
+    wire_start: np.ndarray
+    wire_end: np.ndarray
+    clearance: float = 0.02
+    mass: float = 1.0
+    heat: HeatSpec | None = None
+
+    @property
+    def wire_length(self) -> float:
+        return float(np.linalg.norm(self.wire_end - self.wire_start))
+
+
+@dataclass(frozen=True)
+class CutSpec:
+    """One cut of a part: its surface and how it is cut.
+
+    ``keep``: which side of the surface is the part — a point of the part (3,) in the
+    base frame, ``"inside"`` / ``"outside"`` for a closed surface, or None (the wire
+    runs on the surface itself and the kerf is not compensated).  ``extend``: an open
+    surface that stops short of the block is cut on through it along the extrapolated
+    frame motion (noted) instead of being refused (:func:`.path.cut_paths`).
+    """
+
+    name: str
+    surface: SurfaceSpec
+    feed_speed: float = 0.01
+    lead_in: float = 0.02
+    lead_out: float = 0.02
+    approach_speed: float = 0.3
+    kerf: float = 0.0008
+    keep: str | np.ndarray | None = field(default=None, repr=False)
+    wire_tolerance: float = 0.0005
+    feed_tolerance: float = 0.05
+    extend: bool = False
+
+
+@dataclass(frozen=True)
+class Job:
+    """A validated cut job (see the module doc for the file format): one stock, robot and
+    tool, and the cuts in the order they are made.
+
+    ``source``: the job file, as the reports name it; ``source_bytes``: its bytes as
+    planned, when the job was read from a copy (a batch worker on another machine):
+    the reports hash them and ``job.toml`` is written from them instead of reading
+    ``source`` again (None: read ``source``)."""
+
+    cuts: tuple[CutSpec, ...]
+    stock: Box
+    robot: RobotSpec
+    tool: ToolSpec
+    source: Path | None = None
+    source_bytes: bytes | None = field(default=None, repr=False)
+
+    @property
+    def cut(self) -> CutSpec:
+        """The first cut (the only one of a single-cut job)."""
+        return self.cuts[0]
+
+    @property
+    def surface(self) -> SurfaceSpec:
+        """The first cut's surface (the only one of a single-cut job)."""
+        return self.cuts[0].surface
+
+    def robot_model(self):
+        """The job's robot: the catalogue model with its calibration (if the job names
+        one) and its joint acceleration limits, in its own base frame (``base`` the
+        identity) -- the frame of every pose of the job; the arm every stage plans and
+        checks with."""
+        from ...robot import load
+
+        model = load(self.robot.model).with_calibration(self.robot.calibration)
+        if self.robot.acceleration is not None:
+            model = model.with_limits(acceleration=self.robot.acceleration)
+        return model
+
+    def cell_robot(self):
+        """:meth:`robot_model` placed in the world at ``[robot] base``: the arm of the
+        MuJoCo scene and the viewer, which place the stock and table at ``base @ pose``
+        with it (so ``[robot] base`` moves the whole cell, never the plan)."""
+        return self.robot_model().with_base(self.robot.base)
+
+    def input_lines(self) -> Lines:
+        """The first cut's input rulings in the robot base frame."""
+        return self.surface.lines()

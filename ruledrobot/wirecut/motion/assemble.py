@@ -1,0 +1,335 @@
+"""The whole motion of a job: approach, every pass with its lead-in and lead-out, the
+transits between them, the retract — one timed joint trajectory with a label per sample.
+
+Each pass (:class:`~.path.CutPath`) is timed at its cut's feed speed
+(:func:`~.timing.time_path`), in pieces from rest to rest between the corners of its
+path (:mod:`.corners`).  It is entered from a pose ``LIFT`` beyond its first
+ruling (away from the stock centre) and left to a pose ``LIFT`` beyond its last.
+Between passes the arm moves in joint space from one lifted pose to the next
+(:mod:`.transit` checks that the bow and the arm stay clear of the whole stock —
+what earlier cuts cut off may still lie there — and goes over the top when the
+direct move does not).  With ``[tool] heat`` the arm holds still at the start of
+each lead-in for the pre-heat time (phase ``preheat``).
+
+Labels: ``approach`` (before the first pass), ``preheat``, ``lead_in``, ``cut``
+(the wire in the stock), ``lead_out``, ``transit`` (between passes, including the
+moves to and from the lifted poses), ``retract`` (after the last pass).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass, field
+from itertools import pairwise
+
+import numpy as np
+
+from ...geometry.angles import wrap_near
+from ...geometry.checks import FloatArray
+from ...robot.tool import BowTool
+from ...robot.wire_in_stock import WireInStock, wire_ends, wire_gap, wire_in_stock
+from ..cut.passes import CutPath
+from ..cut.wire_geometry import speed_factor, wire_frame
+from ..job.spec import Job
+from .corners import corner_nodes, corner_stop_mask, time_between_corners
+from .densify import densified, pass_deviation, pass_feed_error, uneven_intervals
+from .timing import TimedPath, concatenate, dwell, joint_move
+from .transit import TransitPlanner
+
+__all__ = ["LIFT", "Motion", "assemble_motion"]
+
+LIFT = 0.1  # m: approach from / retract to this far beyond the lead-in/out pose
+#: rounds of adding rulings where the timed wire leaves the surface or its feed strays,
+#: and the share of the cut's wire and feed tolerances that triggers it (:mod:`.densify`)
+DENSIFY_ROUNDS = 3
+DENSIFY_SHARE = 0.25
+#: m: the time law bounds the speed of the wire's point nearest the block from this far
+#: out (at least; 1.5 ruling intervals where they are longer: :func:`feed_param`), so
+#: that its feed bound
+#: meets the chord's without a jump where the wire enters and leaves
+#: (:func:`ruledrobot.robot.wire_in_stock.feed_chord`)
+FEED_NEAR = 0.002
+#: s: the wire moves at its feed for at least this long before it enters the block (and
+#: after it leaves), so that a servo following the plan has settled by then: ruledrobot's
+#: streams filter with a 0.1 s look-ahead, and the part demo's wire entered its side cut
+#: at 12.7 mm/s against 12 +- 5 % when the lead-in sped up until just before the block
+SETTLE_S = 0.3
+
+
+@dataclass(frozen=True, eq=False)
+class Motion:
+    """The timed motion of a job (M samples) and, per sample, what it belongs to.
+
+    ``timed``: the trajectory.  ``labels`` (M,): the phase (module doc).  ``pass_of``
+    (M,): the index of the pass a sample belongs to (-1 outside passes).  ``s`` (M,):
+    the ruling parameter within its pass (NaN outside).  ``wire``: the one model of the
+    wire against the block measured on the samples (:mod:`ruledrobot.robot.wire_in_stock`);
+    ``in_stock`` (M,) is its ``inside``: the wire's chord in the block is at least
+    ``TOUCH`` long.  ``ends`` (M, 2, 3): the chord ends as points of the wire in the
+    flange frame (0 outside the stock).  A pass's lead-in ends where its wire first
+    enters the block and its lead-out starts where it last leaves.
+    ``heat`` (M,): the wire is hot (pre-heat, lead-in, cut, lead-out) when the tool
+    switches heat, else all False.  ``notes``: what the assembly decided (transits).
+    ``passes``: the passes as timed (with the rulings :mod:`.densify` added).
+    ``surface`` (M,): the wire cuts the target surface (in the stock, phase ``cut``; not
+    the slits of a closed cut, which cut waste): where the feed and the wire's deviation
+    are checked.  ``corner_stop`` (M,): the wire slows to a stop at a corner of its path
+    (:mod:`.corners`); the lowest feed is measured outside these samples.
+    """
+
+    timed: TimedPath = field(repr=False)
+    labels: np.ndarray = field(repr=False)
+    pass_of: np.ndarray = field(repr=False)
+    s: FloatArray = field(repr=False)
+    in_stock: np.ndarray = field(repr=False)
+    ends: FloatArray = field(repr=False)
+    heat: np.ndarray = field(repr=False)
+    notes: tuple[str, ...] = ()
+    passes: tuple[CutPath, ...] = field(default=(), repr=False)
+    surface: np.ndarray | None = field(default=None, repr=False)
+    corner_stop: np.ndarray | None = field(default=None, repr=False)
+    wire: WireInStock | None = field(default=None, repr=False)
+
+
+def _backed_off(model, q: FloatArray, away: FloatArray, dist: float) -> FloatArray | None:
+    """Joints nearest ``q`` whose flange is ``dist`` further along ``away`` (unit, base
+    frame); None if unreachable or out of limits."""
+    P = model.fk(q)
+    P[:3, 3] += dist * away
+    sols = model.ik(P)
+    sols = sols[~np.isnan(sols).any(axis=1)]
+    if not len(sols):
+        return None
+    sols = wrap_near(sols, q)
+    best = sols[np.argmin(np.abs(sols - q).max(axis=1))]
+    return best if model.within_limits(best) else None
+
+
+def _free_pose(
+    transit: TransitPlanner, model, q: FloatArray, away: FloatArray
+) -> FloatArray | None:
+    """A pose near ``q`` clear of the stock, the table and the arm, to enter a pass from
+    or leave it to: ``LIFT`` (then twice that) further along ``away``, else raised over
+    the stock; None when none of them is free."""
+    for cand in (_backed_off(model, q, away, LIFT), _backed_off(model, q, away, 2.0 * LIFT),
+                 transit.lifted(q)):  # fmt: skip
+        if cand is not None and transit.free(cand).all():
+            return cand
+    return None
+
+
+def _legs(transit: TransitPlanner, here: FloatArray, entry: FloatArray | None,
+          start: FloatArray, notes: list[str], what: str):  # fmt: skip
+    """Joint moves from ``here`` through ``entry`` (if any) to the pass's first pose."""
+    if entry is None:
+        return transit.route(here, start, notes, what)
+    return transit.route(here, entry, notes, what) + transit.route(entry, start, notes,
+                                                                   what.replace("to ", "into "))
+
+
+@dataclass
+class _Builder:
+    """Collects timed parts with their labels and pass indices."""
+
+    dt: float
+    parts: list[TimedPath] = field(default_factory=list)
+    kinds: list[tuple[str, int]] = field(default_factory=list)  # (label or "pass", pass index)
+
+    def add(self, part: TimedPath, label: str, pass_index: int = -1) -> None:
+        self.parts.append(part)
+        self.kinds.append((label, pass_index))
+
+
+def _across(p: FloatArray, o: FloatArray, z: FloatArray) -> FloatArray:
+    """Distance (K, P) of points p (K, P, 3) from the lines (o, z) (K, 3): the wire's
+    travel across itself.  Not a chord end's own travel: where the wire leaves the
+    stock at a grazing angle that end runs along the wire, many times faster than the
+    wire moves, and would stretch the parameter there."""
+    d = p - o[:, None]
+    return np.linalg.norm(d - (d * z[:, None]).sum(-1, keepdims=True) * z[:, None], axis=-1)
+
+
+def feed_param(job: Job, cp: CutPath, feed_speed: float) -> tuple[FloatArray, float]:
+    """(M,) the path parameter the feed is held in, and ``near`` (m): the distance [m]
+    travelled across the wire by the part of it nearest the block — the chord's ends
+    inside it — as the speed factor measures it (:func:`~.toolpath.speed_factor`, the
+    one model); ``near``: how far out of the block the time law bounds that part's
+    speed: :data:`FEED_NEAR`, or farther so that the bound reaches three rulings beyond
+    every entry and exit and the wire moves at the feed for :data:`SETTLE_S` before it.
+
+    First the frame origins' travel across the wire ``s0``; then each interval's length
+    is the mean speed factor at its ends (per unit of ``s0``) times its ``s0`` length,
+    so that the speed factor in the new parameter is about 1 everywhere, through the
+    wire's entry and exit too.  The time law bounds the feed with the largest speed
+    factor around each node, so uneven spacing — a subdivided polygon, a slit meeting
+    a loop, a parameter that changes its measure where the wire enters — would hold
+    the feed below the set value by the unevenness (a parameter that switched from
+    chord-end to frame-origin travel at the block's face held the wire of a helicoid
+    to 58 % of its feed there, a conoid's to 63 %)."""
+    F = cp.frames
+    o, z = F[:, :3, 3], F[:, :3, 2]
+    step0 = np.maximum(_across(o[:-1, None], o[1:], z[1:]),
+                       _across(o[1:, None], o[:-1], z[:-1]))[:, 0]  # fmt: skip
+    step0 = np.maximum(step0, 1e-9)  # strictly increasing, also where the wire holds still
+    s0 = np.r_[0.0, np.cumsum(step0)]
+    bow = BowTool.from_spec(job.tool)
+    ends = wire_ends(cp.motion.flange @ bow.wire_frame(), bow.wire_length)
+    step = np.empty_like(step0)
+    cuts = [0, *(int(c) for c in corner_nodes(F, 0.5 * job.tool.wire_length)), len(F) - 1]
+    for a, b in pairwise(cuts):  # between corners: differences never reach across one
+        sf0 = speed_factor(cp.motion.flange[a : b + 1], s0[a : b + 1], job.tool, job.stock,
+                           np.inf)  # fmt: skip
+        step[a:b] = 0.5 * (sf0[:-1] + sf0[1:]) * step0[a:b]
+    step = np.maximum(step, 1e-9)
+    gap = wire_gap(ends, job.stock)
+    inside = gap == 0.0
+    edges = np.flatnonzero(np.diff(inside.astype(np.int8)))  # node before each change
+    beyond = np.r_[edges - 3, edges + 4].clip(0, len(gap) - 1)
+    near = max(FEED_NEAR, feed_speed * SETTLE_S, float(gap[beyond].max(initial=0.0)) * 1.01)
+    return np.r_[0.0, np.cumsum(step)], near
+
+
+def measure_wire(job: Job, model, t: FloatArray, q: FloatArray) -> WireInStock:
+    """The one model of the wire against the job's block along joints ``q`` (M, 6) at
+    times ``t`` (M,) (``model``: the planner's, flange without tool, base frame)."""
+    bow = BowTool.from_spec(job.tool)
+    ends = wire_ends(model.fk(q) @ bow.wire_frame(), bow.wire_length)
+    return wire_in_stock(t, ends, job.stock)
+
+
+def _chord_in_flange(job: Job, wire: WireInStock) -> FloatArray:
+    """(M, 2, 3) the chord ends as points of the wire in the flange frame (0 outside)."""
+    bow = BowTool.from_spec(job.tool)
+    W = bow.wire_frame()
+    f = np.nan_to_num(wire.fractions()) - 0.5
+    return W[:3, 3] + f[:, :, None] * bow.wire_length * W[:3, 2]
+
+
+def _pass_timing(
+    job: Job, model, cp: CutPath, vel, acc, dt
+) -> tuple[CutPath, TimedPath, np.ndarray]:
+    """The pass timed at its feed, with rulings added where the timed wire leaves the
+    surface between them or its feed strays (:mod:`.densify`); returns the (denser)
+    pass too and the samples where the wire stops at a corner (:mod:`.corners`)."""
+    cut = next(c for c in job.cuts if c.name == cp.name)
+    param, near = feed_param(job, cp, cut.feed_speed)
+    cp = dataclasses.replace(cp, param=param)
+    for attempt in range(DENSIFY_ROUNDS + 1):
+        m = cp.motion
+        s = cp.s
+        corners = corner_nodes(cp.frames, 0.5 * job.tool.wire_length)
+
+        def sf(a: int, b: int, m=m, s=s) -> FloatArray:  # one piece between corners
+            return speed_factor(m.flange[a : b + 1], s[a : b + 1], job.tool, job.stock, near)
+
+        timed = time_between_corners(s, m.q, sf, cut.feed_speed, vel, acc, dt, corners)
+        if attempt == DENSIFY_ROUNDS:
+            break
+        wire = measure_wire(job, model, timed.t, timed.q)
+        dev = pass_deviation(cp, timed, wire)
+        feed = pass_feed_error(cp, timed, wire, cut.feed_speed)
+        bad = np.flatnonzero((dev > DENSIFY_SHARE * cut.wire_tolerance)
+                             | (feed > DENSIFY_SHARE * cut.feed_tolerance))  # fmt: skip
+        bad = np.union1d(bad, uneven_intervals(cp, DENSIFY_SHARE * cut.feed_tolerance))
+        if not bad.size:
+            break
+        cp = densified(cp, bad, model, job.tool, job.stock)
+    return cp, timed, corner_stop_mask(timed, s[corners])
+
+
+def assemble_motion(job: Job, model, passes: list[CutPath]) -> Motion:
+    """Time the passes and join them with approach, pre-heat, transits and retract
+    (``Motion.passes`` are the passes as timed)."""
+    passes = list(passes)
+    dt = float(model.control_period)
+    vel = model.max_velocity * job.robot.speed_scale
+    acc = model.max_acceleration  # the job's [robot] acceleration when it names one
+    W = wire_frame(job.tool)
+    transit = TransitPlanner.of(job, model)
+    b = _Builder(dt)
+    notes: list[str] = []
+    timed_passes = []
+    for k, cp in enumerate(passes):
+        passes[k], *timing = _pass_timing(job, model, cp, vel, acc, dt)
+        timed_passes.append(tuple(timing))
+    here: FloatArray | None = None
+    if job.robot.home is not None:
+        here = np.asarray(job.robot.home, dtype=np.float64)
+    for k, (cp, (timed, *_)) in enumerate(zip(passes, timed_passes, strict=True)):
+        cut = next(c for c in job.cuts if c.name == cp.name)
+        slow = cut.approach_speed
+        m = cp.motion
+        start, end = m.q[0], m.q[-1]
+        mids = (m.flange @ W)[[0, -1], :3, 3]
+        away = mids - job.stock.centre
+        away /= np.linalg.norm(away, axis=1, keepdims=True)
+        label = "approach" if k == 0 else "transit"
+        entry = _free_pose(transit, model, start, away[0])
+        if here is None:  # no home: the trajectory starts clear of the stock, near the cut
+            here = start if entry is None else entry
+        elif k == 0:  # home: the whole turns nearest the first pass
+            here = wrap_near(here, start if entry is None else entry)
+        for qa, qb in _legs(transit, here, entry, start, notes, f"to {cp.name}"):
+            b.add(joint_move(qa, qb, vel, acc, dt, slow), label)
+        if job.tool.heat is not None and job.tool.heat.preheat > 0:
+            b.add(dwell(start, job.tool.heat.preheat, vel, acc, dt), "preheat", k)
+        b.add(timed, "pass", k)
+        leave = _free_pose(transit, model, end, away[1])
+        last = k == len(passes) - 1
+        if leave is not None:
+            for qa, qb in transit.route(end, leave, notes, f"from {cp.name}"):
+                b.add(joint_move(qa, qb, vel, acc, dt, slow), "retract" if last else "transit")
+        here = end if leave is None else leave
+    if job.robot.home is not None and here is not None:
+        home = wrap_near(job.robot.home, here)
+        for qa, qb in transit.route(here, home, notes, "home"):
+            b.add(joint_move(qa, qb, vel, acc, dt, job.cuts[-1].approach_speed), "retract")
+    whole = concatenate(b.parts, dt) if len(b.parts) > 1 else b.parts[0]
+    return _label(job, model, whole, b, passes, timed_passes, notes)
+
+
+def _label(job, model, whole: TimedPath, b: _Builder, passes, timed_passes, notes) -> Motion:
+    M = whole.t.size
+    labels = np.full(M, "move", dtype=object)
+    pass_of = np.full(M, -1, dtype=np.int64)
+    s = np.full(M, np.nan)
+    wire = measure_wire(job, model, whole.t, whole.q)
+    in_stock = wire.inside
+    seg = whole.segment
+    stop = np.zeros(M, dtype=bool)
+    for i, (label, k) in enumerate(b.kinds):
+        rows = seg == i
+        if not rows.any():
+            continue
+        if label != "pass":
+            labels[rows] = label
+            if label == "preheat":
+                pass_of[rows] = k
+            continue
+        cp, (timed_k, stop_k) = passes[k], timed_passes[k]
+        idx = np.flatnonzero(rows)
+        # the pass's own parameter: its s_of_t starts at cp.s[0] (the part drops no first
+        # sample when it is the first part; otherwise the dropped one is its start)
+        s_k = whole.s_of_t[idx] - whole.s_of_t[idx[0]] + cp.s[0]
+        if i > 0:
+            s_k = s_k + (b.parts[i].s_of_t[1] - b.parts[i].s_of_t[0])
+        s_k = np.clip(s_k, cp.s[0], cp.s[-1])
+        pass_of[idx] = k
+        s[idx] = s_k
+        h = np.flatnonzero(in_stock[idx])
+        lab = np.full(idx.size, "lead_in", dtype=object)
+        if h.size:
+            lab[h[0] : h[-1] + 1] = "cut"
+            lab[h[-1] + 1 :] = "lead_out"
+        if cp.closed:  # a closed cut's slits cut waste: they lead in and out
+            a, z = cp.extended
+            lab[s_k < cp.s[a]] = "lead_in"
+            lab[s_k > cp.s[len(cp.s) - 1 - z]] = "lead_out"
+        labels[idx] = lab
+        stop[idx] = stop_k[timed_k.t.size - idx.size :]  # its first may be dropped
+    surface = in_stock & (labels == "cut")
+    heat = np.zeros(M, dtype=bool)
+    if job.tool.heat is not None:
+        heat = np.isin(labels.astype(str), ("preheat", "lead_in", "cut", "lead_out"))
+    return Motion(whole, labels, pass_of, s, in_stock, _chord_in_flange(job, wire), heat,
+                  tuple(notes), tuple(passes), surface, stop & surface, wire)

@@ -1,0 +1,193 @@
+"""Transits between passes: joint moves that keep the arm, the bow and the wire clear of
+the stock and the table.
+
+The whole stock box counts as an obstacle during a transit (material an earlier cut
+separated may still lie where it was).  Routes are tried in order, each leg a
+straight joint move whose samples must keep every clearance rule (:mod:`.clearance`):
+
+1. the direct move;
+2. over the top: up from the start until the bow and the wire are ``CLEAR`` above
+   the stock, across, down to the goal;
+3. a bidirectional rapidly-exploring random tree in joint space (RRT-connect, seeded:
+   the same job gives the same route), shortened by cutting corners.
+
+When none is clear the direct move is kept and a note says so — the plan's
+collision checks then fail on it and name it.
+"""
+
+from __future__ import annotations
+
+import itertools
+from dataclasses import dataclass
+
+import numpy as np
+
+from ...geometry.angles import wrap_near
+from ...geometry.checks import FloatArray
+from ..cut.clearance import Cell, clearance
+from ..job.spec import Job
+
+__all__ = ["CLEAR", "TransitPlanner"]
+
+#: how far above the stock's top the bow and wire pass when a transit goes over it [m]
+CLEAR = 0.05
+#: joint-space length between checked samples of a move [rad]
+RESOLUTION = 0.03
+#: the random tree's step [rad], its iteration budget and its seed
+TREE_STEP = 0.4
+TREE_ITERATIONS = 1500
+SEED = 20261202
+
+
+@dataclass(frozen=True)
+class TransitPlanner:
+    """Routes joint moves around the stock for one job's cell."""
+
+    cell: Cell
+    top: float  # z of the stock's highest corner [m]
+    lower: FloatArray
+    upper: FloatArray
+
+    @classmethod
+    def of(cls, job: Job, model, margin: float = 0.005) -> TransitPlanner:
+        cell = Cell.of(model, job.tool, job.stock, 0.0, margin, 0.0, None)
+        corners = np.array([[i, j, k] for i in (-1, 1) for j in (-1, 1) for k in (-1, 1)]) * 0.5
+        pts = job.stock.centre + (corners * job.stock.size) @ job.stock.rotation.T
+        lo = np.maximum(model.lower, -2.0 * np.pi)
+        hi = np.minimum(model.upper, 2.0 * np.pi)
+        return cls(cell, float(pts[:, 2].max()), lo, hi)
+
+    def free(self, q: FloatArray) -> np.ndarray:
+        """(n,) bool: configurations (n, J) that keep every clearance rule and hold the
+        wire out of the stock (between cuts the wire is an obstacle like the bow)."""
+        q = np.atleast_2d(q)
+        P = self.cell.model.fk(q)
+        bad = np.zeros(len(q), dtype=bool)
+        for v in clearance(self.cell, q, P).values():
+            bad |= v
+        bad |= self._wire_in_stock(P)
+        return ~bad & self.cell.model.within_limits(q)
+
+    def _wire_in_stock(self, P: FloatArray) -> np.ndarray:
+        w = np.einsum("nij,kj->nki", P[:, :3, :3], self.cell.wire) + P[:, None, :3, 3]
+        return self.cell.stock.segment_hits(w[:, 0], w[:, 1], self.cell.margin)
+
+    def clear(self, qa: FloatArray, qb: FloatArray) -> bool:
+        """True when every sample of the straight joint move qa -> qb is free."""
+        n = max(2, int(np.ceil(np.abs(qb - qa).max() / RESOLUTION)) + 1)
+        u = np.linspace(0.0, 1.0, n)[:, None]
+        return bool(self.free(qa + u * (qb - qa)).all())
+
+    def lifted(self, q: FloatArray) -> FloatArray | None:
+        """Joints nearest ``q`` with the flange raised until the bow and wire are CLEAR
+        above the stock's top; None when unreachable."""
+        model = self.cell.model
+        P = model.fk(q)
+        pts = np.concatenate([self.cell.rods.reshape(-1, 3), self.cell.wire])
+        low = float((pts @ P[:3, :3].T + P[:3, 3])[:, 2].min())
+        rise = self.top + CLEAR - low
+        if rise <= 0.0:
+            return q
+        P[2, 3] += rise
+        sols = model.ik(P)
+        sols = sols[~np.isnan(sols).any(axis=1)]
+        if not len(sols):
+            return None
+        sols = wrap_near(sols, q)
+        best = sols[np.argmin(np.abs(sols - q).max(axis=1))]
+        return best if model.within_limits(best) else None
+
+    def _tree(self, qa: FloatArray, qb: FloatArray) -> list[FloatArray] | None:
+        """RRT-connect from ``qa`` to ``qb`` (module doc); the waypoints, or None."""
+        rng = np.random.default_rng(SEED)
+        trees = [([qa], [-1]), ([qb], [-1])]
+
+        def extend(tree, target) -> int | None:
+            nodes, parents = tree
+            arr = np.asarray(nodes)
+            i = int(np.argmin(np.abs(arr - target).max(axis=1)))
+            d = target - arr[i]
+            span = float(np.abs(d).max())
+            new = target if span <= TREE_STEP else arr[i] + d * (TREE_STEP / span)
+            if not self.clear(arr[i], new):
+                return None
+            nodes.append(new)
+            parents.append(i)
+            return len(nodes) - 1
+
+        def path(tree, k) -> list[FloatArray]:
+            nodes, parents = tree
+            out = []
+            while k >= 0:
+                out.append(nodes[k])
+                k = parents[k]
+            return out
+
+        for it in range(TREE_ITERATIONS):
+            a, b = trees[it % 2], trees[1 - it % 2]
+            k = extend(a, rng.uniform(self.lower, self.upper))
+            if k is None:
+                continue
+            target = a[0][k]
+            while True:  # connect the other tree greedily towards the new node
+                j = extend(b, target)
+                if j is None:
+                    break
+                if np.allclose(b[0][j], target):
+                    pa, pb = path(a, k), path(b, j)
+                    route = pa[::-1] + pb[1:] if it % 2 == 0 else pb[::-1] + pa[1:]
+                    return self._shortcut(route)
+        return None
+
+    def _shortcut(self, route: list[FloatArray]) -> list[FloatArray]:
+        """Drop waypoints while the move that skips them stays clear (greedy, from the
+        start: the farthest waypoint reachable in one move)."""
+        out = [route[0]]
+        i = 0
+        while i < len(route) - 1:
+            j = len(route) - 1
+            while j > i + 1 and not self.clear(route[i], route[j]):
+                j -= 1
+            out.append(route[j])
+            i = j
+        return out
+
+    def route(
+        self, qa: FloatArray, qb: FloatArray, notes: list[str], what: str
+    ) -> list[tuple[FloatArray, FloatArray]]:
+        """Joint moves from ``qa`` to ``qb`` (rad) clear of the stock (module doc)."""
+        qa, qb = np.asarray(qa, dtype=np.float64), np.asarray(qb, dtype=np.float64)
+        if np.allclose(qa, qb):
+            return []
+        if self.clear(qa, qb):
+            return [(qa, qb)]
+        ua, ub = self.lifted(qa), self.lifted(qb)
+        if ua is not None and ub is not None:
+            legs = [(qa, ua), (ua, ub), (ub, qb)]
+            if all(np.allclose(a, b) or self.clear(a, b) for a, b in legs):
+                notes.append(f"transit {what}: over the stock (the direct move would hit it)")
+                return [(a, b) for a, b in legs if not np.allclose(a, b)]
+        if self.free(qa).all() and self.free(qb).all():
+            waypoints = self._tree(qa, qb)
+            if waypoints is not None:
+                notes.append(f"transit {what}: around the stock through "
+                             f"{len(waypoints) - 2} waypoints (the direct move would hit it)")
+                return list(itertools.pairwise(waypoints))
+        why = ""
+        for name, q in (("its start", qa), ("its goal", qb)):
+            broken = self.broken(q)
+            if broken:
+                why += f"; {name} breaks the clearance rules ({', '.join(broken)})"
+        notes.append(f"transit {what}: no move clear of the stock found{why}; the direct move "
+                     "is kept (see the collision checks)")  # fmt: skip
+        return [(qa, qb)]
+
+    def broken(self, q: FloatArray) -> list[str]:
+        """The clearance rules the configuration ``q`` (J,) breaks (empty: free)."""
+        P = self.cell.model.fk(q[None])
+        out = [k for k, v in clearance(self.cell, q[None], P).items() if v.any()]
+        if self._wire_in_stock(P).any():
+            out.append("wire in the stock")
+        if not self.cell.model.within_limits(q):
+            out.append("outside the joint limits")
+        return out

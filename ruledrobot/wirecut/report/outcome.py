@@ -1,0 +1,205 @@
+"""A plan's outcome: the report (``report.json``) and the verdict, from the plan and its
+verification in MuJoCo (``docs/verdict.md``).
+
+The report holds the whole job (duration, ratios, collisions, the largest figures
+over all cuts) and a section per cut (``report["cuts"]``): its passes, rulings,
+feed, wire deviation, kerf and the kept surface's error, the chosen roll and slide.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ...robot.verdict import Check, Verdict
+from ...robot.wire_cut import feed_measures
+from ..motion.feed_limit import feed_limit_reason
+from ..plan import SINGULARITY_MARGIN, Plan, job_reference
+from ..reach.explain import reach_reasons
+from ..verify import Verification
+from .verdict import CutMeasurements, Measurements, plan_verdict
+
+__all__ = ["REPORT_FORMAT", "plan_outcome"]
+
+REPORT_FORMAT = "ruledrobot.plan-report/1"
+
+
+def _mm(x: float | None) -> float | None:
+    return None if x is None else float(x) * 1e3
+
+
+def _keep_text(keep) -> str | list[float] | None:
+    if keep is None or isinstance(keep, str):
+        return keep
+    return [float(v) for v in keep]
+
+
+def _cut_sections(plan: Plan, ver: Verification | None) -> tuple[list[dict], list[CutMeasurements]]:
+    mo, me = plan.motion, plan.measured
+    sections, measures = [], []
+    cut_meta = plan.trajectory.meta.cut
+    feeds = {f.name: f for f in feed_measures(mo.wire, cut_meta)}
+    for cut in plan.job.cuts:
+        ks = [k for k, cp in enumerate(plan.passes) if cp.name == cut.name]
+        passes = [plan.passes[k] for k in ks]
+        rows = np.isin(mo.pass_of, ks) & mo.surface
+        interior = rows & ~mo.timed.feed_limited
+        slits = np.isin(mo.pass_of, ks) & mo.in_stock & ~mo.surface
+        stops = rows & (False if mo.corner_stop is None else mo.corner_stop)
+        fm = feeds.get(cut.name)
+        n_stops = int(np.count_nonzero(stops & ~np.r_[False, stops[:-1]]))
+        dev_p = float(me.deviation[rows].max()) if rows.any() else 0.0
+        dev_s = None if ver is None else (float(ver.deviation[rows].max()) if rows.any() else 0.0)
+        err = max((float(np.max(cp.kerf_error)) for cp in passes
+                   if cp.kerf_error is not None and cp.kerf_error.size), default=0.0)  # fmt: skip
+        compensated = any(cp.compensated for cp in passes)
+        in_pass = np.isin(mo.pass_of, ks)
+        t_cut = mo.timed.t[in_pass]
+        m0 = passes[0].motion
+        cm = CutMeasurements(
+            name=cut.name, feed_set_mm_s=cut.feed_speed * 1e3,
+            feed_max_mm_s=_mm(None if fm is None or np.isnan(fm.highest) else fm.highest),
+            feed_min_mm_s=_mm(None if fm is None or np.isnan(fm.lowest) else fm.lowest),
+            feed_min_limit=None if fm is None or fm.min_ok else feed_limit_reason(plan, fm),
+            corner_stops=n_stops,
+            feed_within_1pct=float(np.mean(np.abs(me.feed[interior] / cut.feed_speed - 1.0)
+                                           <= 0.01)) if interior.any() else None,
+            wire_deviation_mm=_mm(dev_s), planned_wire_deviation_mm=_mm(dev_p),
+            kerf_mm=cut.kerf * 1e3, compensated=compensated,
+            kept_surface_error_mm=err * 1e3 if compensated else None,
+            wire_tolerance_mm=cut.wire_tolerance * 1e3, feed_tolerance=cut.feed_tolerance,
+        )  # fmt: skip
+        measures.append(cm)
+        sections.append({
+            "name": cut.name,
+            "closed": any(cp.closed for cp in passes),
+            "passes": len(passes),
+            "input_rulings": passes[0].input_rulings,
+            "refinement_steps": passes[0].steps,
+            "path_rulings": int(sum(len(cp.frames) for cp in passes)),
+            "rulings_in_stock": int(sum(int(cp.motion.hit.sum()) for cp in passes)),
+            "cut_duration_s": float(t_cut[-1] - t_cut[0]) if t_cut.size else 0.0,
+            "feed_speed_mm_s": cm.feed_set_mm_s,
+            "max_feed_speed_mm_s": cm.feed_max_mm_s,
+            "min_feed_speed_mm_s": cm.feed_min_mm_s,
+            "corner_stops": n_stops,
+            "feed_within_1pct_fraction": cm.feed_within_1pct,
+            "max_planned_wire_deviation_mm": cm.planned_wire_deviation_mm,
+            "max_wire_deviation_mm": cm.wire_deviation_mm,
+            "kerf_mm": cm.kerf_mm,
+            "kerf_compensated": compensated,
+            "keep": _keep_text(cut.keep),
+            "max_kept_surface_error_mm": cm.kept_surface_error_mm,
+            "roll_deg": float(np.degrees(m0.roll[0])),
+            "constant_roll": bool(np.ptp(m0.roll) < 1e-12),
+            "slide_m": float(m0.slide[0]),
+            "wire_reversed": bool(m0.reverse),
+            "notes": [n for cp in passes for n in cp.notes],
+            "slit_feed_mm_s": [float(me.feed[slits].min() * 1e3),
+                               float(me.feed[slits].max() * 1e3)] if slits.any() else None,
+        })
+    return sections, measures
+
+
+def _unreachable(plan: Plan) -> tuple[dict, Verdict]:
+    reasons = tuple(plan.reasons) + reach_reasons(plan)  # how far, which rule, where to move
+    verdict = Verdict((Check("reach", "every ruling reachable, clear of stock and table",
+                             "no", "yes", relation="==", ok=False,
+                             detail="; ".join(reasons)),))  # fmt: skip
+    cp = plan.passes[0]
+    report = {
+        "format": REPORT_FORMAT,
+        "robot": plan.job.robot.model,
+        "job": job_reference(plan.job),
+        "input_rulings": cp.input_rulings,
+        "refinement_steps": cp.steps,
+        "path_rulings": int(sum(len(p.frames) for p in plan.passes)),
+        "rulings_in_stock": int(sum(int(p.motion.hit.sum()) for p in plan.passes)),
+        "reasons": list(reasons),
+        "notes": list(plan.notes),
+        "feasible": False,
+        "verdict": verdict.as_dict(),
+        "timings": dict(plan.timings),
+    }
+    return report, verdict
+
+
+def plan_outcome(plan: Plan, ver: Verification | None) -> tuple[dict, Verdict]:
+    """The report and the verdict of ``plan``; ``ver`` None: not verified in MuJoCo (the
+    ``verified`` check fails)."""
+    if plan.motion is None:
+        return _unreachable(plan)
+    job, mo, me = plan.job, plan.motion, plan.measured
+    sections, cut_measures = _cut_sections(plan, ver)
+    sim = ver.report if ver is not None else None
+    collisions = list(me.collisions) + (list(ver.collisions) if ver is not None else [])
+    sentences = tuple(me.sentences) + (tuple(ver.sentences) if ver is not None else ())
+    meas = Measurements(
+        reach_ok=True, reach_detail="", rulings=int(sum(len(cp.frames) for cp in plan.passes)),
+        simulated=ver is not None, collisions=sentences,
+        position_ratio=me.position_ratio, speed_ratio=me.ratios["max_speed_ratio"],
+        acc_ratio=me.ratios["max_acc_ratio"],
+        torque_ratio=None if sim is None else sim["joint_torque"]["max_ratio"],
+        singularity_min=me.singularity_min,
+        tracking_error_mm=None if sim is None else sim["tcp_position_error_mm"]["max"],
+        duration_s=float(mo.timed.t[-1]), cuts=tuple(cut_measures),
+    )  # fmt: skip
+    verdict = plan_verdict(meas, singularity_margin=SINGULARITY_MARGIN)
+    if not mo.surface.any():
+        missing = Check("in_stock", "the wire passes through the stock", "no", "yes",
+                        relation="==", ok=False,
+                        detail="no sample has the wire inside the stock")  # fmt: skip
+        verdict = Verdict((*verdict.checks, missing))
+    first = sections[0]
+    cutting = mo.pass_of >= 0
+    t_cut = mo.timed.t[cutting]
+
+    def worst(key: str, fn=max):
+        vals = [s[key] for s in sections if s[key] is not None]
+        return fn(vals) if vals else None
+
+    report = {
+        "format": REPORT_FORMAT,
+        "robot": job.robot.model,
+        "job": job_reference(job),
+        "input_rulings": first["input_rulings"],
+        "refinement_steps": first["refinement_steps"],
+        "path_rulings": meas.rulings,
+        "rulings_in_stock": int(sum(s["rulings_in_stock"] for s in sections)),
+        "reasons": list(plan.reasons),
+        "notes": list(plan.notes),
+        "feasible": verdict.ok,
+        "verdict": verdict.as_dict(),
+        "duration_s": float(mo.timed.t[-1]),
+        "cut_duration_s": float(t_cut[-1] - t_cut[0]) if t_cut.size else 0.0,
+        "samples": int(mo.timed.t.size),
+        "control_period_s": float(plan.model.control_period),
+        "feed_speed_mm_s": first["feed_speed_mm_s"],
+        "max_feed_speed_mm_s": worst("max_feed_speed_mm_s"),
+        "min_feed_speed_mm_s": worst("min_feed_speed_mm_s", min),
+        "feed_within_1pct_fraction": worst("feed_within_1pct_fraction", min),
+        "max_joint_position_ratio": me.position_ratio,
+        "max_joint_speed_ratio": me.ratios["max_speed_ratio"],
+        "max_joint_accel_ratio": me.ratios["max_acc_ratio"],
+        "max_joint_torque_ratio": meas.torque_ratio,
+        "min_singularity_measure": me.singularity_min,
+        "max_planned_wire_deviation_mm": worst("max_planned_wire_deviation_mm"),
+        "max_wire_deviation_mm": worst("max_wire_deviation_mm"),
+        "max_tcp_tracking_error_mm": meas.tracking_error_mm,
+        "collisions": collisions,
+        "roll_deg": first["roll_deg"],
+        "constant_roll": first["constant_roll"],
+        "slide_m": first["slide_m"],
+        "wire_reversed": first["wire_reversed"],
+        "kerf_mm": first["kerf_mm"],
+        "heat": None if job.tool.heat is None else {
+            "output": job.tool.heat.output, "preheat_s": job.tool.heat.preheat,
+            "windows_s": [[float(mo.timed.t[a]), float(mo.timed.t[b - 1])]
+                          for a, b in plan.trajectory.meta.heat.windows],
+        },
+        "cuts": sections,
+        "timings": dict(plan.timings),
+    }
+    if sim is not None:
+        report["simulation_realtime_factor"] = sim.get("realtime_factor")
+        report["timings"]["simulation_s"] = ver.seconds
+    return report, verdict

@@ -1,0 +1,184 @@
+"""The part a job leaves: the stock on the kept side of every cut, as a closed mesh.
+
+The part is the set where a signed distance is negative: the largest of the stock
+box's own signed distance and, for every cut that names its kept side, the distance
+to the cut's *target* surface (positive on the waste side).  The distance to a ruled
+surface is taken at its nearest sample (its rulings, sampled every ``SAMPLE`` metres
+over their chords in the stock) along that sample's waste-side normal: exact to
+second order near the surface, and of the right sign elsewhere in the stock.  The
+zero level is meshed by marching cubes (scikit-image, Lewiner) on a grid of
+``resolution`` over the stock — a mesh to look at and send to CAD (``part.stl``);
+its faces lie within a fraction of the grid step of the surfaces.  How close the
+kept surface is to the target is measured on the wire's path (:mod:`.kerf`), not on
+this mesh.
+
+Cuts without ``keep`` name no part side and are left out (a note says so).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ...geometry.box import Box
+from ...geometry.checks import FloatArray
+from ...geometry.mesh import Mesh
+from ..cut.cutpath import CutPath
+from ..cut.kerf import ruling_normals, waste_sign
+from ..cut.wire_geometry import chords
+from ..job.spec import Job
+
+__all__ = ["RESOLUTION", "part_mesh", "part_sdf", "signed_volume"]
+
+#: grid step of the part mesh [m] and spacing of the surface samples along a ruling
+RESOLUTION = 0.002
+SAMPLE = 0.001
+#: most grid points (about 40 MB of distances): the step grows for large blocks
+MAX_POINTS = 5_000_000
+#: distances nearer zero than this fraction of the grid step are moved out to it
+SNAP = 0.005
+
+
+def _surface_samples(
+    passes: list[CutPath], stock: Box, keep
+) -> tuple[FloatArray, FloatArray]:
+    """Points (P, 3) of a cut's target surface inside the stock (grown by 2 mm), over all
+    its ``passes``, and their normals (P, 3) pointing into the waste (a closed cut's
+    slits, in the waste, are not its surface).
+
+    A loop cut in two passes (:mod:`.closed`) is two arcs, each cut out to the meeting
+    ruling and back along its own kerf: only the way out is sampled (sampled both ways,
+    every point of the arc had two samples of opposite normals, and the nearest of them
+    gave the distance its sign at random: hundreds of specks of part in the waste and of
+    waste in the part).  The normals are taken on each arc's whole sequence of rulings
+    before those missing the block are left out (a difference across the gap between
+    two stretches in the block, as where a column as wide as the block crosses only its
+    corners, turns them anywhere), periodic only for a loop cut in one pass.  Which way
+    is the waste, for ``"inside"``/``"outside"``: from the centroid of the chord
+    midpoints of the whole cut (an arc's own centroid can lie near the arc)."""
+    whole = len(passes) == 1
+    arcs = []
+    grown = Box(stock.centre, stock.size + 0.004, stock.rotation)
+    for cp in passes:
+        S = cp.target_frames
+        if cp.closed:
+            a, b = cp.extended
+            S = S[a : len(S) - b]
+            if not whole and np.allclose(S, S[::-1], rtol=0.0, atol=1e-12):
+                S = S[: len(S) // 2 + 1]  # out and back along its own kerf: the way out
+        c0, c1, hit = chords(S, grown)
+        if not hit.any():
+            continue
+        c0, c1 = np.where(hit, c0, 0.0), np.where(hit, c1, 0.0)
+        n = max(2, int(np.ceil(float(np.max(c1 - c0)) / SAMPLE)) + 1)
+        t = c0[:, None] + (c1 - c0)[:, None] * np.linspace(0.0, 1.0, n)[None, :]
+        normals = ruling_normals(S, t, cp.closed and whole)
+        pts = S[:, None, :3, 3] + t[..., None] * S[:, None, :3, 2]
+        arcs.append((S, cp.closed and whole, pts[hit], normals[hit]))
+    if not arcs:
+        return np.zeros((0, 3)), np.zeros((0, 3))
+    if isinstance(keep, str):  # the centroid of every arc's chord midpoints
+        centre = np.concatenate([p[:, p.shape[1] // 2] for _, _, p, _ in arcs]).mean(axis=0)
+    out_p, out_n = [], []
+    for S, closed, pts, normals in arcs:
+        if isinstance(keep, str):
+            k = pts.shape[1] // 2
+            inward = np.einsum("mi,mi->m", centre - pts[:, k], normals[:, k])
+            part_along_normal = (float(np.mean(inward)) > 0.0) == (keep == "inside")
+            sign = -1.0 if part_along_normal else 1.0
+        else:
+            sign = waste_sign(S, stock, keep, closed)
+        out_p.append(pts.reshape(-1, 3))
+        out_n.append(sign * normals.reshape(-1, 3))
+    return np.concatenate(out_p), np.concatenate(out_n)
+
+
+def _cut_sdf(pts: FloatArray, nrm: FloatArray, world: FloatArray, shape: tuple[int, ...],
+             band: float) -> FloatArray:  # fmt: skip
+    """Signed distance on a grid (``world`` (N, 3), ``shape`` the grid's) to one surface
+    sampled by ``pts`` (P, 3) with waste-side normals ``nrm``, exact within ``band`` of it
+    and ``+-band`` beyond: a nearest-neighbour search far from a thin sampled surface
+    visits nearly every sample (a point on a column's axis is as far from all of them),
+    so far cells take the sign of their connected region instead."""
+    from scipy import ndimage
+    from scipy.spatial import cKDTree
+
+    dist, k = cKDTree(pts).query(world, distance_upper_bound=band)
+    near = np.isfinite(dist)
+    d = np.full(len(world), np.nan)
+    kn = k[near]
+    d[near] = np.einsum("ij,ij->i", world[near] - pts[kn], nrm[kn])
+    d = d.reshape(shape)
+    far = ~near.reshape(shape)
+    labels, count = ndimage.label(far)
+    out = np.where(far, 0.0, d)
+    for lab in range(1, count + 1):
+        region = labels == lab
+        rim = ndimage.binary_dilation(region) & ~far
+        side = float(np.sign(np.nansum(np.sign(d[rim])))) if rim.any() else 1.0
+        out[region] = band * (side if side != 0.0 else 1.0)
+    return out
+
+
+def part_sdf(job: Job, passes: tuple[CutPath, ...], world: FloatArray,
+             shape: tuple[int, ...], band: float) -> FloatArray:  # fmt: skip
+    """Signed distance [m] to the part on a grid of world points ``world`` (N, 3) with
+    ``shape`` (module doc): negative inside, the distance within ``band`` of a cut."""
+    stock = job.stock
+    local = stock.to_box(world)
+    q = np.abs(local) - 0.5 * stock.size
+    out = np.linalg.norm(np.maximum(q, 0.0), axis=1) + np.minimum(q.max(axis=1), 0.0)
+    out = out.reshape(shape)
+    for cut in job.cuts:
+        if cut.keep is None:
+            continue
+        pts, nrm = _surface_samples([cp for cp in passes if cp.name == cut.name], stock, cut.keep)
+        if len(pts):
+            out = np.maximum(out, _cut_sdf(pts, nrm, world, shape, band))
+    return out
+
+
+def part_mesh(
+    job: Job, passes: tuple[CutPath, ...], resolution: float = RESOLUTION
+) -> Mesh | None:
+    """The part's closed triangle mesh in the base frame [m] (module doc); None when no
+    cut names its kept side or nothing of the stock is kept."""
+    if all(c.keep is None for c in job.cuts):
+        return None
+    from skimage.measure import marching_cubes
+
+    stock = job.stock
+    h = max(resolution, float(np.prod(stock.size + 4 * resolution) / MAX_POINTS) ** (1 / 3))
+    counts = np.ceil((stock.size + 4.0 * h) / h).astype(int) + 1
+    axes = [(np.arange(c) - (c - 1) / 2.0) * h for c in counts]
+    X, Y, Z = np.meshgrid(*axes, indexing="ij")
+    local = np.stack([X, Y, Z], axis=-1).reshape(-1, 3)
+    world = local @ stock.rotation.T + stock.centre
+    f = _off_grid_points(part_sdf(job, passes, world, tuple(counts), 3.0 * h), h)
+    if f.min() >= 0.0:
+        return None
+    verts, faces, _, _ = marching_cubes(f, level=0.0, spacing=(h, h, h))
+    verts = verts + np.array([a[0] for a in axes])
+    faces = faces.astype(np.int64)
+    if signed_volume(verts, faces) < 0.0:  # outward normals (counter-clockwise seen outside)
+        faces = faces[:, ::-1]
+    return Mesh(verts @ stock.rotation.T + stock.centre, faces)
+
+
+def _off_grid_points(f: FloatArray, h: float) -> FloatArray:
+    """The distances ``f`` with none nearer zero than ``SNAP * h``: the surface passes no
+    grid point.  Marching cubes puts a vertex of every sign-changing edge at a grid point
+    that holds 0 (or nearly: a stock face on a grid plane, a cut through a grid point), so
+    that several vertices of different index coincide: zero-area triangles, and in an STL
+    (which welds equal coordinates, in float32) edges shared by 4 to 16 faces.  Moved off
+    by ``SNAP * h`` (10 um at the 2 mm step; the surface moves no farther), every vertex
+    lies at least that far from a grid point and the mesh is a closed 2-manifold after
+    the float32 rounding of STL too."""
+    eps = SNAP * h
+    return np.where(np.abs(f) < eps, np.where(f < 0.0, -eps, eps), f)
+
+
+def signed_volume(vertices: FloatArray, faces: np.ndarray) -> float:
+    """Volume [m^3] enclosed by a closed triangle mesh, positive when its faces turn
+    counter-clockwise seen from outside (the divergence theorem over the faces)."""
+    a, b, c = vertices[faces[:, 0]], vertices[faces[:, 1]], vertices[faces[:, 2]]
+    return float(np.einsum("ij,ij->i", a, np.cross(b, c)).sum() / 6.0)

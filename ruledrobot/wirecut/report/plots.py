@@ -1,0 +1,120 @@
+"""``plots.png`` of a plan: the cut surfaces in the stock with the planned wire positions
+(and, kerf compensated, the offset wire path), the joints against their limits, the
+feed of every cut against its set feed, the phases on the time axis."""
+
+from __future__ import annotations
+
+import io
+from pathlib import Path
+
+import numpy as np
+
+from ...geometry.checks import FloatArray
+from ...io.atomic import atomic_write_bytes
+from ...robot.tool import BowTool
+from ..plan import Plan
+
+__all__ = ["PHASE_COLOURS", "plot_plan", "stock_edges"]
+
+#: colours of the phases in every picture of a plan
+PHASE_COLOURS = {
+    "approach": "0.75", "preheat": "tab:red", "lead_in": "tab:olive", "cut": "tab:green",
+    "lead_out": "tab:cyan", "transit": "tab:purple", "retract": "0.55", "move": "0.9",
+}  # fmt: skip
+
+
+def stock_edges(job) -> FloatArray:
+    """The 12 edges (12, 2, 3) of the stock box in the base frame [m]."""
+    corners = np.array([[i, j, k] for i in (-1, 1) for j in (-1, 1) for k in (-1, 1)]) * 0.5
+    pts = job.stock.centre + (corners * job.stock.size) @ job.stock.rotation.T
+    pairs = [(i, j) for i in range(8) for j in range(i + 1, 8)
+             if np.sum(corners[i] != corners[j]) == 1]  # fmt: skip
+    return np.array([[pts[i], pts[j]] for i, j in pairs])
+
+
+def _phase_bands(ax, t: FloatArray, labels: np.ndarray) -> None:
+    lab = labels.astype(str)
+    cut = np.flatnonzero(lab[1:] != lab[:-1]) + 1
+    for a, b in zip(np.r_[0, cut], np.r_[cut, lab.size] - 1, strict=True):
+        ax.axvspan(t[a], t[b], color=PHASE_COLOURS.get(lab[a], "0.9"), alpha=0.15, lw=0)
+
+
+def plot_plan(path: str | Path, plan: Plan, part=None) -> Path:
+    """Write the plan's picture (one PNG) to ``path`` atomically; ``part``: the kept part's
+    mesh (:func:`~.part.part_mesh`), drawn see-through in the stock."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+    from matplotlib.patches import Patch
+    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+
+    job, mo, me = plan.job, plan.motion, plan.measured
+    fig = Figure(figsize=(14, 9))
+    FigureCanvasAgg(fig)
+    ax = fig.add_subplot(2, 2, (1, 3), projection="3d")
+    W = BowTool.from_spec(job.tool).wire_frame()
+    half = 0.5 * job.tool.wire_length
+    colours = ["tab:blue", "tab:green", "tab:brown", "tab:pink", "tab:olive", "tab:cyan"]
+    for cp in plan.passes:
+        m, h = cp.motion, cp.motion.hit
+        c0, c1 = m.chord[:, 0], m.chord[:, 1]
+        S = cp.target_frames
+        stride = max(1, int(h.sum()) // 60)
+        a = S[h, :3, 3] + c0[h, None] * S[h, :3, 2]
+        b = S[h, :3, 3] + c1[h, None] * S[h, :3, 2]
+        colour = colours[[c.name for c in job.cuts].index(cp.name) % len(colours)]
+        for p, q in zip(a[::stride], b[::stride], strict=True):
+            ax.plot(*np.c_[p, q], color=colour, lw=0.6)
+        if cp.compensated:
+            F = cp.frames
+            mid = F[h, :3, 3] + (0.5 * (c0 + c1))[h, None] * F[h, :3, 2]
+            ax.plot(*mid.T, color="tab:red", lw=1.0)
+        G = m.flange @ W
+        ends = np.stack([G[:, :3, 3] - half * G[:, :3, 2], G[:, :3, 3] + half * G[:, :3, 2]], 1)
+        for e in ends[:: max(1, len(ends) // 10)]:
+            ax.plot(*e.T, color="tab:orange", lw=1.2)
+    for e in stock_edges(job):
+        ax.plot(*e.T, color="0.4", lw=0.8)
+    if part is not None:
+        tri = part.vertices[part.faces]
+        step = max(1, len(tri) // 15000)  # a few thousand facets draw in a second
+        ax.add_collection3d(Poly3DCollection(tri[::step], facecolor="tab:green", alpha=0.35,
+                                             edgecolor="none"))  # fmt: skip
+    names = ", ".join(c.name for c in job.cuts) if len(job.cuts) > 1 else "cut surface"
+    comp = "; red: wire path offset by half the kerf" if any(
+        cp.compensated for cp in plan.passes) else ""  # fmt: skip
+    kept = "; green: the part" if part is not None else ""
+    ax.set_title(f"{names} in the stock; orange: planned wire{comp}{kept}", fontsize=9)
+    ax.set_xlabel("x (m)")
+    ax.set_ylabel("y (m)")
+    ax.set_zlabel("z (m)")
+    t = mo.timed.t
+    ax2 = fig.add_subplot(2, 2, 2)
+    _phase_bands(ax2, t, mo.labels)
+    for j in range(6):
+        ax2.plot(t, mo.timed.q[:, j], label=f"q{j + 1}")
+    model = plan.model
+    lim = ", ".join(f"{hi:.3g}" if np.isfinite(hi) else "inf" for hi in model.upper)
+    ax2.set_title(f"joint positions (rad); limits ± [{lim}]", fontsize=9)
+    ax2.set_xlabel("t (s)")
+    ax2.legend(ncol=6, fontsize=7, loc="upper right")
+    ax3 = fig.add_subplot(2, 2, 4)
+    _phase_bands(ax3, t, mo.labels)
+    for cut in job.cuts:
+        ks = [k for k, cp in enumerate(plan.passes) if cp.name == cut.name]
+        rows = np.isin(mo.pass_of, ks) & mo.surface
+        ax3.plot(t[rows], me.feed[rows] * 1e3, ".", ms=1,
+                 label=f"{cut.name} (set {cut.feed_speed * 1e3:g})")  # fmt: skip
+        ax3.hlines(cut.feed_speed * 1e3, t[rows].min() if rows.any() else 0,
+                   t[rows].max() if rows.any() else 0, color="k", lw=0.8)  # fmt: skip
+    ax3.set_title("feed of the wire inside the stock (mm/s), measured on the samples",
+                  fontsize=9)  # fmt: skip
+    ax3.set_xlabel("t (s)")
+    handles = [Patch(color=c, alpha=0.3, label=n) for n, c in PHASE_COLOURS.items()
+               if n in set(mo.labels.astype(str))]  # fmt: skip
+    leg = ax3.legend(fontsize=7, loc="lower right")
+    ax3.add_artist(leg)
+    ax3.legend(handles=handles, fontsize=7, loc="upper right", title="phase")
+    fig.tight_layout()
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=90)
+    return atomic_write_bytes(path, buf.getvalue())
