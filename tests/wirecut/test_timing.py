@@ -162,7 +162,7 @@ def test_limits_that_cannot_be_met_raise(monkeypatch):
         tp, _, _ = real(prob, t, sig, *rest)
         return tp, sig[:1], sig[1:2]
 
-    monkeypatch.setattr(timing.path, "_timed_from_law", always_over)
+    monkeypatch.setattr(timing.time_law, "_timed_from_law", always_over)
     with pytest.raises(ValueError, match=r"exceeds the limits after 6 rounds.*between s ="):
         time_path(s, q, sf, 0.05, VL, AL, DT)
 
