@@ -21,7 +21,7 @@ from ruledrobot.wirecut.job.load import load_job
 from ruledrobot.wirecut.motion.corners import corner_nodes
 from ruledrobot.wirecut.plan import make_plan
 
-DATA = Path(__file__).parents[1] / "formats" / "data"
+DATA = Path(__file__).parents[2] / "formats" / "data"
 
 #: the profile job of tests/formats/test_gcode_corners.py, kerf compensated (the part inside)
 JOB = """\

@@ -10,7 +10,7 @@ from ruledrobot.wirecut.cut.passes import chord_ends_in_flange, cut_path, refine
 from ruledrobot.wirecut.cut.wire_geometry import chords
 from ruledrobot.wirecut.job.load import load_job
 
-from .test_job import EXAMPLE
+from ..job.test_job import EXAMPLE
 
 
 @pytest.fixture(scope="module")

@@ -17,7 +17,7 @@ from ruledrobot.wirecut.job.load import load_job
 from ruledrobot.wirecut.reach.map import job_cell, reach_map
 from ruledrobot.wirecut.reach.margins import DEFAULT_RULES, Reason
 
-from .reach_jobs import demo_at
+from ..reach_jobs import demo_at
 
 runner = CliRunner()
 

@@ -37,12 +37,12 @@ from ruledrobot.wirecut.reach.explain import reach_reasons
 from ruledrobot.wirecut.reach.map import reach_map
 from ruledrobot.wirecut.reach.report import summary_lines
 
-from .reach_jobs import demo_at
+from ..reach_jobs import demo_at
 
 runner = CliRunner()
-DATA = Path(__file__).parents[1] / "formats" / "data"
+DATA = Path(__file__).parents[2] / "formats" / "data"
 
-#: the tapered foam profile of tests/wirecut/test_polyline_corners.py as a Rhino model
+#: the tapered foam profile of tests/wirecut/motion/test_polyline_corners.py as a Rhino model
 #: (its two profile curves), in front of a UR3e: the planner finds no roll
 RHINO_JOB = """\
 [surface]

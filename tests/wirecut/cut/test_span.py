@@ -21,7 +21,7 @@ from ruledrobot.wirecut.job.load import load_job
 
 #: the demo's hyperbolic paraboloid stops in the middle of the block (x = 0.5 of 0.4..0.6)
 SHORT = "u = [-0.12, 0.0]"
-DATA = Path(__file__).parents[1] / "formats" / "data"
+DATA = Path(__file__).parents[2] / "formats" / "data"
 #: the cutter frame of tests/formats/data/wedge.ngc in the demo cell (tests/formats)
 WEDGE_POSE = "[0.4, 0.4, 0.25, 1.5707963267948966, 0.0, 0.0]"
 DEMO_SURFACE = '''builtin = "hyperbolic_paraboloid"

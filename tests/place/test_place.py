@@ -15,8 +15,7 @@ from ruledrobot.place.job_file import write_job_file
 from ruledrobot.place.regions import Placement, moved_job
 from ruledrobot.wirecut.job.load import load_job
 from ruledrobot.wirecut.planner import plan
-
-from .reach_jobs import LONG_JOB, demo_at
+from tests.wirecut.reach_jobs import LONG_JOB, demo_at
 
 runner = CliRunner()
 

@@ -10,7 +10,7 @@ from ruledrobot.wirecut.cut import wire_pose as red
 from ruledrobot.wirecut.cut.clearance import Cell
 from ruledrobot.wirecut.job.load import load_job
 
-from .test_job import EXAMPLE
+from ..job.test_job import EXAMPLE
 
 
 @pytest.fixture(scope="module")
