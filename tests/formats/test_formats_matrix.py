@@ -179,3 +179,21 @@ def test_the_rulings_follow_the_closed_form(plans, kind):
     for y, truth in _truth().items():
         pts = _face_points(plans[kind][3], y, kind != "airfoil")
         assert _to_polyline(pts, truth).max() < 1e-4, (kind, y)
+
+
+def test_the_default_panel_in_a_block_past_its_trailing_edge_plans(tmp_path):
+    """The issue's case: a NACA 4415/0012 panel with the reader's defaults (matched by
+    parameter, cosine spacing) in a block 5 cm past the trailing edge — refused before
+    ("does not leave the stock within 400 extrapolated rulings") — plans PASS, the wire
+    at its feed through the entry and exit at the trailing edge (measured 7.92-8.04 mm/s)."""
+    (tmp_path / "root.dat").write_text(selig_text("NACA 4415", naca4("4415", 81)))
+    (tmp_path / "tip.dat").write_text(selig_text("NACA 0012", naca4("0012", 81)))
+    surface = ('airfoil = { root = "root.dat", tip = "tip.dat", span = 0.3, root_chord = 0.15, '
+               'tip_chord = 0.12 }')
+    (tmp_path / "job.toml").write_text(JOB.format(surface=surface, pose=POSE))
+    r = runner.invoke(app, ["plan", str(tmp_path / "job.toml"), "--out", str(tmp_path / "o")])
+    report = json.loads((tmp_path / "o" / "report.json").read_text())
+    assert r.exit_code == 0 and report["verdict"]["ok"], r.output[-800:]
+    checks = {c["name"]: c["value"] for c in report["verdict"]["checks"]}
+    assert 7.8 < checks["feed_min"] <= checks["feed_max"] < 8.2
+    assert "corner_stops" not in checks  # no stop at the trailing edge
