@@ -37,6 +37,7 @@ from ...algorithms import check_distinct_neighbours, refine
 from ...geometry import se3
 from ...geometry.box import Box
 from ...geometry.checks import FloatArray
+from ...geometry.lines import coincident_neighbours
 from ...geometry.ruled import RuledSurface
 from ...subdivision import check_length, check_size, get_scheme, refined_count
 from ..job.spec import CutSpec, Job
@@ -175,6 +176,9 @@ def refine_cut(
     label = f"{where}: [surface]" if cut.name == "cut" else f"{where}: [cut '{cut.name}'.surface]"
     doc = s.document()
     lines, closed = doc.lines, bool(doc.closed)
+    if closed and len(lines) > 3 and (len(lines) - 1) in coincident_neighbours(
+            lines.plucker, closed=True):  # fmt: skip
+        lines = lines[:-1]  # a closed profile drawn back to its start: the end is the start
     check_distinct_neighbours(lines.plucker, closed, f"{label} {s.label}")
     sch = get_scheme(s.scheme)
     half = 0.5 * wire_length
