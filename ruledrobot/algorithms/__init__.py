@@ -1,15 +1,19 @@
 """The paper's three refinement algorithms for discrete ruled surfaces (section 3).
 
-* ``projection``: Plücker coordinates refined in R^6, every step projected back
-  onto the line manifold by Eq. 4;
-* ``combined``: the discrete striction curve (computed once) refined in R^3,
-  the spherical image refined geodesically on S^2, lines rebuilt from both;
-* ``dh``: the DH frames of the rulings refined by geodesic subdivision in
-  SE(3); the refined frames give the lines (their z axes), an approximate
-  striction curve (their origins) and a smooth frame motion.  The frames are
-  taken with sign-continuous x axes (``RuledSurface.dh_frames("continuous")``):
-  the same origins and z axes as the design's DH frames, without the half
-  turns where the distribution parameter changes sign.
+* ``projection`` (§3.1): Plücker coordinates refined in R^6, every step
+  projected back onto the line manifold M^4 by Eq. 4;
+* ``combined`` (§3.2): the discrete striction curve (§2.4, computed once)
+  refined in R^3, the spherical image refined geodesically on S^2 (§2.7),
+  lines rebuilt from both;
+* ``dh`` (§3.3): the DH frames of the rulings refined by geodesic subdivision
+  in SE(3) (§2.8); the refined frames give the lines (their z axes), an
+  approximate striction curve (their origins) and a smooth frame motion.  The
+  frames are taken with sign-continuous x axes
+  (``RuledSurface.dh_frames("continuous")``): the same origins and z axes as
+  the design's DH frames, without the half turns where the distribution
+  parameter changes sign (a decision, see ``docs/conventions.md``).
+
+All lengths are metres, in the frame the input lines are given in.
 """
 
 from __future__ import annotations
@@ -41,14 +45,30 @@ Algorithm = Literal["projection", "combined", "dh"]
 
 @dataclass(frozen=True)
 class RefineResult:
-    """Result of :func:`refine`.
+    """Refined discrete ruled surface, the result of :func:`refine`.
 
-    * ``lines``: the refined rulings (M lines);
-    * ``frames``: (M, 4, 4) refined DH frames for ``"dh"``, else None;
-    * ``striction``: (M, 3) the refined striction polygon (``combined``: the
-      refined discrete striction curve; ``dh``: the frame origins; ``projection``:
-      None — compute it from the lines with :class:`RuledSurface` if needed);
-    * ``closed``, ``flip``: topology of the result (the input's).
+    All in the frame of the input lines, lengths [m].
+
+    Attributes
+    ----------
+    lines : Lines
+        The refined rulings (M lines).
+    frames : ndarray, shape (M, 4, 4), or None
+        Refined DH frames (z along the ruling, origin on it) for ``"dh"``,
+        else None.
+    striction : ndarray, shape (M, 3), or None
+        The refined striction polygon [m]: ``combined``, the refined discrete
+        striction curve; ``dh``, the frame origins; ``projection``, None
+        (compute it from the lines with :class:`RuledSurface` if needed).
+    closed, flip : bool
+        Topology of the result (the input's): periodic, and closed with an
+        orientation flip (Möbius band).
+    algorithm : str
+        ``"projection"``, ``"combined"`` or ``"dh"``.
+    scheme : str
+        The subdivision scheme's name.
+    steps : int
+        Number of refinement steps.
     """
 
     lines: Lines
@@ -61,13 +81,40 @@ class RefineResult:
     steps: int = 0
 
     def surface(self) -> RuledSurface:
-        """The refined rulings as a :class:`RuledSurface`."""
+        """Return the refined rulings as a :class:`RuledSurface`.
+
+        Returns
+        -------
+        surface : RuledSurface
+            ``lines`` with the result's ``closed`` and ``flip``.
+        """
         return RuledSurface(self.lines, closed=self.closed, flip=self.flip if self.closed else None)
 
 
 def check_distinct_neighbours(plucker: FloatArray, closed: bool, what: str = "lines") -> None:
-    """ValueError naming consecutive lines that coincide (a duplicated ruling: its DH
-    frame is undefined and the refined surface kinks there; remove one of them)."""
+    """Check that no two consecutive lines coincide.
+
+    A duplicated ruling has no DH frame (its common normal with the next is
+    undefined) and the refined surface kinks there.  Lines count as coincident
+    when their gap (:func:`~ruledrobot.geometry.lines.neighbour_gaps`) is below
+    ``COINCIDENT_REL`` times the median gap or ``COINCIDENT_ABS`` [m];
+    orientation does not count.
+
+    Parameters
+    ----------
+    plucker : ndarray, shape (N, 6)
+        Plücker rows ``[l, m]`` of the rulings (moment [m]).
+    closed : bool
+        Also compare the last line with the first.
+    what : str, default "lines"
+        Name of the argument the error message blames.
+
+    Raises
+    ------
+    ValueError
+        Naming up to six coincident pairs (indices from 0) with their gaps [m]
+        and the median gap.
+    """
     bad = coincident_neighbours(plucker, closed)
     if bad.size:
         n = len(plucker)
@@ -90,11 +137,46 @@ def refine(
 ) -> RefineResult:
     """Refine a discrete ruled surface by one of the paper's algorithms.
 
-    ``lines``: :class:`Lines` (with ``closed``, default False) or a
-    :class:`RuledSurface` (its own ``closed``/``flip``).  A closed sequence
-    whose last line points against its first is closed with a flip.
-    ``scheme``/``params``: see :func:`ruledrobot.subdivide`.  Open sequences
-    keep their first and last rulings.
+    Parameters
+    ----------
+    lines : Lines or RuledSurface
+        The rulings, in any frame (lengths [m]).  A :class:`RuledSurface`
+        brings its own ``closed`` and ``flip``; for :class:`Lines` a closed
+        sequence whose last line points against its first is closed with a
+        flip (Möbius band).
+    algorithm : {"projection", "combined", "dh"}, default "dh"
+        ``projection``: Plücker rows subdivided in R^6 and projected by Eq. 4
+        after every step (paper §3.1); ``combined``: the discrete striction
+        curve (§2.4) in R^3 and the spherical image on S^2 (§2.7), the lines
+        through the refined points along the refined directions (§3.2);
+        ``dh``: the sign-continuous DH frames subdivided along screw motions
+        in SE(3) (§2.8, §3.3).
+    scheme : str, default "four_point"
+        One of :data:`~ruledrobot.subdivision.SCHEME_NAMES`.
+    steps : int, default 4
+        Number of refinement steps, ``0 <= steps <= 20``.
+    closed : bool or None, default None
+        For :class:`Lines`: periodic (None means False).  For a
+        :class:`RuledSurface` it must agree with the surface's own flag.
+    **params : float
+        Scheme parameters: ``w`` (four_point), ``mu`` (ternary_four_point);
+        see :func:`ruledrobot.subdivision.get_scheme`.
+
+    Returns
+    -------
+    result : RefineResult
+        The refined rulings, with the frames (``dh``) and the striction
+        polygon (``combined``, ``dh``).  Open sequences keep their first and
+        last rulings.
+
+    Raises
+    ------
+    ValueError
+        For an input that is neither :class:`Lines` nor :class:`RuledSurface`,
+        a ``closed`` that contradicts the surface, an unknown algorithm, scheme
+        or parameter, a bad step count, coincident consecutive rulings
+        (:func:`check_distinct_neighbours`), too few rulings for the scheme,
+        or more than :data:`~ruledrobot.subdivision.MAX_REFINED` refined rulings.
     """
     if isinstance(lines, RuledSurface):
         if closed is not None and bool(closed) != lines.closed:

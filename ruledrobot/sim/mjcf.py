@@ -1,10 +1,14 @@
-"""MJCF generation: robot arms from their DH tables, and the chain of a line sequence.
+"""MJCF generation of robot arms from their DH tables and inertial data.
 
 :func:`robot_mjcf` writes a MuJoCo model of any :class:`~ruledrobot.robot.RobotModel`
 (the UR catalogue or a custom DH arm) from its DH table and inertial data,
 with primitive geometry only (cylinders and capsules, no meshes).
-:func:`chain_mjcf` writes the serial chain whose joint axes are a given
-sequence of lines (the paper's view of a discrete ruled surface as a robot).
+:func:`build_robot` builds the same element tree for callers that add to it
+(the cell scene, :mod:`ruledrobot.sim.scene`); :class:`ServoGains`,
+:func:`default_armature`, :func:`default_damping` and :func:`physics_timestep`
+are the parameters shared with the playback and the inverse dynamics.
+The serial chain whose joint axes are a sequence of lines (the paper's view of
+a discrete ruled surface as a robot) is :func:`ruledrobot.sim.chain.chain_mjcf`.
 
 Frames and names of the robot model (see ``docs/sim.md``):
 
@@ -265,6 +269,15 @@ def build_robot(
     comment_model: str,
     conaffinity: int = 1,
 ) -> _RobotTree:
+    """Build the MJCF element tree of a robot arm (see the module docstring for names).
+
+    Parameters are those of :func:`robot_mjcf`, plus ``payload`` (add the
+    ``payload`` body of a tool mass), ``comment_model`` (the ``model``
+    attribute of ``<mujoco>``) and ``conaffinity`` (of the arm's geoms, when
+    ``collisions``).  Returns the root with handles to the world body, the last
+    link body, the contact, actuator and sensor sections, the link body names
+    and the flange pose (DH frame J) in the last link body's frame.
+    """
     n = model.n_joints
     g = (gains or ServoGains.default(model)).for_joints(n)
     arm = _per_joint(armature, default_armature(model), "armature")

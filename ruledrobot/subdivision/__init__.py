@@ -1,7 +1,11 @@
 """Subdivision schemes on R^n, S^2, SE(3) and the manifold of lines.
 
-``subdivide`` is the user entry point; schemes live in :mod:`.schemes`, the
-spaces in :mod:`.spaces`, the boundary handling in :mod:`.engine`.
+:func:`subdivide` is the user entry point; the schemes live in :mod:`.schemes`
+(paper §2.5–2.6), the spaces in :mod:`.spaces` (§2.7–2.8), the open, closed and
+flip-closed boundary handling in :mod:`.engine`.  :func:`refine_plucker` is the
+projection algorithm of §3.1; the size guards (:func:`check_steps`,
+:func:`check_length`, :func:`check_size`) are shared with
+:mod:`ruledrobot.algorithms`.
 """
 
 from __future__ import annotations
@@ -35,7 +39,23 @@ SpaceName = Literal["euclidean", "sphere", "se3"]
 
 
 def check_steps(steps: int) -> int:
-    """Validate a number of subdivision steps (0 <= steps <= 20)."""
+    """Validate a number of subdivision steps.
+
+    Parameters
+    ----------
+    steps : int
+        Number of refinement steps (dimensionless); ``bool`` is refused.
+
+    Returns
+    -------
+    steps : int
+        The same number as a Python ``int``.
+
+    Raises
+    ------
+    ValueError
+        When ``steps`` is not an integer with ``0 <= steps <= 20``.
+    """
     if isinstance(steps, bool) or not isinstance(steps, (int, np.integer)) or not 0 <= steps <= 20:
         raise ValueError(f"steps: expected an integer 0 <= steps <= 20, got {steps!r}")
     return int(steps)
@@ -50,7 +70,25 @@ BYTES_PER_ELEMENT = 1000
 
 
 def refined_count(scheme: Scheme, n: int, steps: int, closed: bool) -> int:
-    """How many elements ``steps`` steps of ``scheme`` make of ``n`` (exact)."""
+    """Count the elements ``steps`` steps of ``scheme`` make of ``n`` (exact).
+
+    Parameters
+    ----------
+    scheme : Scheme
+        The subdivision scheme (its arity and end rule decide the count).
+    n : int
+        Number of input elements.
+    steps : int
+        Number of refinement steps.
+    closed : bool
+        Whether the sequence is periodic (closed, with or without a flip).
+
+    Returns
+    -------
+    count : int
+        Number of elements after ``steps`` steps, by
+        :meth:`Scheme.refined_length` applied ``steps`` times.
+    """
     for _ in range(steps):
         n = scheme.refined_length(n, closed)
     return n
@@ -60,8 +98,38 @@ def check_size(
     scheme: Scheme, n: int, steps: int, closed: bool, what: str, limit: int = MAX_REFINED,
     bytes_per_element: float | None = BYTES_PER_ELEMENT,
 ) -> int:
-    """The refined count, or ValueError with the numbers (and the memory estimate when
-    ``bytes_per_element`` is given) and the most steps that fit."""
+    """Check that a refinement stays within the element limit, before any work.
+
+    Parameters
+    ----------
+    scheme : Scheme
+        The subdivision scheme.
+    n : int
+        Number of input elements.
+    steps : int
+        Number of refinement steps asked for.
+    closed : bool
+        Whether the sequence is periodic.
+    what : str
+        Name of the argument the error message blames (e.g. ``"steps"``).
+    limit : int, default MAX_REFINED
+        Most elements allowed after refinement.
+    bytes_per_element : float or None, default BYTES_PER_ELEMENT
+        Memory per refined element [bytes] for the estimate quoted in the
+        error message; None leaves the estimate out.
+
+    Returns
+    -------
+    count : int
+        The refined count (:func:`refined_count`), when it is at most ``limit``.
+
+    Raises
+    ------
+    ValueError
+        When the refined count exceeds ``limit``; the message gives the count,
+        the limit (with memory estimates when ``bytes_per_element`` is given)
+        and the most steps that fit.
+    """
     count = refined_count(scheme, n, steps, closed)
     if count <= limit:
         return count
@@ -77,7 +145,22 @@ def check_size(
 
 
 def check_length(scheme: Scheme, n: int, what: str) -> None:
-    """Raise ValueError when ``n`` elements are too few for ``scheme``."""
+    """Check that ``n`` elements are enough for ``scheme``.
+
+    Parameters
+    ----------
+    scheme : Scheme
+        The subdivision scheme (its :attr:`Scheme.min_points`).
+    n : int
+        Number of input elements.
+    what : str
+        Name of the argument the error message blames (``"lines"``, ``"points"``).
+
+    Raises
+    ------
+    ValueError
+        When ``n < scheme.min_points``.
+    """
     if n < scheme.min_points:
         raise ValueError(
             f"{what}: scheme {scheme.name!r} needs at least {scheme.min_points} elements, got {n}"
@@ -87,8 +170,32 @@ def check_length(scheme: Scheme, n: int, what: str) -> None:
 def refine_plucker(
     plucker: FloatArray, scheme: Scheme, steps: int, closed: bool, flip: bool
 ) -> FloatArray:
-    """The projection algorithm on Plücker rows (N, 6): one step of ``scheme`` in R^6,
-    then every element projected onto M^4 by Eq. 4; repeated ``steps`` times."""
+    """Refine lines by the projection algorithm (paper §3.1).
+
+    One step of ``scheme`` on the Plücker rows as points of R^6, then every
+    element projected back onto the line manifold M^4 by Eq. 4
+    (:func:`~ruledrobot.geometry.lines.plucker_project`); repeated ``steps``
+    times.  A flip reverses a line by negating its row.
+
+    Parameters
+    ----------
+    plucker : ndarray, shape (N, 6)
+        Plücker coordinates ``[l, m]`` of the rulings (``|l| = 1``,
+        ``l · m = 0``, Eq. 1); ``l`` unit direction, ``m`` moment [m].
+    scheme : Scheme
+        The subdivision scheme.
+    steps : int
+        Number of refinement steps.
+    closed : bool
+        Whether the sequence is periodic.
+    flip : bool
+        Close with an orientation flip (Möbius band); only with ``closed``.
+
+    Returns
+    -------
+    plucker : ndarray, shape (M, 6)
+        Plücker rows of the refined rulings, on M^4 to rounding.
+    """
     return refine_sequence(
         EuclideanSpace(negate_on_flip=True), plucker, scheme, steps, closed, flip, plucker_project
     )
@@ -129,16 +236,48 @@ def subdivide(
 
     The space follows from the elements unless ``space`` is given:
 
-    * (N, 3) or (N, d) points -> Euclidean R^d (the linear scheme);
-    * (N, 3) unit vectors with ``space="sphere"`` -> geodesic scheme on S^2;
-    * (N, 4, 4) poses -> geodesic scheme in SE(3) (screw motions);
-    * :class:`~ruledrobot.Lines` -> the projection algorithm (R^6 + Eq. 4).
+    * (N, d) points -> Euclidean R^d (the linear scheme);
+    * (N, 3) unit vectors with ``space="sphere"`` -> geodesic scheme on S^2
+      (paper §2.7);
+    * (N, 4, 4) poses -> geodesic scheme in SE(3), screw motions (§2.8);
+    * :class:`~ruledrobot.Lines` -> the projection algorithm (R^6 + Eq. 4, §3.1).
 
-    ``closed`` makes the sequence periodic; ``flip=True`` closes it with an
-    orientation flip (Möbius band; for lines detected automatically when the
-    last line points against the first).  Open sequences keep their ends.
-    Scheme parameters: ``w`` (four_point), ``mu`` (ternary_four_point).
-    Returns refined elements of the same kind.
+    Parameters
+    ----------
+    elements : Lines or array-like, shape (N, d), (N, 3) or (N, 4, 4)
+        The sequence: lines, points (any unit, usually [m]), unit vectors, or
+        poses (rigid motions, all in one common frame).
+    scheme : str, default "four_point"
+        One of :data:`SCHEME_NAMES`.
+    steps : int, default 4
+        Number of refinement steps, ``0 <= steps <= 20``.
+    closed : bool, default False
+        Make the sequence periodic.  Open sequences keep their first and last
+        elements.
+    space : {"euclidean", "sphere", "se3"} or None, default None
+        The space of array elements; None infers ``"se3"`` for (N, 4, 4) and
+        ``"euclidean"`` otherwise.  Ignored for :class:`~ruledrobot.Lines`.
+    flip : bool or None, default None
+        Close with an orientation flip (Möbius band): the element after the
+        last is the first one flipped (a line reversed, a unit vector negated,
+        a frame turned by pi about its x axis).  None: for lines, detected when
+        the last line points against the first; for arrays, no flip.
+    **params : float
+        Scheme parameters: ``w`` (four_point), ``mu`` (ternary_four_point);
+        see :func:`get_scheme`.
+
+    Returns
+    -------
+    refined : Lines or ndarray, shape (M, d), (M, 3) or (M, 4, 4)
+        Refined elements of the same kind, in the same frame.
+
+    Raises
+    ------
+    ValueError
+        For an unknown scheme, space or parameter, a bad shape, non-unit
+        vectors or non-rigid poses, too few elements, more than
+        :data:`MAX_REFINED` refined elements, or (arrays) ``flip=True``
+        without ``closed=True``; for lines a flip without ``closed`` is ignored.
     """
     sch = get_scheme(scheme, **params)
     steps = check_steps(steps)

@@ -1,4 +1,4 @@
-"""Running a scheme for several steps on open, closed and flip-closed sequences.
+"""Run a scheme for several steps on open, closed and flip-closed sequences.
 
 Boundary rules (also in ``docs/subdivision.md``):
 
@@ -14,7 +14,11 @@ Boundary rules (also in ``docs/subdivision.md``):
   they reproduce what they reproduce inside (cubics in R^n; any uniformly
   sampled geodesic — screw motion, great circle — exactly).  chaikin uses the
   clamped quadratic B-spline rule and bspline3 keeps its end points (natural
-  end condition).
+  end condition); linear needs no ghosts for open data.
+
+The paper keeps the end elements of open curves (§2.6, after Eq. 10) and only
+says that higher-order schemes need care at the ends; the phantoms are our
+decision.
 """
 
 from __future__ import annotations
@@ -31,12 +35,28 @@ __all__ = ["extend", "neville", "refine_sequence"]
 
 
 def neville(space: Space, points: list[FloatArray], taus: FloatArray) -> FloatArray:
-    """Geodesic Neville–Aitken interpolation through ``points[i]`` at parameter i.
+    """Evaluate the geodesic Neville–Aitken interpolant through ``points[i]`` at i.
 
-    ``points`` are d+1 arrays (each a single element with a leading axis of 1);
-    returns the interpolant at each parameter of ``taus`` (k,), shape (k, ...).
-    Level j combines ``P_{i..i+j}(tau) = geodesic(P_{i..i+j-1}, P_{i+1..i+j}, (tau - i)/j)``;
-    in R^n it is Lagrange interpolation, on a geodesic it stays on the geodesic.
+    Level j combines
+    ``P_{i..i+j}(tau) = geodesic(P_{i..i+j-1}, P_{i+1..i+j}, (tau - i)/j)``;
+    in R^n it is Lagrange interpolation of degree d, on a geodesic it stays on
+    the geodesic (uniform samples of a screw motion or great circle are
+    reproduced exactly).
+
+    Parameters
+    ----------
+    space : Space
+        The space the elements live in.
+    points : list of ndarray, each shape (1, ...)
+        The d + 1 encoded elements (a leading axis of 1 each), at parameters
+        0, 1, ..., d.
+    taus : ndarray, shape (k,)
+        Parameters to evaluate at (any real value; negative ones extrapolate).
+
+    Returns
+    -------
+    values : ndarray, shape (k, ...)
+        The interpolant at each parameter, encoded like ``points``.
     """
     k = taus.shape[0]
     level = [np.repeat(p, k, axis=0) for p in points]
@@ -50,7 +70,30 @@ def neville(space: Space, points: list[FloatArray], taus: FloatArray) -> FloatAr
 def extend(
     space: Space, x: FloatArray, ghosts: int, closed: bool, flip: bool, degree: int
 ) -> FloatArray:
-    """The sequence with ``ghosts`` extra elements on each side (see module doc)."""
+    """Pad a sequence with ``ghosts`` extra elements on each side (see module doc).
+
+    Parameters
+    ----------
+    space : Space
+        The space of the elements (its ``flip`` and ``geodesic``).
+    x : ndarray, shape (N, ...)
+        Encoded elements.
+    ghosts : int
+        Number of extra elements on each side (:attr:`Scheme.ghosts`).
+    closed : bool
+        Periodic copies (True) or extrapolated phantoms (False).
+    flip : bool
+        For closed sequences, flip the copied elements (Möbius band).
+    degree : int
+        For open sequences, degree of the phantom extrapolation
+        (:attr:`Scheme.phantom_degree`; at most N - 1 is used); 0 returns
+        ``x`` unpadded.
+
+    Returns
+    -------
+    extended : ndarray, shape (N + 2 ghosts, ...)
+        ``x`` with its ghosts, or ``x`` itself when nothing is added.
+    """
     if ghosts == 0 or (not closed and degree == 0):
         return x
     n = x.shape[0]
@@ -78,10 +121,33 @@ def refine_sequence(
     flip: bool = False,
     after_step: Callable[[FloatArray], FloatArray] | None = None,
 ) -> FloatArray:
-    """Apply ``steps`` steps of ``scheme`` to encoded elements ``x`` (N, ...).
+    """Apply ``steps`` steps of ``scheme`` to encoded elements.
 
-    ``after_step`` (optional) maps each step's result (the projection
-    algorithm projects onto the line manifold there).
+    Each step extends the sequence (:func:`extend`), applies the scheme's rule
+    and then ``after_step``.
+
+    Parameters
+    ----------
+    space : Space
+        The space of the elements.
+    x : ndarray, shape (N, ...)
+        Encoded elements (:meth:`Space.encode`).
+    scheme : Scheme
+        The subdivision scheme.
+    steps : int
+        Number of refinement steps.
+    closed : bool
+        Whether the sequence is periodic.
+    flip : bool, default False
+        Close with an orientation flip (Möbius band); only with ``closed``.
+    after_step : callable or None, default None
+        Maps each step's result (N', ...) to an array of the same shape; the
+        projection algorithm projects onto the line manifold there (Eq. 4).
+
+    Returns
+    -------
+    refined : ndarray, shape (M, ...)
+        Encoded refined elements (:meth:`Space.decode` gives the elements).
     """
     for _ in range(steps):
         n = x.shape[0]

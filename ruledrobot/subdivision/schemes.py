@@ -22,6 +22,24 @@ four_point (w)       2      yes             C^1 (w<.154)  4 at w = 1/16
 six_point            2      yes             C^2           6
 ternary_four_point   3      yes             C^2 (mu)      3
 ===================  =====  ==============  ============  =====================
+
+The paper uses four_point (its DLG scheme, §2.5 Eq. 9, rewritten as two-point
+averages in §2.7) and chaikin (§2.6 Eq. 10); the others are our additions.
+
+References
+----------
+Odehnal, *Subdivision algorithms for ruled surfaces*, 2008 (the paper).
+Wallner & Dyn, *Convergence and C^1 analysis of subdivision schemes on
+manifolds by proximity*, CAGD 22, 2005.
+Dyn, Levin & Gregory, *A 4-point interpolatory subdivision scheme for curve
+design*, CAGD 4, 1987.
+Chaikin, *An algorithm for high speed curve generation*, CGIP 3, 1974.
+Lane & Riesenfeld, *A theoretical development for the computer generation and
+display of piecewise polynomial surfaces*, IEEE PAMI 2, 1980.
+Deslauriers & Dubuc, *Symmetric iterative interpolation processes*,
+Constructive Approximation 5, 1989.
+Hassan, Ivrissimtzis, Dodgson & Sabin, *An interpolating 4-point C^2 ternary
+stationary subdivision scheme*, CAGD 19, 2002.
 """
 
 from __future__ import annotations
@@ -38,7 +56,19 @@ __all__ = ["SCHEME_NAMES", "Scheme", "get_scheme"]
 
 
 def interleave(*parts: FloatArray) -> FloatArray:
-    """Interleave k arrays along axis 0: a0 b0 c0 a1 b1 c1 ... (the first may be one longer)."""
+    """Interleave k arrays along axis 0: a0 b0 c0 a1 b1 c1 ...
+
+    Parameters
+    ----------
+    *parts : ndarray, shape (n_j, ...)
+        The arrays, with equal trailing shapes; the first may be one longer
+        than the others (the kept old element after the last new one).
+
+    Returns
+    -------
+    out : ndarray, shape (sum n_j, ...)
+        ``out[j::k] = parts[j]``.
+    """
     k = len(parts)
     total = sum(len(p) for p in parts)
     out = np.empty((total, *parts[0].shape[1:]))
@@ -51,12 +81,29 @@ def interleave(*parts: FloatArray) -> FloatArray:
 class Scheme:
     """A subdivision scheme: its rule, arity and what its boundary handling needs.
 
-    * ``rule(space, E, n, closed) -> refined``: one step on extended data.
-    * ``ghosts``: extended elements needed on each side.
-    * ``phantom_degree``: for open sequences, the degree of the geodesic
-      (Neville–Aitken) extrapolation that makes the ghosts; 0 when the scheme
-      has its own end rule and needs no ghosts for open data.
-    * ``min_points``: fewest elements the scheme accepts.
+    Made by :func:`get_scheme`; immutable.
+
+    Attributes
+    ----------
+    name : str
+        One of :data:`SCHEME_NAMES`.
+    arity : int
+        Refinement factor: 2 (binary) or 3 (ternary).
+    interpolatory : bool
+        Whether the old elements are kept.
+    ghosts : int
+        Extended elements the rule needs on each side.
+    phantom_degree : int
+        For open sequences, the degree of the geodesic (Neville–Aitken)
+        extrapolation that makes the ghosts; 0 when the scheme has its own end
+        rule and needs no ghosts for open data.
+    min_points : int
+        Fewest elements the scheme accepts.
+    rule : callable
+        ``rule(space, E, n, closed) -> refined``: one step on extended data
+        ``E`` (n + 2 ghosts, ...) of n encoded elements.
+    params : tuple of (str, float)
+        The scheme's parameters, e.g. ``(("w", 0.0625),)``.
     """
 
     name: str
@@ -69,7 +116,21 @@ class Scheme:
     params: tuple[tuple[str, float], ...] = ()
 
     def refined_length(self, n: int, closed: bool) -> int:
-        """Number of elements after one step on ``n`` elements."""
+        """Count the elements after one step on ``n`` elements.
+
+        Parameters
+        ----------
+        n : int
+            Number of elements before the step.
+        closed : bool
+            Whether the sequence is periodic.
+
+        Returns
+        -------
+        count : int
+            ``arity n`` when closed; otherwise ``arity (n - 1) + 1``
+            (chaikin: ``2 n - 2``).
+        """
         if closed:
             return self.arity * n
         if self.name == "chaikin":
@@ -119,8 +180,9 @@ def _bspline3(space: Space, E: FloatArray, n: int, closed: bool) -> FloatArray:
 
 def _make_four_point(w: float) -> Callable[[Space, FloatArray, int, bool], FloatArray]:
     def rule(space: Space, E: FloatArray, n: int, closed: bool) -> FloatArray:
-        """Dyn–Levin–Gregory: new = (1/2 + w)(p_i + p_{i+1}) - w (p_{i-1} + p_{i+2}),
-        as the paper's three two-point steps: ``mid(g(p_{i-1}, p_i, 1+2w),
+        """Dyn–Levin–Gregory (paper Eq. 9):
+        new = (1/2 + w)(p_i + p_{i+1}) - w (p_{i-1} + p_{i+2}),
+        as the paper's three two-point steps (§2.7): ``mid(g(p_{i-1}, p_i, 1+2w),
         g(p_{i+1}, p_{i+2}, -2w))`` — one logarithm per pair, used twice."""
         s = n if closed else n - 1  # segments
         P = E[1 : 1 + s + 3]  # p_{-1} .. p_{s+1}; pair k = (p_{k-1}, p_k)
@@ -200,12 +262,28 @@ _DLG_C1_LIMIT = (np.sqrt(5.0) - 1.0) / 8.0
 
 
 def get_scheme(name: str, **params: float) -> Scheme:
-    """The scheme called ``name`` (see :data:`SCHEME_NAMES`) with its parameters.
+    """Make the scheme called ``name`` with its parameters.
 
-    ``four_point`` takes ``w`` (default 1/16, allowed 0 <= w < (sqrt 5 - 1)/8,
-    the C^1 range); ``ternary_four_point`` takes ``mu`` (default 1/11, allowed
-    0 <= mu <= 1/9; C^2 for 1/15 < mu < 1/9).  Unknown names or parameters
-    raise ValueError listing what is valid.
+    Parameters
+    ----------
+    name : str
+        One of :data:`SCHEME_NAMES`.
+    **params : float
+        ``four_point`` takes ``w`` (dimensionless, default 1/16, allowed
+        ``0 <= w < (sqrt 5 - 1)/8``, the C^1 range; paper Eq. 9);
+        ``ternary_four_point`` takes ``mu`` (default 1/11, allowed
+        ``0 <= mu <= 1/9``; C^2 for ``1/15 < mu < 1/9``).  The others take none.
+
+    Returns
+    -------
+    scheme : Scheme
+        The scheme with its rule, ghosts and phantom degree.
+
+    Raises
+    ------
+    ValueError
+        For an unknown name or parameter (the message lists what is valid) or
+        a parameter out of its range.
     """
     allowed = {"four_point": {"w"}, "ternary_four_point": {"mu"}}
     if name not in SCHEME_NAMES:
