@@ -158,7 +158,8 @@ def main() -> None:
 
 def bench_calibrated(args: argparse.Namespace, robot, t_ik: float) -> None:
     """All 8 branches of a calibrated arm on the same poses: time, ratio, residuals, rates."""
-    from ruledrobot.robot import calibrated_ik, random_calibration
+    from ruledrobot.robot import random_calibration
+    from ruledrobot.robot.ik import calibrated as calibrated_ik
 
     n = args.n
     cal = random_calibration(robot.name, args.calibration_seed)

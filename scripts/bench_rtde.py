@@ -151,7 +151,7 @@ def runner_latency(host: str, model_name: str, physics: str) -> dict:
     from ruledrobot.export import run_trajectory
     from ruledrobot.io.trajectory import read_trajectory, write_trajectory
     from ruledrobot.robot import load
-    from ruledrobot.robot.trajectory import Trajectory
+    from ruledrobot.robot.motion.trajectory import Trajectory
 
     model = load(model_name)
     t = np.arange(0.0, 3.0, model.control_period)

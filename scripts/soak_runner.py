@@ -129,7 +129,7 @@ def main() -> int:
 
     from ruledrobot.io.trajectory import write_trajectory
     from ruledrobot.robot import load
-    from ruledrobot.robot.trajectory import Trajectory
+    from ruledrobot.robot.motion.trajectory import Trajectory
     from ruledrobot.ursim import DEFAULT_Q, Emulator
     from tests.support.faultproxy import FaultProxy
 

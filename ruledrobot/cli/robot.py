@@ -389,7 +389,7 @@ def calibration_show(path: Path = typer.Argument(..., help="Calibration file."))
 def _show_calibration(cal) -> None:
     import numpy as np
 
-    from ..robot.calibration import calibration_deviations
+    from ..robot.arm.calibration import calibration_deviations
 
     dev = calibration_deviations(cal)
     lines = [repr(cal)]

@@ -17,7 +17,7 @@ import os
 from pathlib import Path
 
 from ..io.trajectory import WouldReplace, check_export_targets, export_targets
-from ..robot.trajectory import Trajectory
+from ..robot.motion.trajectory import Trajectory
 from .limits import check_trajectory
 from .run_plan import recording_path_for
 from .runner import ControllerError, RunMode, RunPlan, RunResult, run_trajectory

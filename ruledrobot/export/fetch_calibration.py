@@ -7,7 +7,7 @@ What ``ruledrobot calibration fetch --host H --out robot.calib.json`` does.
 from __future__ import annotations
 
 from ..protocol.primary import PRIMARY_PORT, read_kinematics_info
-from ..robot.calibration import Calibration
+from ..robot.arm.calibration import Calibration
 from .run_checks import query_dashboard
 
 __all__ = ["fetch_calibration"]

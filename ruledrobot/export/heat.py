@@ -1,7 +1,7 @@
 """Switching the hot wire through the robot's IO, in the three ways a run or a program
 does it.
 
-A trajectory's :class:`~ruledrobot.robot.trajectory.Heat` names the output (standard,
+A trajectory's :class:`~ruledrobot.robot.motion.trajectory.Heat` names the output (standard,
 configurable or tool digital output, or a standard analog output at a fraction of its
 range) and the sample ranges with the heat on.
 
@@ -18,7 +18,7 @@ from __future__ import annotations
 import socket
 from typing import Any
 
-from ..robot.trajectory import Heat
+from ..robot.motion.trajectory import Heat
 
 __all__ = ["heat_off_program", "send_heat_off", "set_heat_rtde", "urscript_heat"]
 

@@ -1,8 +1,8 @@
 """Checks of a joint trajectory against a robot's limits, before anything moves.
 
 The first sample that breaks a limit is named (the planner's report,
-:func:`ruledrobot.robot.rates.trajectory_limits_report`, gives the worst one; both
-difference the samples with :func:`ruledrobot.robot.rates.finite_difference_rates`).
+:func:`ruledrobot.robot.motion.rates.trajectory_limits_report`, gives the worst one; both
+difference the samples with :func:`ruledrobot.robot.motion.rates.finite_difference_rates`).
 
 Speeds and accelerations are finite differences of the samples (the way the
 controller will see them when the samples are streamed one per period):
@@ -15,8 +15,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..robot import RobotModel
-from ..robot.rates import finite_difference_rates
-from ..robot.trajectory import Trajectory
+from ..robot.motion.rates import finite_difference_rates
+from ..robot.motion.trajectory import Trajectory
 
 __all__ = ["check_trajectory"]
 

@@ -21,8 +21,8 @@ from enum import IntEnum
 import numpy as np
 
 from ..protocol.modes import RobotMode, SafetyMode
-from ..robot.trajectory import KinematicsRef, TrajectoryMeta
-from ..robot.ur_tables import nominal_dh
+from ..robot.arm.ur_tables import nominal_dh
+from ..robot.motion.trajectory import KinematicsRef, TrajectoryMeta
 from ..robot.verdict import Check
 
 __all__ = [

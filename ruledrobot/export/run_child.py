@@ -34,7 +34,7 @@ from multiprocessing.connection import Connection
 
 import numpy as np
 
-from ..robot.trajectory import Heat
+from ..robot.motion.trajectory import Heat
 from .run_motion import approach, preheat, run_program, stream
 from .run_session import Link, Session, SessionError, Stop
 

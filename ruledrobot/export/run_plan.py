@@ -36,7 +36,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..robot.trajectory import Trajectory
+from ..robot.motion.trajectory import Trajectory
 from ..robot.verdict import Check
 
 __all__ = [

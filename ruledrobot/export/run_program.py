@@ -26,9 +26,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..robot.trajectory import Heat, Trajectory
+from ..robot.motion.trajectory import Heat, Trajectory
 from ..robot.verdict import Check
-from ..robot.wire_cut import FeedWindow, WireCut
+from ..robot.wire.cut import FeedWindow, WireCut
 from .urscript import path_program
 from .verify_program import Move, Op, ProgramCheck, Sleep, Switch, check_path_program
 

@@ -6,7 +6,7 @@ import shlex
 from pathlib import Path
 from typing import Any
 
-from ..robot.trajectory import Trajectory
+from ..robot.motion.trajectory import Trajectory
 from .run_plan import inside_mask
 
 __all__ = ["RunProgress", "resume_command"]

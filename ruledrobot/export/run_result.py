@@ -8,7 +8,7 @@ from enum import Enum
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from ..robot.trajectory import KinematicsRef, Trajectory
+from ..robot.motion.trajectory import KinematicsRef, Trajectory
 from ..robot.verdict import Check, Verdict
 from .run_plan import Entry, StopPlace
 

@@ -28,7 +28,7 @@ from typing import Any
 
 import numpy as np
 
-from ..robot.trajectory import Heat
+from ..robot.motion.trajectory import Heat
 from .heat import set_heat_rtde
 
 __all__ = ["CHUNK", "Link", "Session", "SessionError", "Stop"]

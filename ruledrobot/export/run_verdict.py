@@ -1,5 +1,5 @@
 """A run's verdict from what the robot did: the recording measured by the one model of the
-wire against the block (:mod:`ruledrobot.robot.wire_in_stock`, :mod:`~ruledrobot.robot.wire_cut`).
+wire against the block (:mod:`ruledrobot.robot.wire.in_stock`, :mod:`~ruledrobot.robot.wire.cut`).
 
 After the motion the runner has the recording (the controller's actual joints) and, per
 recorded sample, the plan sample the live deviation match put it at (the child tags
@@ -7,9 +7,9 @@ each sample; the samples recorded while the arm settled after a stop are matched
 the same way, nearest in joint space near the last match).  From them:
 
 * the **actual wire**: forward kinematics of the recorded joints with the trajectory's
-  own model (:func:`~ruledrobot.robot.trajectory.model_for`: its kinematics, its TCP,
+  own model (:func:`~ruledrobot.robot.motion.trajectory.model_for`: its kinematics, its TCP,
   no base) — the TCP is the wire's midpoint with z along the wire;
-* **feed** (``feed_max:NAME``, ``feed_min:NAME``): :func:`~ruledrobot.robot.wire_cut.feed_measures`
+* **feed** (``feed_max:NAME``, ``feed_min:NAME``): :func:`~ruledrobot.robot.wire.cut.feed_measures`
   of the actual wire against the trajectory's cut (``meta.cut``), whose feed windows
   (plan samples) are carried over to the recorded samples matched into them; the set
   speed scales with the run's ``speed_scale``;
@@ -35,10 +35,10 @@ from typing import Any
 
 import numpy as np
 
-from ..robot.trajectory import Trajectory, model_for
+from ..robot.motion.trajectory import Trajectory, model_for
 from ..robot.verdict import Check, Verdict
-from ..robot.wire_cut import FeedMeasure, FeedWindow, WireCut, feed_measures
-from ..robot.wire_in_stock import runs_of, wire_ends
+from ..robot.wire.cut import FeedMeasure, FeedWindow, WireCut, feed_measures
+from ..robot.wire.in_stock import runs_of, wire_ends
 from .run_plan import inside_mask
 from .urscript import plan_wire_tolerance
 

@@ -43,7 +43,7 @@ import numpy as np
 from ..io.atomic import atomic_write_text
 from ..io.trajectory import read_trajectory, sidecar_path, write_trajectory
 from ..robot import RobotModel, load, model_for
-from ..robot.trajectory import Trajectory
+from ..robot.motion.trajectory import Trajectory
 from ..robot.verdict import Check, Verdict
 from .heat import send_heat_off
 from .limits import check_trajectory

@@ -51,7 +51,7 @@ from ..geometry.se3 import ur_vector_from_pose
 from ..io.atomic import atomic_write_text
 from ..io.trajectory import write_trajectory, write_trajectory_json, write_trajectory_npz
 from ..robot import model_for
-from ..robot.trajectory import Trajectory
+from ..robot.motion.trajectory import Trajectory
 from .decimate import path_steps
 from .heat import urscript_heat
 from .limits import check_trajectory

@@ -4,11 +4,11 @@ A path program (:func:`~.urscript.urscript_program` with ``mode="movel"`` or ``"
 replaces the plan's samples by linear moves with UR's speed, acceleration and blend
 semantics.  Before the program is written its motion is generated, one setpoint per
 control period, by the same trajectory generator the emulator runs
-(:mod:`ruledrobot.robot.ur_motion`: trapezoidal profiles, blends, IK nearest the
-previous sample, with :class:`~ruledrobot.robot.arm_kinematics.ArmKinematics` of the
+(:mod:`ruledrobot.robot.motion.ur_motion`: trapezoidal profiles, blends, IK nearest the
+previous sample, with :class:`~ruledrobot.robot.motion.arm_kinematics.ArmKinematics` of the
 trajectory's robot and TCP) and measured with the one model of the wire against the
-block (:meth:`WireCut.measure <ruledrobot.robot.wire_cut.WireCut.measure>`,
-:func:`~ruledrobot.robot.wire_cut.feed_measures`):
+block (:meth:`WireCut.measure <ruledrobot.robot.wire.cut.WireCut.measure>`,
+:func:`~ruledrobot.robot.wire.cut.feed_measures`):
 
 * **feed** per cut: the highest cutting speed in the stock and the lowest where the
   plan holds the feed, against the plan's ``speed · (1 ± tolerance)``; the plan's feed
@@ -34,11 +34,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..robot.arm_kinematics import ArmKinematics
-from ..robot.trajectory import Trajectory, model_for, runs
-from ..robot.ur_motion import PathMotion, Segment, joint_segment, linear_segment
-from ..robot.wire_cut import FeedMeasure, FeedWindow, WireCut, feed_measures
-from ..robot.wire_in_stock import wire_ends
+from ..robot.motion.arm_kinematics import ArmKinematics
+from ..robot.motion.trajectory import Trajectory, model_for, runs
+from ..robot.motion.ur_motion import PathMotion, Segment, joint_segment, linear_segment
+from ..robot.wire.cut import FeedMeasure, FeedWindow, WireCut, feed_measures
+from ..robot.wire.in_stock import wire_ends
 
 __all__ = [
     "MATCH_WINDOW",
@@ -164,7 +164,7 @@ def simulate_path_program(
     """The joint setpoints ``(t, q)`` of a path program's ``ops`` on ``traj``'s robot with
     its TCP, one per control period from rest at ``q0`` (default the first sample), as
     the controller generates them: consecutive moves with ``r > 0`` form one blended
-    path (:class:`~ruledrobot.robot.ur_motion.PathMotion`), a move with ``r = 0`` or any
+    path (:class:`~ruledrobot.robot.motion.ur_motion.PathMotion`), a move with ``r = 0`` or any
     other statement ends it; a sleep holds for whole periods."""
     model = model_for(traj.meta)
     kin = ArmKinematics(model)

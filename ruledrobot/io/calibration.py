@@ -22,7 +22,7 @@ import os
 from pathlib import Path
 from typing import Any
 
-from ..robot.calibration import _COLUMNS, Calibration, CalibrationError, _column
+from ..robot.arm.calibration import _COLUMNS, Calibration, CalibrationError, _column
 from .atomic import atomic_write_text
 
 __all__ = ["CALIBRATION_FORMAT", "load_calibration", "save_calibration"]

@@ -49,8 +49,15 @@ import numpy as np
 
 from ..geometry.box import Box
 from ..geometry.se3 import pose_from_rotvec, rotvec_from_matrix
-from ..robot.trajectory import Heat, KinematicsRef, Payload, Phase, Trajectory, TrajectoryMeta
-from ..robot.wire_cut import FeedWindow, WireCut
+from ..robot.motion.trajectory import (
+    Heat,
+    KinematicsRef,
+    Payload,
+    Phase,
+    Trajectory,
+    TrajectoryMeta,
+)
+from ..robot.wire.cut import FeedWindow, WireCut
 from .atomic import atomic_write_bytes, atomic_write_text
 from .text import read_user_text
 

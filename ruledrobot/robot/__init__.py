@@ -21,14 +21,14 @@ from __future__ import annotations
 from numpy.typing import ArrayLike
 
 from ._checks import FloatArray
-from .analytic_ik import IKSolutions, URGeometry, wrap_angle
-from .calibrated_ik import CalibratedIKSolutions
-from .calibration import Calibration, CalibrationBounds, CalibrationError
-from .calibration_random import random_calibration
-from .catalogue import MODEL_NAMES, load
-from .model import DEFAULT_ACCELERATION, RobotModel
-from .path import PathIKResult, PathStatus, path_ik
-from .trajectory import KinematicsRef, Payload, Phase, Trajectory, TrajectoryMeta, model_for
+from .arm.calibration import Calibration, CalibrationBounds, CalibrationError
+from .arm.calibration_random import random_calibration
+from .arm.catalogue import MODEL_NAMES, load
+from .arm.model import DEFAULT_ACCELERATION, RobotModel
+from .ik.analytic import IKSolutions, URGeometry, wrap_angle
+from .ik.calibrated import CalibratedIKSolutions
+from .ik.path import PathIKResult, PathStatus, path_ik
+from .motion.trajectory import KinematicsRef, Payload, Phase, Trajectory, TrajectoryMeta, model_for
 
 __all__ = [
     "DEFAULT_ACCELERATION",

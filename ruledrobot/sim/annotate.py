@@ -10,7 +10,7 @@ motion with:
 * the **trail** of the wire's middle (the TCP), a line that stays, coloured by
   phase;
 * a **caption**: time, phase and feed (the speed of the fastest wire point in
-  the stock, :mod:`ruledrobot.robot.wire_in_stock`, the one model);
+  the stock, :mod:`ruledrobot.robot.wire.in_stock`, the one model);
 * while the wire cuts (phases lead-in, cut, lead-out, or in the stock when the
   phases are not given) a **close-up** of the wire inset in the lower right
   corner, seen from the side of the cut surface facing the main camera.
@@ -31,7 +31,7 @@ import numpy as np
 from ..geometry._arrays import FloatArray
 from ..geometry.box import Box
 from ..geometry.interp import interp_linear
-from ..robot.wire_in_stock import chord_fractions, wire_in_stock
+from ..robot.wire.in_stock import chord_fractions, wire_in_stock
 
 __all__ = ["CUTTING_PHASES", "CutAnnotator", "phase_labels"]
 

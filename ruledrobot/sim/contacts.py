@@ -14,7 +14,7 @@ import numpy as np
 
 from ..geometry.box import Box
 from ..geometry.checks import FloatArray
-from ..robot.model import RobotModel
+from ..robot.arm.model import RobotModel
 from .scene import BowTool
 
 __all__ = ["Collision", "ProgressCallback"]

@@ -13,7 +13,7 @@ from pathlib import Path
 from typing import Any
 
 from ..geometry.checks import FloatArray
-from ..robot.model import RobotModel
+from ..robot.arm.model import RobotModel
 from .playback import PlaybackResult, ProgressCallback, play
 from .scene import Scene
 
@@ -46,7 +46,7 @@ def play_file(
     """
     from ..io.trajectory import read_trajectory
     from ..robot import model_for
-    from ..robot.trajectory import KinematicsRef
+    from ..robot.motion.trajectory import KinematicsRef
 
     traj = read_trajectory(path)
     planned = model_for(traj.meta)

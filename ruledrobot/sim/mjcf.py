@@ -41,8 +41,8 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ..geometry.checks import FloatArray, as_per_joint
-from ..robot.model import RobotModel
-from ..robot.shape import Segment, dh_tail, link_radii, link_segments, rot_z
+from ..robot.arm.model import RobotModel
+from ..robot.arm.shape import Segment, dh_tail, link_radii, link_segments, rot_z
 from ._xml import placed, sub, to_string
 
 __all__ = [

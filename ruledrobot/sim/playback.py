@@ -39,7 +39,7 @@ from numpy.typing import ArrayLike
 
 from ..geometry.checks import FloatArray, as_float_array
 from ..geometry.interp import interp_hermite
-from ..robot.model import RobotModel
+from ..robot.arm.model import RobotModel
 from ._mujoco import mujoco
 from .contacts import Collision, ProgressCallback, _detect_collisions, _geom_reach, _wire
 from .mjcf import ServoGains, physics_timestep, robot_mjcf

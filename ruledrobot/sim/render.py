@@ -31,7 +31,7 @@ from numpy.typing import ArrayLike
 from ..geometry.checks import FloatArray
 from ..geometry.interp import interp_linear
 from ..io.atomic import atomic_write_bytes
-from ..robot.model import RobotModel
+from ..robot.arm.model import RobotModel
 from ._mujoco import INSTALL_HINT, RenderUnavailable, mujoco
 from .scene import Scene
 

@@ -15,7 +15,7 @@ import numpy as np
 from ..geometry import se3
 from ..geometry.checks import FloatArray
 from ..io.atomic import atomic_open, atomic_write_text
-from ..robot.model import RobotModel
+from ..robot.arm.model import RobotModel
 from ..robot.verdict import Check, Verdict
 from .contacts import Collision
 from .mjcf import ServoGains
@@ -229,7 +229,7 @@ class PlaybackResult:
             paths.update(self.plot(out))
         if trajectory and self.robot.n_joints == 6:
             from ..io.trajectory import write_trajectory
-            from ..robot.trajectory import Trajectory, TrajectoryMeta
+            from ..robot.motion.trajectory import Trajectory, TrajectoryMeta
 
             base_inv = se3.inverse(np.asarray(self.robot.base))
             meta = TrajectoryMeta.for_model(

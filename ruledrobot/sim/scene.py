@@ -30,8 +30,8 @@ from numpy.typing import ArrayLike
 from ..geometry.box import Box
 from ..geometry.checks import FloatArray
 from ..robot._checks import as_point
-from ..robot.model import RobotModel
-from ..robot.shape import link_radii
+from ..robot.arm.model import RobotModel
+from ..robot.arm.shape import link_radii
 from ..robot.tool import BowTool
 from ._xml import placed, sub, to_string
 from .mjcf import ServoGains, build_robot

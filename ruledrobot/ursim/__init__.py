@@ -15,8 +15,8 @@ control-script register protocol), ``script_runner`` (standalone programs),
 :func:`serve`), ``process`` (:class:`Emulator`: the emulator in a child
 process, so that a ur_rtde client in this process does not deadlock it).  The
 trajectory generator (moveJ/moveL/movep with blends, stops) and the per-tick kinematics
-are the robot layer's :mod:`ruledrobot.robot.ur_motion` and
-:mod:`ruledrobot.robot.arm_kinematics`, shared with the verification of exported programs.
+are the robot layer's :mod:`ruledrobot.robot.motion.ur_motion` and
+:mod:`ruledrobot.robot.motion.arm_kinematics`, shared with the verification of exported programs.
 """
 
 from __future__ import annotations

@@ -45,8 +45,8 @@ from numpy.typing import ArrayLike
 
 from ..protocol.modes import JointMode, RobotMode, RuntimeState, SafetyMode, SafetyStatusBit
 from ..robot import RobotModel
-from ..robot.arm_kinematics import ArmKinematics
-from ..robot.ur_motion import (
+from ..robot.motion.arm_kinematics import ArmKinematics
+from ..robot.motion.ur_motion import (
     MotionError,
     PathMotion,
     Segment,

@@ -12,7 +12,7 @@ from threading import RLock
 from typing import Any
 
 from ..protocol.modes import RobotMode, SafetyMode
-from ..robot.ur_motion import StopMotion
+from ..robot.motion.ur_motion import StopMotion
 
 __all__ = ["SafetyMixin"]
 

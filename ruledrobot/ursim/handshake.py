@@ -38,7 +38,13 @@ from enum import IntEnum
 import numpy as np
 
 from ..geometry.se3 import pose_from_ur_vector, ur_vector_from_pose
-from ..robot.ur_motion import MotionError, PathMotion, StopMotion, joint_segment, linear_segment
+from ..robot.motion.ur_motion import (
+    MotionError,
+    PathMotion,
+    StopMotion,
+    joint_segment,
+    linear_segment,
+)
 from .host import ProgramHost
 from .program import Program
 

@@ -18,8 +18,8 @@ from typing import Protocol
 
 from numpy.typing import ArrayLike
 
-from ..robot.arm_kinematics import ArmKinematics
-from ..robot.ur_motion import PathMotion, StopMotion
+from ..robot.motion.arm_kinematics import ArmKinematics
+from ..robot.motion.ur_motion import PathMotion, StopMotion
 from .backend import ArmState
 from .program import PathWaypoint
 

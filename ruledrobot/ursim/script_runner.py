@@ -31,7 +31,7 @@ import math
 
 import numpy as np
 
-from ..robot.ur_motion import (
+from ..robot.motion.ur_motion import (
     MotionError,
     PathMotion,
     Segment,

@@ -33,7 +33,7 @@ from ..io.mesh import read_stl
 from ..io.outdir import read_manifest
 from ..io.paths import input_path
 from ..io.text import read_user_text
-from ..robot.trajectory import Trajectory
+from ..robot.motion.trajectory import Trajectory
 from ..robot.verdict import Check
 
 if sys.version_info >= (3, 11):

@@ -30,11 +30,11 @@ import numpy as np
 from ..geometry._arrays import FloatArray
 from ..geometry.box import Box
 from ..geometry.mesh import Mesh
-from ..robot.model import RobotModel
-from ..robot.rates import finite_difference_rates
-from ..robot.trajectory import KinematicsRef, model_for
+from ..robot.arm.model import RobotModel
+from ..robot.motion.rates import finite_difference_rates
+from ..robot.motion.trajectory import KinematicsRef, model_for
 from ..robot.verdict import Check
-from ..robot.wire_in_stock import chord_fractions, wire_in_stock
+from ..robot.wire.in_stock import chord_fractions, wire_in_stock
 from ..sim._mujoco import mujoco
 from ..sim.scene import Scene, default_camera
 from .clearance import Event, contacts_along, locate, near_misses

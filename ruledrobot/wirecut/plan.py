@@ -18,10 +18,10 @@ from pathlib import Path
 import numpy as np
 
 from ..geometry.checks import FloatArray
-from ..robot.rates import trajectory_limits_report
+from ..robot.motion.rates import trajectory_limits_report
+from ..robot.motion.trajectory import Heat, Trajectory, phases_from_labels, runs
 from ..robot.tool import BowTool
-from ..robot.trajectory import Heat, Trajectory, phases_from_labels, runs
-from ..robot.wire_cut import FeedWindow, WireCut
+from ..robot.wire.cut import FeedWindow, WireCut
 from .cut.order import check_cut_order
 from .cut.passes import CutPath, cut_paths
 from .cut.wire_geometry import distance_from_rulings

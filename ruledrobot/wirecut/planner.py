@@ -26,7 +26,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..io.outdir import StagedFolder
-from ..robot.trajectory import Trajectory
+from ..robot.motion.trajectory import Trajectory
 from ..robot.verdict import Verdict
 from .cut.passes import CutPath
 from .job.spec import Job

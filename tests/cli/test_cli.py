@@ -93,7 +93,7 @@ def test_chain_command_writes_mjcf_whose_axes_are_the_lines(tmp_path, rng):
 
 def test_simulate_command_reports_tracking(tmp_path):
     from ruledrobot.io.trajectory import write_trajectory
-    from ruledrobot.robot.trajectory import Trajectory
+    from ruledrobot.robot.motion.trajectory import Trajectory
 
     model = rr.robot.load("ur5e")
     t = np.arange(0, 1.0, 0.002)
@@ -107,7 +107,7 @@ def test_simulate_command_reports_tracking(tmp_path):
 
 def _small_trajectory(tmp_path):
     from ruledrobot.io.trajectory import write_trajectory
-    from ruledrobot.robot.trajectory import Trajectory
+    from ruledrobot.robot.motion.trajectory import Trajectory
 
     model = rr.robot.load("ur5e").with_tool([0, 0, 0.1, 0, 0, 0])
     t = np.arange(0, 0.6, 0.002)

@@ -10,7 +10,7 @@ import pytest
 from ruledrobot.export import run_trajectory
 from ruledrobot.io.trajectory import read_trajectory, write_trajectory
 from ruledrobot.robot import load
-from ruledrobot.robot.trajectory import Trajectory
+from ruledrobot.robot.motion.trajectory import Trajectory
 from ruledrobot.ursim.physics import MujocoBackend
 from tests.support.emulators import start_emulator
 

@@ -14,7 +14,7 @@ import pytest
 from ruledrobot.export import RunPlan, run_trajectory
 from ruledrobot.export.run_checks import ControllerInfo, controller_checks, query_dashboard
 from ruledrobot.robot import load
-from ruledrobot.robot.trajectory import TrajectoryMeta
+from ruledrobot.robot.motion.trajectory import TrajectoryMeta
 from ruledrobot.ursim import DEFAULT_Q, Emulator
 from tests.support.emulators import smooth_trajectory
 

@@ -19,8 +19,8 @@ from ruledrobot.cli import app
 from ruledrobot.export import run_trajectory
 from ruledrobot.export.run_program import plan_path_run, run_slice
 from ruledrobot.io.trajectory import write_trajectory
-from ruledrobot.robot.trajectory import Heat, Phase, Trajectory
-from ruledrobot.robot.wire_cut import FeedWindow, WireCut
+from ruledrobot.robot.motion.trajectory import Heat, Phase, Trajectory
+from ruledrobot.robot.wire.cut import FeedWindow, WireCut
 from ruledrobot.wirecut.job.demo import DEMO_JOB
 from ruledrobot.wirecut.job.load import load_job
 from ruledrobot.wirecut.planner import plan

@@ -16,7 +16,7 @@ from ruledrobot.export.run_plan import (
     stop_place,
 )
 from ruledrobot.robot import load
-from ruledrobot.robot.trajectory import Phase, Trajectory
+from ruledrobot.robot.motion.trajectory import Phase, Trajectory
 from ruledrobot.ursim import DEFAULT_Q
 
 #: the phases of :func:`cut_trajectory` (sample ranges) and its one in-stock run

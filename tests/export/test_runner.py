@@ -18,7 +18,7 @@ import pytest
 from ruledrobot.export import ControllerError, RunResult, run_trajectory
 from ruledrobot.io.trajectory import read_trajectory, write_trajectory
 from ruledrobot.robot import load
-from ruledrobot.robot.trajectory import Trajectory
+from ruledrobot.robot.motion.trajectory import Trajectory
 from ruledrobot.ursim import DEFAULT_Q, Emulator, KinematicBackend
 from tests.support.emulators import smooth_trajectory, start_emulator
 

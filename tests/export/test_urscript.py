@@ -12,7 +12,7 @@ from ruledrobot.export import export_trajectory, urscript_program
 from ruledrobot.geometry.se3 import pose_from_ur_vector
 from ruledrobot.io.trajectory import read_trajectory
 from ruledrobot.robot import load, model_for
-from ruledrobot.robot.trajectory import Payload, Trajectory
+from ruledrobot.robot.motion.trajectory import Payload, Trajectory
 from ruledrobot.ursim import Emulator
 from ruledrobot.ursim.program import Pose, parse_call
 from tests.support.emulators import smooth_trajectory

@@ -11,7 +11,7 @@ import pytest
 import ruledrobot as rr
 from ruledrobot.export import export_trajectory
 from ruledrobot.io.trajectory import read_trajectory, sidecar_path, write_trajectory
-from ruledrobot.robot.trajectory import Payload, Phase, Trajectory
+from ruledrobot.robot.motion.trajectory import Payload, Phase, Trajectory
 
 
 def _traj(tool=(0.0, 0.0, 0.25, 0.0, 0.3, 0.0), n: int = 50) -> Trajectory:

@@ -1,4 +1,4 @@
-"""The compiled calibrated IK (robot/_calibrated_kernel.py): seeds, sines, lanes, properties."""
+"""The compiled calibrated IK (robot/ik/_calibrated_kernel.py): seeds, sines, lanes, properties."""
 
 from __future__ import annotations
 
@@ -7,8 +7,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from ruledrobot.robot import MODEL_NAMES, load, random_calibration
-from ruledrobot.robot import calibrated_ik as cik
-from ruledrobot.robot.analytic_ik import wrap_angle
+from ruledrobot.robot.ik import calibrated as cik
+from ruledrobot.robot.ik.analytic import wrap_angle
 
 from .test_calibration_ik import flags, residuals
 
@@ -18,7 +18,7 @@ TOL = 1e-10
 def test_lane_sines_and_cosines_are_libm_to_an_ulp() -> None:
     import numba as nb
 
-    from ruledrobot.robot import _calibrated_kernel as k
+    from ruledrobot.robot.ik import _calibrated_kernel as k
 
     @nb.njit
     def run(x: np.ndarray) -> np.ndarray:
@@ -110,7 +110,7 @@ def test_small_batches_do_not_load_numba() -> None:
 import sys
 import numpy as np
 from ruledrobot.robot import load, random_calibration
-from ruledrobot.robot import calibrated_ik as cik
+from ruledrobot.robot.ik import calibrated as cik
 m = load("ur5e", calibration=random_calibration("ur5e", 2))
 T = m.fk(np.random.default_rng(0).uniform(-3, 3, (cik.NUMPY_POSES + 1, 6)))
 q = m.ik(T[:-1])

@@ -18,8 +18,8 @@ from ruledrobot.robot import (
     load,
     random_calibration,
 )
-from ruledrobot.robot.calibration import calibration_deviations, zero_frames
-from ruledrobot.robot.calibration_random import dh_from_axes
+from ruledrobot.robot.arm.calibration import calibration_deviations, zero_frames
+from ruledrobot.robot.arm.calibration_random import dh_from_axes
 
 from .helpers import dh_fk_reference
 

@@ -20,7 +20,7 @@ from ruledrobot.robot import (
     load,
     random_calibration,
 )
-from ruledrobot.robot import calibrated_ik as cik
+from ruledrobot.robot.ik import calibrated as cik
 
 from .helpers import angle_diff, solutions_contain
 from .test_calibration import REAL, real_calibration

@@ -12,7 +12,8 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from ruledrobot.geometry import se3
-from ruledrobot.robot import MODEL_NAMES, IKSolutions, RobotModel, analytic_ik, load
+from ruledrobot.robot import MODEL_NAMES, IKSolutions, RobotModel, load
+from ruledrobot.robot.ik import analytic as analytic_ik
 
 from .helpers import angle_diff, pose_error, random_poses, solutions_contain
 

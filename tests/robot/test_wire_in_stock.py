@@ -10,8 +10,8 @@ from hypothesis import strategies as st
 
 from ruledrobot.geometry import se3
 from ruledrobot.geometry.box import Box
-from ruledrobot.robot.wire_cut import FeedWindow, WireCut, feed_measures
-from ruledrobot.robot.wire_in_stock import (
+from ruledrobot.robot.wire.cut import FeedWindow, WireCut, feed_measures
+from ruledrobot.robot.wire.in_stock import (
     TOUCH,
     feed_chord,
     wire_ends,

@@ -1,4 +1,4 @@
-"""How far a pose misses a UR arm's reach (robot.workspace), checked against the IK."""
+"""How far a pose misses a UR arm's reach (robot.ik.workspace), checked against the IK."""
 
 from __future__ import annotations
 
@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from ruledrobot.robot import load
-from ruledrobot.robot.workspace import elbow_distance, reach_excess, reach_margin
+from ruledrobot.robot.ik.workspace import elbow_distance, reach_excess, reach_margin
 
 
 @pytest.mark.parametrize("name", ["ur3e", "ur5e", "ur10e"])

@@ -188,7 +188,7 @@ def test_progress_and_errors():
 def test_trajectory_file_and_simulate(tmp_path):
     """A trajectory file of a robot with a TCP: the robot and TCP come from its metadata,
     and simulate() writes the report and plots (the CLI's `ruledrobot simulate`)."""
-    from ruledrobot.robot.trajectory import Trajectory
+    from ruledrobot.robot.motion.trajectory import Trajectory
 
     robot = load("ur10e").with_tool([0.02, 0.0, 0.2, 0.0, 0.3, 0.0])
     t, q, _ = smooth_trajectory(1.0, q0=(0.0, -1.4, 1.2, -1.4, -1.57, 0.0))

@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 
 from ruledrobot.robot import load
-from ruledrobot.robot.trajectory import Trajectory
+from ruledrobot.robot.motion.trajectory import Trajectory
 from ruledrobot.ursim import DEFAULT_Q, Emulator
 
 #: hard limit per test [s]

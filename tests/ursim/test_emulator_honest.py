@@ -20,7 +20,7 @@ import pytest
 
 from ruledrobot.export import urscript_program
 from ruledrobot.robot import load
-from ruledrobot.robot.trajectory import Payload, Trajectory
+from ruledrobot.robot.motion.trajectory import Payload, Trajectory
 from ruledrobot.ursim import DEFAULT_Q, Emulator
 from ruledrobot.ursim.controller import Controller
 from tests.support.emulators import UR, smooth_trajectory

@@ -19,8 +19,8 @@ from ruledrobot.protocol.rtde import (
 )
 from ruledrobot.protocol.rtde_types import TYPE_SIZES, input_type, output_type
 from ruledrobot.robot import load
-from ruledrobot.robot.arm_kinematics import ArmKinematics
-from ruledrobot.robot.ur_motion import (
+from ruledrobot.robot.motion.arm_kinematics import ArmKinematics
+from ruledrobot.robot.motion.ur_motion import (
     PathMotion,
     Profile,
     StopMotion,

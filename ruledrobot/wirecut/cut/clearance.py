@@ -14,7 +14,7 @@ import numpy as np
 from ...geometry.box import Box
 from ...geometry.checks import FloatArray
 from ...geometry.segments import segment_distance
-from ...robot.shape import arm_capsules
+from ...robot.arm.shape import arm_capsules
 from ...robot.tool import BowTool
 from ..job.spec import ToolSpec
 from .wire_geometry import wire_frame
@@ -56,7 +56,7 @@ def clearance(cell: Cell, q: FloatArray, P: FloatArray) -> dict[str, np.ndarray]
     """Per configuration (...): which clearance rule it breaks (dict of bool arrays).
 
     ``q`` (..., 6) joints and ``P`` (..., 4, 4) their flange poses.  The arm is the
-    MuJoCo model's own link geometry as capsules (:func:`ruledrobot.robot.shape.arm_capsules`:
+    MuJoCo model's own link geometry as capsules (:func:`ruledrobot.robot.arm.shape.arm_capsules`:
     housings and tubes, the UR's side offset included), the bow rods have the
     simulated bow's rod radius.  The wire inside the stock is the cut, not a collision.
     """

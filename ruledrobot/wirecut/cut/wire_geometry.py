@@ -29,7 +29,7 @@ from ...geometry import se3
 from ...geometry.box import Box
 from ...geometry.checks import FloatArray
 from ...robot.tool import BowTool
-from ...robot.wire_in_stock import across_speeds, feed_chord, wire_ends
+from ...robot.wire.in_stock import across_speeds, feed_chord, wire_ends
 from ..job.spec import ToolSpec
 
 __all__ = [
@@ -156,8 +156,8 @@ def speed_factor(
 
     ``flange`` (M, 4, 4) flange poses along the path at parameters ``path_s`` (M,).
     The chord and the speed across the wire come from the one model of the wire
-    against the block (:func:`ruledrobot.robot.wire_in_stock.feed_chord`,
-    :func:`~ruledrobot.robot.wire_in_stock.across_speeds`): where the wire is outside
+    against the block (:func:`ruledrobot.robot.wire.in_stock.feed_chord`,
+    :func:`~ruledrobot.robot.wire.in_stock.across_speeds`): where the wire is outside
     but near the block, its point nearest the block, so that the bound meets the
     chord's without a jump as the wire enters and leaves.  0 further away.
     """

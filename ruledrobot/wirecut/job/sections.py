@@ -16,7 +16,7 @@ import numpy as np
 from ...geometry import se3
 from ...geometry.box import Box
 from ...io.paths import input_path, missing_file
-from ...robot.calibration import Calibration
+from ...robot.arm.calibration import Calibration
 from ...subdivision.schemes import SCHEME_NAMES
 from .spec import HeatSpec, RobotSpec, SurfaceSpec
 
@@ -237,7 +237,7 @@ def parse_stock(st: Section) -> Box:
 def parse_robot(r: Section, base_dir: Path | None) -> RobotSpec:
     """``[robot]`` -> :class:`.spec.RobotSpec` (the calibration file read and checked)."""
     from ...robot import MODEL_NAMES
-    from ...robot.ur_tables import canonical_name
+    from ...robot.arm.ur_tables import canonical_name
 
     raw = r.get("model", "ur5e")
     try:

@@ -14,7 +14,7 @@ import numpy as np
 
 from ...geometry.box import Box
 from ...geometry.lines import Lines
-from ...robot.calibration import Calibration
+from ...robot.arm.calibration import Calibration
 
 __all__ = ["CutSpec", "HeatSpec", "Job", "RobotSpec", "SurfaceSpec", "ToolSpec"]
 

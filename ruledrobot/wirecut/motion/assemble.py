@@ -27,7 +27,7 @@ import numpy as np
 from ...geometry.angles import wrap_near
 from ...geometry.checks import FloatArray
 from ...robot.tool import BowTool
-from ...robot.wire_in_stock import WireInStock, wire_ends, wire_gap, wire_in_stock
+from ...robot.wire.in_stock import WireInStock, wire_ends, wire_gap, wire_in_stock
 from ..cut.passes import CutPath
 from ..cut.wire_geometry import speed_factor, wire_frame
 from ..job.spec import Job
@@ -47,7 +47,7 @@ DENSIFY_SHARE = 0.25
 #: out (at least; 1.5 ruling intervals where they are longer: :func:`feed_param`), so
 #: that its feed bound
 #: meets the chord's without a jump where the wire enters and leaves
-#: (:func:`ruledrobot.robot.wire_in_stock.feed_chord`)
+#: (:func:`ruledrobot.robot.wire.in_stock.feed_chord`)
 FEED_NEAR = 0.002
 #: s: the wire moves at its feed for at least this long before it enters the block (and
 #: after it leaves), so that a servo following the plan has settled by then: ruledrobot's
@@ -63,7 +63,7 @@ class Motion:
     ``timed``: the trajectory.  ``labels`` (M,): the phase (module doc).  ``pass_of``
     (M,): the index of the pass a sample belongs to (-1 outside passes).  ``s`` (M,):
     the ruling parameter within its pass (NaN outside).  ``wire``: the one model of the
-    wire against the block measured on the samples (:mod:`ruledrobot.robot.wire_in_stock`);
+    wire against the block measured on the samples (:mod:`ruledrobot.robot.wire.in_stock`);
     ``in_stock`` (M,) is its ``inside``: the wire's chord in the block is at least
     ``TOUCH`` long.  ``ends`` (M, 2, 3): the chord ends as points of the wire in the
     flange frame (0 outside the stock).  A pass's lead-in ends where its wire first

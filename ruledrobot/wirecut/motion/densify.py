@@ -23,7 +23,7 @@ from ...geometry.angles import wrap_near
 from ...geometry.box import Box
 from ...geometry.checks import FloatArray
 from ...robot.tool import BowTool
-from ...robot.wire_in_stock import WireInStock
+from ...robot.wire.in_stock import WireInStock
 from ..cut.cutpath import CutPath
 from ..cut.wire_geometry import chords, distance_from_rulings, flange_poses, wire_poses
 from .timing import TimedPath

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ...robot.wire_cut import FeedMeasure
+from ...robot.wire.cut import FeedMeasure
 from ..cut.wire_geometry import speed_factor
 from ..plan import Plan
 from .assemble import feed_param

@@ -352,7 +352,7 @@ def details(ev: Evaluator, T: FloatArray) -> list[ColumnDetail]:
     """The best column of every pass for the placement T (4, 4), ruling by ruling: the
     same margins the search scores (:meth:`Evaluator.__call__`), the bow's gate and a
     chord longer than the wire included."""
-    from ...robot.workspace import reach_margin
+    from ...robot.ik.workspace import reach_margin
     from .margins import REASON_TEXT, joint_limit_margin, limit_levers
 
     sc = ev(T[None])

@@ -26,7 +26,7 @@ import numpy as np
 from ...geometry.angles import wrap_angle
 from ...geometry.checks import FloatArray
 from ...io.words import mm
-from ...robot.workspace import REACH_DIRECTIONS, reach_excess
+from ...robot.ik.workspace import REACH_DIRECTIONS, reach_excess
 from ..cut.clearance import Cell
 from ..cut.cutpath import CutPath
 from .grid import ROLLS
@@ -35,7 +35,7 @@ from .margins import DEFAULT_RULES, REASON_TEXT, Reason
 from .report import ruling_ranges
 
 if TYPE_CHECKING:
-    from ...robot.model import RobotModel
+    from ...robot.arm.model import RobotModel
     from ..job.spec import Job
     from ..plan import Plan
     from .evaluate import Evaluator

@@ -5,9 +5,9 @@ wire direction) and one of its 8 IK branches.  Its **margin** is one length in
 metres: the smallest of
 
 * **reach**: how far the elbow target lies inside the arm's reach
-  (:func:`ruledrobot.robot.workspace.reach_margin`; 0 stretched or folded); a pose a
+  (:func:`ruledrobot.robot.ik.workspace.reach_margin`; 0 stretched or folded); a pose a
   branch cannot reach gets ``-`` the distance it misses by
-  (:func:`~ruledrobot.robot.workspace.reach_excess`);
+  (:func:`~ruledrobot.robot.ik.workspace.reach_excess`);
 * **joint limits**: radians from the nearest joint limit (best ``2 pi``
   representative) times the joint's lever (:func:`limit_levers`: the arm's length
   for the shoulder joints, the forearm for the elbow, ``d5 + d6`` for the wrists),
@@ -45,7 +45,7 @@ import numpy as np
 
 from ...geometry.angles import wrap_angle
 from ...geometry.checks import FloatArray
-from ...robot.workspace import reach_excess, reach_margin
+from ...robot.ik.workspace import reach_excess, reach_margin
 from ..cut.clearance import Cell, clearance
 
 __all__ = [

@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from ...robot.verdict import Check, Verdict
-from ...robot.wire_cut import feed_measures
+from ...robot.wire.cut import feed_measures
 from ..motion.feed_limit import feed_limit_reason
 from ..plan import SINGULARITY_MARGIN, Plan, job_reference
 from ..reach.explain import reach_reasons

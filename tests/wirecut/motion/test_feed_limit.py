@@ -11,7 +11,7 @@ import re
 import numpy as np
 import pytest
 
-from ruledrobot.robot.wire_cut import FeedMeasure
+from ruledrobot.robot.wire.cut import FeedMeasure
 from ruledrobot.wirecut.job.demo import DEMO_JOB
 from ruledrobot.wirecut.job.load import job_document, parse_job
 from ruledrobot.wirecut.motion.feed_limit import AT_LIMIT, WINDOW_S, feed_limit_reason

@@ -13,7 +13,7 @@ from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
 from ruledrobot.geometry.box import Box
-from ruledrobot.robot.wire_cut import feed_measures
+from ruledrobot.robot.wire.cut import feed_measures
 from ruledrobot.wirecut.job.demo import DEMO_JOB
 from ruledrobot.wirecut.job.load import job_document, parse_job
 from ruledrobot.wirecut.plan import make_plan

@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from ruledrobot.io.formats.convert import convert
-from ruledrobot.robot.wire_cut import feed_measures
+from ruledrobot.robot.wire.cut import feed_measures
 from ruledrobot.wirecut.cut.passes import refine_cut
 from ruledrobot.wirecut.job.load import load_job
 from ruledrobot.wirecut.motion.corners import corner_nodes

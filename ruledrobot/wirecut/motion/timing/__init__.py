@@ -65,7 +65,7 @@ finite-difference verification), ``problem`` (grid and constraint rows),
 
 from __future__ import annotations
 
-from ....robot.rates import trajectory_limits_report
+from ....robot.motion.rates import trajectory_limits_report
 from .moves import concatenate, dwell, joint_move
 from .result import TimedPath
 from .time_law import time_path

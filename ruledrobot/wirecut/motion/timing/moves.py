@@ -9,7 +9,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ....geometry.checks import as_limits, as_number, as_shaped
-from ....robot.rates import trajectory_limits_report
+from ....robot.motion.rates import trajectory_limits_report
 from .result import TimedPath
 from .tolerances import CONTINUITY_TOL, MAX_SAMPLES, FloatArray
 

@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from ....robot.rates import trajectory_limits_report
+from ....robot.motion.rates import trajectory_limits_report
 from .problem import _Problem
 from .report import _feed_of_samples
 from .result import TimedPath

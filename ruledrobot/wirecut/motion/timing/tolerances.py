@@ -6,7 +6,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ....geometry.checks import FloatArray
-from ....robot.rates import RATIO_TOL
+from ....robot.motion.rates import RATIO_TOL
 
 __all__ = ["RATIO_TOL", "FloatArray"]
 

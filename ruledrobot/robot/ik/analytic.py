@@ -69,8 +69,8 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..geometry.angles import wrap_angle
-from ._checks import FloatArray
+from ...geometry.angles import wrap_angle
+from .._checks import FloatArray
 
 WRIST_EPS = 1e-12  # |sin q5| below which the wrist is treated as singular
 RESCUE_W = 1e-6  # |sin q5| below which a missed elbow may be rescued by turning q6 ...

@@ -34,12 +34,12 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..geometry.se3 import pose_from_ur_vector, ur_vector_from_pose
-from ._checks import FloatArray, as_array, as_pose_or_vector, readonly
-from .model import DEFAULT_ACCELERATION, RobotModel
+from ...geometry.se3 import pose_from_ur_vector, ur_vector_from_pose
+from .._checks import FloatArray, as_array, as_pose_or_vector, readonly
+from ..arm.model import DEFAULT_ACCELERATION, RobotModel
+from ..wire.cut import WireCut
+from ..wire.in_stock import WireInStock, runs_of
 from .rates import finite_difference_rates
-from .wire_cut import WireCut
-from .wire_in_stock import WireInStock, runs_of
 
 __all__ = [
     "PHASE_NAMES",
@@ -268,7 +268,7 @@ def model_for(meta: TrajectoryMeta) -> RobotModel:
     the trajectory's kinematics, its TCP offset as tool, its payload and the joint
     acceleration limits it was planned within; no base (the trajectory's poses are in the
     robot base frame)."""
-    from .catalogue import load
+    from ..arm.catalogue import load
 
     model = load(meta.robot)
     dh = meta.kinematics.dh
@@ -277,7 +277,7 @@ def model_for(meta: TrajectoryMeta) -> RobotModel:
                          f"trajectory's table has shape {dh.shape}")  # fmt: skip
     nominal = KinematicsRef.of(model)
     if meta.kinematics.checksum != nominal.checksum:
-        from .calibration import Calibration
+        from ..arm.calibration import Calibration
 
         cal = Calibration.from_dh(meta.robot, dh, checksum=meta.kinematics.controller_checksum,
                                   source=meta.kinematics.source)  # fmt: skip

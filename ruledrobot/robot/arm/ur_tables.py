@@ -46,7 +46,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ._checks import FloatArray
+from .._checks import FloatArray
 
 __all__ = ["MODEL_NAMES", "NominalDH", "canonical_name", "nominal_dh"]
 

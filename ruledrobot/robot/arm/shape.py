@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..geometry.checks import FloatArray
+from ...geometry.checks import FloatArray
 from .model import RobotModel
 
 __all__ = [

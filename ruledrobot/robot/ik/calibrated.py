@@ -5,12 +5,12 @@ exactly parallel, the wrist axes do not exactly intersect.  The corrections are
 small in the arm's geometry, so each of the 8 nominal analytic solutions of a pose
 lies within about 1e-2 rad of the calibrated solution of the same branch.  This
 module refines all of them; for batches of more than :data:`NUMPY_POSES` poses both
-steps run in compiled kernels (:mod:`ruledrobot.robot._calibrated_kernel`, numba, loaded
+steps run in compiled kernels (:mod:`ruledrobot.robot.ik._calibrated_kernel`, numba, loaded
 by the first such batch or by :func:`load_kernels`); smaller batches run the same steps
-in numpy (:mod:`ruledrobot.robot._calibrated_numpy`, see :func:`uses_kernel`):
+in numpy (:mod:`ruledrobot.robot.ik._calibrated_numpy`, see :func:`uses_kernel`):
 
 1. **Seeds.**  The nominal closed form of the flange pose (the formulas of
-   :mod:`~ruledrobot.robot.analytic_ik`) gives up to 8 seeds.  Branches the nominal
+   :mod:`~ruledrobot.robot.ik.analytic`) gives up to 8 seeds.  Branches the nominal
    arm cannot reach (the pose lies just beyond its reach, inside its shoulder cylinder
    or closer than its folded elbow) are seeded from the closed form of a nominal arm
    that reaches 1 cm further in each direction (:func:`fallback_geometry`; 3 cm for
@@ -51,8 +51,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import analytic_ik as _ik
-from ._checks import FloatArray
+from .._checks import FloatArray
+from . import analytic as _ik
 
 __all__ = [
     "DEFAULT_MAX_ITER",
@@ -105,7 +105,7 @@ class CalibratedIKSolutions(_ik.IKSolutions):
 
 def kernels_loaded() -> bool:
     """Whether the compiled kernels (numba) are loaded in this process."""
-    return "ruledrobot.robot._calibrated_kernel" in sys.modules
+    return "ruledrobot.robot.ik._calibrated_kernel" in sys.modules
 
 
 def load_kernels() -> None:
@@ -134,7 +134,7 @@ def load_kernels() -> None:
 def uses_kernel(n: int) -> bool:
     """Whether a batch of ``n`` poses runs in the compiled kernels: ``n > NUMPY_POSES``.
 
-    Smaller batches run the same iteration in numpy (:mod:`ruledrobot.robot._calibrated_numpy`):
+    Smaller batches run the same iteration in numpy (:mod:`ruledrobot.robot.ik._calibrated_numpy`):
     a process that solves single poses and short moves, such as the emulator in its clock
     thread, then never waits a second for numba; and the choice depends on the batch alone,
     so that a job planned in a worker thread gives the bytes the main thread gives.  Both

@@ -1,10 +1,10 @@
-"""Compiled (numba) kernels of :mod:`ruledrobot.robot.calibrated_ik`: seeds and Newton finish.
+"""Compiled (numba) kernels of :mod:`ruledrobot.robot.ik.calibrated`: seeds and Newton finish.
 
 :func:`seeds`: the nominal closed form (``analytic_ik``'s formulas) of every pose, with
 the fallback geometries for the branches it misses, in scalar code.
 
 :func:`refine`: the damped Newton / Levenberg-Marquardt iteration of every (pose, branch)
-pair on the calibrated chain (the rules of :mod:`~ruledrobot.robot.calibrated_ik`).  One
+pair on the calibrated chain (the rules of :mod:`~ruledrobot.robot.ik.calibrated`).  One
 pair's iteration is a chain of dependent operations (5 frames, 4 divisions in the
 elimination), so the kernel iterates ``_L`` pairs side by side: their state lives in one
 flat array ``V`` (rows of ``_L`` lanes, constant offsets), and the three costly parts of

@@ -12,7 +12,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..geometry.checks import FloatArray, as_limits, as_shaped, check_increasing
+from ...geometry.checks import FloatArray, as_limits, as_shaped, check_increasing
 
 __all__ = ["RATIO_TOL", "finite_difference_rates", "trajectory_limits_report"]
 

@@ -18,8 +18,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import analytic_ik as _ik
-from ._checks import FloatArray
+from .._checks import FloatArray
+from . import analytic as _ik
 
 _CHUNK = 8192  # (pose, branch) pairs per chunk
 _MAX_STEP = 0.5  # rad: a longer step is shortened (trust region)

@@ -13,8 +13,8 @@ from typing import Protocol
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..geometry.angles import wrap_angle
-from ._checks import FloatArray
+from ...geometry.angles import wrap_angle
+from .._checks import FloatArray
 from .calibration import Calibration, CalibrationError, _nominal_model, zero_frames
 from .ur_tables import NominalDH
 

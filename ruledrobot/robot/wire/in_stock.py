@@ -37,8 +37,8 @@ from itertools import combinations
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..geometry.box import Box
-from ._checks import FloatArray
+from ...geometry.box import Box
+from .._checks import FloatArray
 
 __all__ = [
     "TOUCH",

@@ -23,8 +23,8 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ._checks import FloatArray
-from .analytic_ik import WRIST_EPS, URGeometry
+from .._checks import FloatArray
+from .analytic import WRIST_EPS, URGeometry
 
 __all__ = ["REACH_DIRECTIONS", "elbow_distance", "reach_excess", "reach_margin"]
 

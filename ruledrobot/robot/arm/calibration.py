@@ -41,12 +41,12 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..geometry.angles import wrap_angle
-from ._checks import FloatArray, readonly
+from ...geometry.angles import wrap_angle
+from .._checks import FloatArray, readonly
 from .ur_tables import MODEL_NAMES, NominalDH, nominal_dh
 
 if TYPE_CHECKING:
-    from ..protocol.primary import KinematicsInfo
+    from ...protocol.primary import KinematicsInfo
 
 __all__ = [
     "DEFAULT_BOUNDS",
@@ -239,7 +239,7 @@ class Calibration:
     def kinematics_info(self) -> KinematicsInfo:
         """This calibration as the primary interface's KinematicsInfo (checksums 0 if unknown,
         status 2 "linearised" if unknown)."""
-        from ..protocol.primary import KinematicsInfo
+        from ...protocol.primary import KinematicsInfo
 
         return KinematicsInfo(
             checksum=self.checksum if self.checksum is not None else (0,) * 6,

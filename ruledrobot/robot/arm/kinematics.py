@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._checks import FloatArray
+from .._checks import FloatArray
 
 _CHUNK = 8192  # poses per chunk: ~30 component arrays of 64 kB stay in L2
 

@@ -40,9 +40,9 @@ from typing import Protocol
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..geometry.angles import TWO_PI, wrap_angle
-from . import analytic_ik as _ik
-from ._checks import FloatArray, as_array, as_joint_vector, as_poses
+from ...geometry.angles import TWO_PI, wrap_angle
+from .._checks import FloatArray, as_array, as_joint_vector, as_poses
+from . import analytic as _ik
 
 
 class PathArm(Protocol):

@@ -22,8 +22,8 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..geometry.box import Box
-from .wire_in_stock import WireInStock, wire_ends, wire_in_stock
+from ...geometry.box import Box
+from .in_stock import WireInStock, wire_ends, wire_in_stock
 
 __all__ = ["FeedMeasure", "FeedWindow", "WireCut", "feed_measures"]
 

@@ -24,9 +24,9 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..geometry.angles import wrap_angle, wrap_near
-from ..geometry.se3 import pose_from_ur_vector, ur_vector_from_pose
-from .model import RobotModel
+from ...geometry.angles import wrap_angle, wrap_near
+from ...geometry.se3 import pose_from_ur_vector, ur_vector_from_pose
+from ..arm.model import RobotModel
 
 __all__ = ["ArmKinematics", "rotvec_from_rows"]
 

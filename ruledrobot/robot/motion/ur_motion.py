@@ -35,7 +35,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..geometry.se3 import pose_from_ur_vector, ur_vector_from_pose
+from ...geometry.se3 import pose_from_ur_vector, ur_vector_from_pose
 from .arm_kinematics import ArmKinematics
 
 __all__ = [
@@ -188,7 +188,7 @@ def linear_segment(
     poses = np.repeat(T0[None], n, axis=0)
     poses[:, :3, 3] = T0[:3, 3] + u[:, None] * dp
     if theta > 0:
-        from ..geometry.se3 import pose_from_rotvec
+        from ...geometry.se3 import pose_from_rotvec
 
         Rs = pose_from_rotvec(u[:, None] * w)[:, :3, :3]
         poses[:, :3, :3] = np.einsum("ij,njk->nik", T0[:3, :3], Rs)

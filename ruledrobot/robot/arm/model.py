@@ -21,7 +21,7 @@ A catalogue arm can carry its factory calibration
 (:meth:`RobotModel.with_calibration`, ``load(name, calibration=...)``): its DH
 columns are then the controller's *effective* values, FK is exact for that robot,
 and ``ik`` refines the nominal closed form on the calibrated chain
-(:mod:`ruledrobot.robot.calibrated_ik`).
+(:mod:`ruledrobot.robot.ik.calibrated`).
 """
 
 from __future__ import annotations
@@ -33,8 +33,7 @@ from typing import Any, Literal, overload
 import numpy as np
 from numpy.typing import ArrayLike
 
-from . import analytic_ik as _ik
-from ._checks import (
+from .._checks import (
     FloatArray,
     as_array,
     as_joint_vector,
@@ -42,9 +41,10 @@ from ._checks import (
     as_poses,
     readonly,
 )
+from ..ik import analytic as _ik
+from ..ik.path import PathIKResult, path_ik
 from .calibration import Calibration
 from .kinematics import dh_fk, dh_jacobian, dh_skeleton
-from .path import PathIKResult, path_ik
 from .ur_tables import nominal_dh
 
 #: Default joint acceleration limit [rad/s^2].  UR publishes none; this is the
@@ -529,7 +529,7 @@ class RobotModel:
         self, flat: FloatArray, shape: tuple, seed: FloatArray, return_info: bool
     ) -> FloatArray | _ik.IKSolutions:
         """Nominal closed-form seeds refined on the calibrated chain (see ``calibrated_ik``)."""
-        from . import calibrated_ik as _cik
+        from ..ik import calibrated as _cik
 
         g = self.ur_geometry
         offset = self._seed_dh[3]
