@@ -306,12 +306,11 @@ def meta_from_dict(doc: Any, where: str = "trajectory metadata") -> TrajectoryMe
 
 
 def csv_text(traj: Trajectory) -> str:
-    """The CSV of ``traj``: the header line, then one row per sample."""
-    buf = io.StringIO()
-    buf.write(",".join(HEADER) + "\n")
+    """The CSV of ``traj``: the header line, then one row per sample (``%.10g`` each,
+    the text ``numpy.savetxt`` writes, formatted a whole row at a time)."""
     data = np.concatenate([traj.t[:, None], traj.q, traj.tcp], axis=1)
-    np.savetxt(buf, data, delimiter=",", fmt="%.10g")
-    return buf.getvalue()
+    row = ",".join(["%.10g"] * data.shape[1]) + "\n"
+    return ",".join(HEADER) + "\n" + "".join(map(row.__mod__, map(tuple, data.tolist())))
 
 
 def write_trajectory(path: str | os.PathLike[str], traj: Trajectory) -> Path:

@@ -10,13 +10,29 @@ controller is told and the simulation carries.  Units: m, kg, flange frame.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Protocol
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ._checks import FloatArray, as_point
 
-__all__ = ["BowTool"]
+__all__ = ["BowSpec", "BowTool"]
+
+
+class BowSpec(Protocol):
+    """What :meth:`BowTool.from_spec` reads of a spec (the ``[tool]`` of a cut job,
+    ``ruledrobot.wirecut.job.spec.ToolSpec``): the wire's end points in the flange frame
+    [m] and the bow's mass [kg] (None: the default)."""
+
+    @property
+    def wire_start(self) -> ArrayLike: ...
+
+    @property
+    def wire_end(self) -> ArrayLike: ...
+
+    @property
+    def mass(self) -> float | None: ...
 
 
 @dataclass(frozen=True)
@@ -64,14 +80,20 @@ class BowTool:
         object.__setattr__(self, "mass", mass)
 
     @classmethod
-    def from_spec(cls, spec: Any, **overrides: Any) -> BowTool:
+    def from_spec(cls, spec: BowSpec, **overrides: Any) -> BowTool:
         """From any object with ``wire_start``, ``wire_end`` (and optionally ``mass``),
-        e.g. the ``[tool]`` of a cut job (``ruledrobot.wirecut.job.load.ToolSpec``)."""
+        e.g. the ``[tool]`` of a cut job (``ruledrobot.wirecut.job.spec.ToolSpec``)."""
         kw: dict[str, Any] = {"wire_start": spec.wire_start, "wire_end": spec.wire_end}
         if getattr(spec, "mass", None) is not None:
             kw["mass"] = spec.mass
         kw.update(overrides)
         return cls(**kw)
+
+    @classmethod
+    def of(cls, tool: BowSpec | BowTool) -> BowTool:
+        """``tool`` itself when it is a bow already (built once and passed down), else
+        :meth:`from_spec` of it."""
+        return tool if isinstance(tool, BowTool) else cls.from_spec(tool)
 
     @property
     def wire_length(self) -> float:

@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import copy
 import json
 import math
 import os
@@ -117,7 +118,15 @@ class PlaybackResult:
         ))  # fmt: skip
 
     def report(self) -> dict[str, Any]:
-        """The playback report as a JSON-ready dict (keys documented in ``docs/sim.md``)."""
+        """The playback report as a JSON-ready dict (keys documented in ``docs/sim.md``):
+        measured once per result (a pure function of it), a fresh copy each call."""
+        cached = self.__dict__.get("_report")
+        if cached is None:
+            cached = self._measure()
+            object.__setattr__(self, "_report", cached)
+        return copy.deepcopy(cached)
+
+    def _measure(self) -> dict[str, Any]:
         r = self.robot
         e = self.joint_error()
         pe = self.tcp_position_error()

@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Protocol
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -32,11 +32,36 @@ from ..geometry.checks import FloatArray
 from ..robot._checks import as_point
 from ..robot.arm.model import RobotModel
 from ..robot.arm.shape import link_radii
-from ..robot.tool import BowTool
+from ..robot.tool import BowSpec, BowTool
 from ._xml import placed, sub, to_string
 from .mjcf import ServoGains, build_robot
 
-__all__ = ["BowTool", "Scene", "default_camera", "default_table", "example_scene", "scene_mjcf"]
+__all__ = [
+    "BowTool", "CutJob", "Scene", "default_camera", "default_table", "example_scene",
+    "scene_mjcf",
+]  # fmt: skip
+
+
+class _Placed(Protocol):
+    @property
+    def base(self) -> ArrayLike: ...
+
+
+class CutJob(Protocol):
+    """What :meth:`Scene.from_job` reads of a cut job (``ruledrobot.wirecut.job.spec.Job``):
+    ``robot.base`` (4, 4) where the arm stands in the world, ``tool`` the bow's spec,
+    ``stock`` the block (robot base frame) and ``robot_model()`` the arm."""
+
+    @property
+    def robot(self) -> _Placed: ...
+
+    @property
+    def tool(self) -> BowSpec: ...
+
+    @property
+    def stock(self) -> Box: ...
+
+    def robot_model(self) -> RobotModel: ...
 
 #: Geom names of the scene's static objects and of the wire.
 WIRE_GEOM = "wire"
@@ -127,15 +152,20 @@ class Scene:
     part: Any = field(default=None, repr=False)
 
     @classmethod
-    def from_job(cls, job: Any, robot: RobotModel | None = None, **kw: Any) -> Scene:
-        """The cell of a cut job (``ruledrobot.wirecut.job.load.Job``, read by attribute):
+    def from_job(
+        cls, job: CutJob, robot: RobotModel | None = None, bow: BowTool | None = None,
+        **kw: Any,
+    ) -> Scene:
+        """The cell of a cut job (:class:`CutJob`: ``ruledrobot.wirecut.job.spec.Job``):
         ``job.robot_model()`` (model, calibration; unless ``robot`` is given) placed at the
-        job's ``[robot] base``, the bow of ``job.tool`` (:meth:`BowTool.from_spec`) and
-        ``job.stock`` (in the robot base frame, like every pose of a job)."""
+        job's ``[robot] base``, the bow of ``job.tool`` (:meth:`BowTool.from_spec`; ``bow``
+        when the caller built it already) and ``job.stock`` (in the robot base frame, like
+        every pose of a job)."""
         if robot is None:
             robot = job.robot_model()
         robot = robot.with_base(job.robot.base)
-        return cls(robot, tool=BowTool.from_spec(job.tool), stock=job.stock, **kw)
+        tool = BowTool.from_spec(job.tool) if bow is None else bow
+        return cls(robot, tool=tool, stock=job.stock, **kw)
 
     def mjcf(self) -> str:
         """The MJCF text of the scene (:func:`scene_mjcf`)."""

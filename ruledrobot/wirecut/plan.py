@@ -18,19 +18,22 @@ from pathlib import Path
 import numpy as np
 
 from ..geometry.checks import FloatArray
+from ..robot.arm.model import RobotModel
 from ..robot.motion.rates import trajectory_limits_report
 from ..robot.motion.trajectory import Heat, Trajectory, phases_from_labels, runs
 from ..robot.tool import BowTool
 from ..robot.wire.cut import FeedWindow, WireCut
 from .cut.order import check_cut_order
-from .cut.passes import CutPath, cut_paths
+from .cut.passes import CutPath, cut_paths, job_search
 from .cut.wire_geometry import distance_from_rulings
+from .cut.wire_pose import SearchOptions
 from .job.spec import Job
 from .motion.assemble import Motion, assemble_motion
 from .motion.densify import target_frames
 
 __all__ = [
-    "SINGULARITY_MARGIN", "Plan", "PlannedMeasures", "make_plan", "wire_cut", "wire_deviation",
+    "SINGULARITY_MARGIN", "Plan", "PlannedMeasures", "SearchOptions", "make_plan", "wire_cut",
+    "wire_deviation",
 ]
 
 SINGULARITY_MARGIN = 0.02  # the redundancy search's own threshold (solve_redundancy)
@@ -56,7 +59,7 @@ class Plan:
     no feasible wire motion (``reasons`` say why)."""
 
     job: Job
-    model: object = field(repr=False)  # RobotModel: flange, no tool, the job's base
+    model: RobotModel = field(repr=False)  # flange, no tool, the job's base
     passes: tuple[CutPath, ...] = field(repr=False)
     motion: Motion | None = field(repr=False)
     trajectory: Trajectory | None = field(repr=False)
@@ -64,6 +67,12 @@ class Plan:
     reasons: tuple[str, ...]
     notes: tuple[str, ...]
     timings: dict[str, float]
+    #: the job's bow, built once for the whole plan (None: build it from ``job.tool``)
+    bow: BowTool | None = field(default=None, repr=False)
+    #: the job file's bytes as planned, read once (None: a job built in memory, or not read)
+    source_bytes: bytes | None = field(default=None, repr=False)
+    #: ``{"path", "sha256"}`` of the job file (:func:`job_reference`), hashed once
+    job_ref: dict[str, str] | None = field(default=None, repr=False)
 
     @property
     def reachable(self) -> bool:
@@ -71,11 +80,22 @@ class Plan:
         return self.motion is not None
 
 
-def job_reference(job: Job) -> dict[str, str] | None:
-    """``{"path", "sha256"}`` of the job file (None for a job built in memory)."""
+def job_source_bytes(job: Job) -> bytes | None:
+    """The job file's bytes: the job's own copy, else the file read (None: a job built in
+    memory)."""
     if job.source is None:
         return None
-    data = job.source_bytes if job.source_bytes is not None else Path(job.source).read_bytes()
+    return job.source_bytes if job.source_bytes is not None else Path(job.source).read_bytes()
+
+
+def job_reference(job: Job | Plan) -> dict[str, str] | None:
+    """``{"path", "sha256"}`` of the job file (None for a job built in memory); of a
+    :class:`Plan`, the reference it hashed when it was made."""
+    if isinstance(job, Plan):
+        return job.job_ref if job.job_ref is not None else job_reference(job.job)
+    data = job_source_bytes(job)
+    if data is None:
+        return None
     return {"path": str(job.source), "sha256": hashlib.sha256(data).hexdigest()}
 
 
@@ -85,10 +105,13 @@ def wire_deviation(plan: Plan, q: FloatArray) -> FloatArray:
     of the wire's frame motion there (the screw geodesic between neighbouring frames);
     0 outside the stock.  The chord is the planned one (the one model,
     ``plan.motion.wire``), as points of the wire."""
-    mo = plan.motion
-    flange = plan.model.fk(q)
-    out = np.zeros(len(q))
-    for k, cp in enumerate(plan.passes):
+    return _deviation_at(plan.model.fk(q), plan.passes, plan.motion)
+
+
+def _deviation_at(flange: FloatArray, passes: tuple[CutPath, ...], mo: Motion) -> FloatArray:
+    """:func:`wire_deviation` from the flange poses (M, 4, 4) of the joints."""
+    out = np.zeros(len(flange))
+    for k, cp in enumerate(passes):
         rows = np.flatnonzero((mo.pass_of == k) & mo.in_stock)
         if not rows.size:
             continue
@@ -103,26 +126,28 @@ def wire_points(flange: FloatArray, points_in_flange: FloatArray) -> FloatArray:
     return np.einsum("mij,mkj->mki", flange[:, :3, :3], points_in_flange) + flange[:, None, :3, 3]
 
 
-def wire_cut(job: Job, motion: Motion) -> WireCut:
+def wire_cut(job: Job, motion: Motion, bow: BowTool | None = None) -> WireCut:
     """What the planned trajectory cuts (the sidecar's ``cut``): the block, the wire and
     per pass the feed window — the pass's samples, the cut's feed and tolerance, and
-    where the feed is held (its cut phase less the corner stops and slits)."""
+    where the feed is held (its cut phase less the corner stops and slits).  ``bow``: the
+    job's, when the caller built it."""
     held_all = motion.surface & ~(False if motion.corner_stop is None else motion.corner_stop)
     feeds = []
     for k, cp in enumerate(motion.passes):
         rows = np.flatnonzero(motion.pass_of == k)
         if not rows.size:
             continue
-        cut = next(c for c in job.cuts if c.name == cp.name)
+        cut = cp.cut
         mask = np.zeros(len(motion.pass_of), dtype=bool)
         mask[rows] = True
         feeds.append(FeedWindow(cut.name, int(rows[0]), int(rows[-1]) + 1, cut.feed_speed,
                                 cut.feed_tolerance, runs(held_all & mask),
                                 cut.wire_tolerance))  # fmt: skip
-    return WireCut(job.stock, BowTool.from_spec(job.tool).wire_length, tuple(feeds))
+    bow = BowTool.of(job.tool if bow is None else bow)
+    return WireCut(job.stock, bow.wire_length, tuple(feeds))
 
 
-def _position_ratio(model, q: FloatArray) -> float:
+def _position_ratio(model: RobotModel, q: FloatArray) -> float:
     """Largest |q - centre| / half-range over joints with finite limits (1 = at a limit)."""
     lo, hi = np.asarray(model.lower), np.asarray(model.upper)
     fin = np.isfinite(lo) & np.isfinite(hi)
@@ -133,9 +158,11 @@ def _position_ratio(model, q: FloatArray) -> float:
     return float((np.abs(q[:, fin] - mid) / half).max())
 
 
-def _bow_outside_cuts(job: Job, model, motion: Motion, flange: FloatArray):
+def _bow_outside_cuts(
+    job: Job, bow: BowTool, motion: Motion, flange: FloatArray
+) -> tuple[tuple[dict, ...], tuple[str, ...]]:
     """The planner's bow model (rods and wire) in the stock where no pass cuts."""
-    segs = BowTool.from_spec(job.tool).segments()
+    segs = bow.segments()
     world = wire_points(flange, np.broadcast_to(segs.reshape(1, 6, 3), (len(flange), 6, 3)))
     world = world.reshape(-1, 3, 2, 3)
     cutting = motion.pass_of >= 0
@@ -161,29 +188,43 @@ def _heat(job: Job, motion: Motion) -> Heat | None:
 
 
 def make_plan(
-    job: Job, model=None, progress: Callable[[str], None] | None = None, **search
+    job: Job,
+    model: RobotModel | None = None,
+    progress: Callable[[str], None] | None = None,
+    search: SearchOptions | None = None,
 ) -> Plan:
     """Plan every cut of ``job`` (no files, no simulation): see the module doc.
-    ``search`` goes to the redundancy search of every pass."""
+    ``search``: the options of every pass's wire-pose search (default: the planner's).
+
+    Each thing once: the job file is read (and hashed) once, the bow and the clearance
+    cell are built once, each cut's input rulings are read once; all are handed down."""
     say = progress or (lambda msg: None)
     t0 = time.perf_counter()
     timings: dict[str, float] = {}
     model = job.robot_model() if model is None else model
-    check_cut_order(job)
+    data = job_source_bytes(job)
+    ref = None if data is None else {"path": str(job.source),
+                                     "sha256": hashlib.sha256(data).hexdigest()}  # fmt: skip
+    bow = BowTool.from_spec(job.tool)
+    options = job_search(job, search)
+    cell = options.cell(model, bow, job.stock)
+    documents = tuple(cut.surface.document() for cut in job.cuts)
+    check_cut_order(job, documents)
     passes: list[CutPath] = []
-    for cut in job.cuts:
+    for cut, doc in zip(job.cuts, documents, strict=True):
         say(f"refining the rulings and choosing the wire motion ({cut.name})"
             if len(job.cuts) > 1 else "refining the rulings and choosing the wire motion")
-        passes += cut_paths(job, cut, model, **search)
+        passes += cut_paths(job, cut, model, options, cell=cell, document=doc)
     timings["path_s"] = time.perf_counter() - t0
     reasons = tuple(f"{cp.name}: {r}" if len(job.cuts) > 1 else r
                     for cp in passes for r in cp.motion.reasons)  # fmt: skip
     notes = tuple(n for cp in passes for n in cp.notes)
     if not all(cp.feasible for cp in passes):
-        return Plan(job, model, tuple(passes), None, None, None, reasons, notes, timings)
+        return Plan(job, model, tuple(passes), None, None, None, reasons, notes, timings,
+                    bow, data, ref)  # fmt: skip
     say("timing the cut")
     t1 = time.perf_counter()
-    motion = assemble_motion(job, model, passes)
+    motion = assemble_motion(job, model, passes, cell)
     passes = list(motion.passes)
     timings["timing_s"] = time.perf_counter() - t1
     say("measuring the planned motion")
@@ -191,10 +232,8 @@ def make_plan(
     timed = motion.timed
     flange = model.fk(timed.q)
     feed = motion.wire.feed
-    plan = Plan(job, model, tuple(passes), motion, None, None, reasons,
-                notes + motion.notes, timings)  # fmt: skip
-    dev = wire_deviation(plan, timed.q)
-    collisions, sentences = _bow_outside_cuts(job, model, motion, flange)
+    dev = _deviation_at(flange, tuple(passes), motion)
+    collisions, sentences = _bow_outside_cuts(job, bow, motion, flange)
     cutting = motion.pass_of >= 0
     measured = PlannedMeasures(
         flange=flange, feed=feed, deviation=dev,
@@ -204,13 +243,13 @@ def make_plan(
         singularity_min=float(model.singularity_measure(timed.q[cutting]).min()),
         collisions=collisions, sentences=sentences,
     )  # fmt: skip
-    bow = BowTool.from_spec(job.tool)
     robot = model.with_tool(bow.wire_frame()).with_base(np.eye(4))
     robot = dataclasses.replace(robot, tool_mass=job.tool.mass, tool_com=bow.inertia()[0])
     trajectory = Trajectory.from_joints(
         timed.t, timed.q, robot, base=job.robot.base, phases=phases_from_labels(motion.labels),
-        in_stock=motion.wire.runs(), job=job_reference(job), source="ruledrobot plan",
-        heat=_heat(job, motion), cut=wire_cut(job, motion),
+        in_stock=motion.wire.runs(), job=ref, source="ruledrobot plan",
+        heat=_heat(job, motion), cut=wire_cut(job, motion, bow),
     )  # fmt: skip
     timings["measure_s"] = time.perf_counter() - t2
-    return dataclasses.replace(plan, trajectory=trajectory, measured=measured)
+    return Plan(job, model, tuple(passes), motion, trajectory, measured, reasons,
+                notes + motion.notes, timings, bow, data, ref)  # fmt: skip

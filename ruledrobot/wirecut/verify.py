@@ -44,7 +44,7 @@ def verify_plan(plan: Plan, progress: Callable[[str], None] | None = None) -> Ve
     (progress or (lambda msg: None))("verifying in MuJoCo")
     t0 = time.perf_counter()
     timed, labels = plan.motion.timed, plan.motion.labels
-    scene = Scene.from_job(plan.job, robot=plan.model)
+    scene = Scene.from_job(plan.job, robot=plan.model, bow=plan.bow)
     pb = play(scene, timed.t, timed.q, timed.qd)
     report = pb.report()
     dev = wire_deviation(plan, pb.q)

@@ -7,17 +7,18 @@ the simulation agree); the bow rods have the simulated bow's rod radius.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import dataclasses
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from ...geometry.box import Box
 from ...geometry.checks import FloatArray
 from ...geometry.segments import segment_distance
+from ...robot.arm.model import RobotModel
 from ...robot.arm.shape import arm_capsules
 from ...robot.tool import BowTool
 from ..job.spec import ToolSpec
-from .wire_geometry import wire_frame
 
 __all__ = ["Cell", "clearance"]
 
@@ -29,9 +30,13 @@ _BODIES_NEAR_BOW = (1, 2, 3)
 
 @dataclass(frozen=True)
 class Cell:
-    """The fixed setting of a search: robot, bow and wire, stock, table, thresholds."""
+    """The fixed setting of a search: robot, bow and wire, stock, table, thresholds.
 
-    model: object
+    Built once per plan (:meth:`of`, :meth:`~.wire_pose.SearchOptions.cell`) and passed
+    down: the passes' search, the transits (:meth:`with_rules`) and the timing read
+    its ``bow``."""
+
+    model: RobotModel
     W: FloatArray  # wire frame in the flange frame
     rods: FloatArray  # (3, 2, 3) bow rods in the flange frame
     wire: FloatArray  # (2, 3) wire ends in the flange frame
@@ -42,14 +47,27 @@ class Cell:
     q_start: FloatArray | None
     hub: FloatArray | None = None  # (2, 3) the hub's axis in the flange frame
     hub_radius: float = 0.0
+    bow: BowTool | None = field(default=None, repr=False)
 
     @classmethod
-    def of(cls, model, tool: ToolSpec, stock: Box, table_z, margin, singular_min, q_start):
-        bow = BowTool.from_spec(tool)
+    def of(
+        cls, model: RobotModel, tool: ToolSpec | BowTool, stock: Box, table_z: float | None,
+        margin: float, singular_min: float, q_start: FloatArray | None,
+    ) -> Cell:
+        """The cell of ``model`` with the bow of ``tool`` (a spec, or the bow built once)."""
+        bow = BowTool.of(tool)
         wire = np.array([bow.wire_start, bow.wire_end])
         hub = np.array([[0.0, 0.0, 0.0], [0.0, 0.0, bow.hub_length]])
-        return cls(model, wire_frame(tool), bow.segments(), wire, stock, table_z, margin,
-                   singular_min, q_start, hub, bow.hub_radius)  # fmt: skip
+        return cls(model, bow.wire_frame(), bow.segments(), wire, stock, table_z, margin,
+                   singular_min, q_start, hub, bow.hub_radius, bow)  # fmt: skip
+
+    def with_rules(
+        self, table_z: float | None, margin: float, singular_min: float,
+        q_start: FloatArray | None,
+    ) -> Cell:
+        """The same robot, bow and stock under other thresholds (no bow built again)."""
+        return dataclasses.replace(self, table_z=table_z, margin=margin,
+                                   singular_min=singular_min, q_start=q_start)  # fmt: skip
 
 
 def clearance(cell: Cell, q: FloatArray, P: FloatArray) -> dict[str, np.ndarray]:
@@ -67,28 +85,36 @@ def clearance(cell: Cell, q: FloatArray, P: FloatArray) -> dict[str, np.ndarray]
     rods = np.concatenate([cell.rods, cell.wire[None]], axis=0)  # (4, 2, 3)
     w = np.einsum("nij,kej->nkei", Pf[:, :3, :3], rods) + Pf[:, None, None, :3, 3]
     ends, radius, body = arm_capsules(model, qf)  # (n, S, 2, 3), (S,), (S,)
-    n = len(qf)
-    # the rods are tubes of the bow's arm radius; the wire is the cut, not a collision
-    bow_in_stock = stock.segment_hits(w[:, :3, 0], w[:, :3, 1],
-                                      margin + BowTool.arm_radius).any(axis=1)  # fmt: skip
-    if cell.hub is not None:  # the hub on the flange: a short cylinder, as a capsule
+    n, S = len(qf), len(radius)
+    # one batch of segments against the stock, each with its own grown margin: the bow's
+    # rods (tubes of the bow's arm radius; the wire is the cut, not a collision), the hub
+    # on the flange (a short cylinder, as a capsule) and the arm's capsules
+    seg_a, seg_b = [w[:, :3, 0]], [w[:, :3, 1]]
+    grow = [np.full(3, margin + BowTool.arm_radius)]
+    if cell.hub is not None:
         h = np.einsum("nij,ej->nei", Pf[:, :3, :3], cell.hub) + Pf[:, None, :3, 3]
-        bow_in_stock |= stock.segment_hits(h[:, 0], h[:, 1], margin + cell.hub_radius)
+        seg_a.append(h[:, None, 0])
+        seg_b.append(h[:, None, 1])
+        grow.append(np.array([margin + cell.hub_radius]))
+    seg_a.append(ends[:, :, 0])
+    seg_b.append(ends[:, :, 1])
+    grow.append(margin + radius)
+    hits = stock.segment_hits(np.concatenate(seg_a, axis=1), np.concatenate(seg_b, axis=1),
+                              np.concatenate(grow)[:, None])  # (n, segments)  # fmt: skip
     out = {
-        "bow hits the stock": bow_in_stock,
-        "arm hits the stock": np.zeros(n, bool),
+        "bow hits the stock": hits[:, : hits.shape[1] - S].any(axis=1),
+        "arm hits the stock": hits[:, hits.shape[1] - S :].any(axis=1),
         "bow or wire hits the arm": np.zeros(n, bool),
         "bow below the table": np.zeros(n, bool),
         "arm below the table": np.zeros(n, bool),
     }
-    for k in range(len(radius)):
-        a, b = ends[:, k, 0], ends[:, k, 1]
-        out["arm hits the stock"] |= stock.segment_hits(a, b, margin + radius[k])
-        if body[k] in _BODIES_NEAR_BOW:
-            dist = segment_distance(a[:, None], b[:, None], w[:, :, 0], w[:, :, 1])
-            out["bow or wire hits the arm"] |= (
-                dist < radius[k] + BowTool.arm_radius + margin
-            ).any(axis=1)
+    near = np.isin(body, _BODIES_NEAR_BOW)
+    if near.any():  # the capsules of the links near the bow against its rods and wire
+        e = ends[:, near]  # (n, K, 2, 3)
+        a, b = e[:, :, None, 0], e[:, :, None, 1]  # (n, K, 1, 3)
+        dist = segment_distance(a, b, w[:, None, :, 0], w[:, None, :, 1])  # (n, K, 4)
+        reach = radius[near] + BowTool.arm_radius + margin
+        out["bow or wire hits the arm"] = (dist < reach[None, :, None]).any(axis=(1, 2))
     if cell.table_z is not None:
         out["bow below the table"] = (w[:, :3, :, 2] < cell.table_z + margin).any(axis=(1, 2))
         # every link from the shoulder on (the column stands on the base, on the table);

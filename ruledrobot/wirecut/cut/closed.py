@@ -28,10 +28,11 @@ import numpy as np
 from ...geometry.box import Box
 from ...geometry.checks import FloatArray
 from ..job.spec import CutSpec, Job
+from .clearance import Cell
 from .cutpath import CutPath, RefinedCut
 from .kerf import KerfOffsets
 from .wire_geometry import chords, world_referenced
-from .wire_pose import solve_redundancy
+from .wire_pose import SearchOptions, search_wire_pose
 
 __all__ = ["loop_paths", "slit_direction"]
 
@@ -107,17 +108,18 @@ def _slit(frame: FloatArray, direction: FloatArray, stock: Box, lead: float,
     return out
 
 
-def _pass(job: Job, cut: CutSpec, model, rc: RefinedCut, loop_frames: FloatArray,
+def _pass(job: Job, cut: CutSpec, rc: RefinedCut, loop_frames: FloatArray,
           loop_surface: FloatArray, loop_err: FloatArray, slit: FloatArray, exit_: FloatArray,
-          name: str, notes: tuple[str, ...], compensated: bool, **search) -> CutPath:  # fmt: skip
+          notes: tuple[str, ...], compensated: bool, cell: Cell,
+          options: SearchOptions) -> CutPath:  # fmt: skip
     """Slit in, the loop's frames, slit out, as one pass through the redundancy search;
     the target of the slits' frames is the wire's own line (they cut waste)."""
     F = np.concatenate([slit[:-1], loop_frames, exit_[1:]])
     S = np.concatenate([slit[:-1], loop_surface, exit_[1:]])
     err = np.r_[np.zeros(len(slit) - 1), loop_err, np.zeros(len(exit_) - 1)]
-    motion = solve_redundancy(F, job.stock, job.tool, model, **search)
+    motion = search_wire_pose(F, job.tool, cell, options)
     return CutPath(F, motion, rc.steps, (len(slit) - 1, len(exit_) - 1), rc.input_rulings,
-                   name, S, err, compensated, True, notes)  # fmt: skip
+                   cut.name, S, err, compensated, True, notes, cut=cut)  # fmt: skip
 
 
 def _exit(frame: FloatArray, direction: FloatArray, stock: Box, lead: float,
@@ -141,13 +143,14 @@ def _turn_rate(a: FloatArray, b: FloatArray) -> FloatArray:
 def loop_paths(
     job: Job,
     cut: CutSpec,
-    model,
     rc: RefinedCut,
     wire: FloatArray,
     kerf: KerfOffsets,
-    **search,
+    cell: Cell,
+    options: SearchOptions,
 ) -> list[CutPath]:
-    """The passes of a closed cut (module doc): one, or two that meet opposite the slit."""
+    """The passes of a closed cut (module doc): one, or two that meet opposite the slit;
+    each pass's wire pose searched in ``cell`` with ``options``."""
     M = wire.shape[0]
     wire = world_referenced(wire)
     S = world_referenced(rc.frames)
@@ -170,9 +173,9 @@ def loop_paths(
         lf = _loop(wire, rc.flip, i, 1, M)
         ls = _loop(S, rc.flip, i, 1, M)
         le = kerf.error[np.mod(i + np.arange(M + 1), M)]
-        cp = _pass(job, cut, model, rc, lf, ls, le, entry, exit_, cut.name,
+        cp = _pass(job, cut, rc, lf, ls, le, entry, exit_,
                    (f"closed: one pass round the loop, entered and left along the tangent at "
-                    f"ruling {i}",), kerf.compensated, **search)  # fmt: skip
+                    f"ruling {i}",), kerf.compensated, cell, options)  # fmt: skip
         if cp.feasible:
             return [cp]
         best = best or cp
@@ -195,7 +198,7 @@ def loop_paths(
         lf = np.concatenate([out, out[-2::-1]])  # there and back along its own kerf
         ls = np.concatenate([out_s, out_s[-2::-1]])
         le = np.r_[kerf.error[idx], kerf.error[idx][-2::-1]]
-        passes.append(_pass(job, cut, model, rc, lf, ls, le, way, way[::-1],
-                            cut.name, (note,) if n_pass == 0 else (), kerf.compensated,
-                            **search))  # fmt: skip
+        passes.append(_pass(job, cut, rc, lf, ls, le, way, way[::-1],
+                            (note,) if n_pass == 0 else (), kerf.compensated, cell,
+                            options))  # fmt: skip
     return passes

@@ -7,6 +7,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ...geometry.checks import FloatArray
+from ..job.spec import CutSpec
 from .wire_pose import RedundancyResult
 
 __all__ = ["CutPath", "RefinedCut"]
@@ -21,7 +22,8 @@ class CutPath:
     ``kerf_error`` (M,) the predicted error [m] of the kept surface there.  ``param``
     (M,): the path parameter of the rulings, increasing (None: 0, 1, ..., M - 1; a
     ruling added halfway between two gets the mean of theirs, so that the parameter
-    stays proportional to the distance along the surface).
+    stays proportional to the distance along the surface).  ``cut``: the job's cut this
+    pass makes (the object itself: its feed, tolerances, keep; ``name`` is its name).
     """
 
     frames: FloatArray = field(repr=False)
@@ -36,6 +38,7 @@ class CutPath:
     closed: bool = False
     notes: tuple[str, ...] = ()
     param: FloatArray | None = field(default=None, repr=False)
+    cut: CutSpec | None = field(default=None, repr=False, compare=False)
 
     @property
     def s(self) -> FloatArray:

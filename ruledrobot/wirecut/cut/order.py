@@ -16,9 +16,12 @@ on the polygon of its chord midpoints (tube-like loops: columns, bands).
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
 
 from ...geometry.checks import FloatArray
+from ...io.lines import LinesDocument
 from ..job.spec import Job
 from .wire_geometry import chords
 
@@ -38,18 +41,23 @@ def _points_in_polygon(p: FloatArray, poly: FloatArray) -> np.ndarray:
     return (crosses & (x < xi)).sum(axis=1) % 2 == 1
 
 
-def _frames_of(cut) -> FloatArray:
+def _frames_of(doc: LinesDocument) -> FloatArray:
     from ...geometry.ruled import RuledSurface
 
-    doc = cut.surface.document()
     return RuledSurface(doc.lines, closed=bool(doc.closed)).dh_frames("continuous")
 
 
-def check_cut_order(job: Job) -> None:
-    """ValueError naming the cuts when the job's order breaks a rule of the module doc."""
+def check_cut_order(job: Job, documents: Sequence[LinesDocument] | None = None) -> None:
+    """ValueError naming the cuts when the job's order breaks a rule of the module doc.
+    ``documents``: the cuts' input rulings (``cut.surface.document()`` of each, in the
+    job's order) when the caller read them already."""
     where = str(job.source or "job")
+    docs = list(documents) if documents is not None else [None] * len(job.cuts)
+    for k, cut in enumerate(job.cuts):
+        if docs[k] is None:  # read each surface once, when the rules need it
+            docs[k] = cut.surface.document()
     for i, cut in enumerate(job.cuts):
-        closed = bool(cut.surface.document().closed)
+        closed = bool(docs[i].closed)
         if not closed or cut.keep is None:
             continue
         if isinstance(cut.keep, str) and cut.keep == "outside":
@@ -59,7 +67,7 @@ def check_cut_order(job: Job) -> None:
             )
         if not (isinstance(cut.keep, str) and cut.keep == "inside"):
             continue
-        F = _frames_of(cut)
+        F = _frames_of(docs[i])
         c0, c1, hit = chords(F, job.stock)
         if not hit.any():
             continue
@@ -70,8 +78,8 @@ def check_cut_order(job: Job) -> None:
         v = np.cross(axis, u)
         mid = F[hit, :3, 3] + (0.5 * (c0 + c1))[hit, None] * F[hit, :3, 2]
         poly = np.stack([mid @ u, mid @ v], axis=1)
-        for later in job.cuts[i + 1 :]:
-            G = _frames_of(later)
+        for j, later in enumerate(job.cuts[i + 1 :], start=i + 1):
+            G = _frames_of(docs[j])
             g0, g1, ghit = chords(G, job.stock)
             if not ghit.any():
                 continue

@@ -28,6 +28,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 from itertools import pairwise
 
@@ -39,15 +40,18 @@ from ...geometry.box import Box
 from ...geometry.checks import FloatArray
 from ...geometry.lines import coincident_neighbours
 from ...geometry.ruled import RuledSurface
+from ...io.lines import LinesDocument
+from ...robot.arm.model import RobotModel
 from ...subdivision import check_length, check_size, get_scheme, refined_count
 from ..job.spec import CutSpec, Job
 from ..motion.corners import CORNER_ANGLE, polygon_corners
+from .clearance import Cell
 from .closed import loop_paths
 from .cutpath import CutPath, RefinedCut
 from .entry import PROFILE_KINDS, profile_entry
 from .kerf import kerf_offsets
 from .wire_geometry import anchored_frames, chords, world_referenced
-from .wire_pose import solve_redundancy
+from .wire_pose import SearchOptions, search_wire_pose
 
 __all__ = [
     "SPAN_TOLERANCE",
@@ -56,6 +60,7 @@ __all__ = [
     "chord_ends_in_flange",
     "cut_path",
     "cut_paths",
+    "job_search",
     "refine_cut",
     "refine_for_job",
 ]
@@ -167,14 +172,16 @@ def _polyline_pieces(lines, closed: bool, kind: str | None, stock: Box, half: fl
 
 
 def refine_cut(
-    cut: CutSpec, stock: Box, where: str = "job", wire_length: float = 0.4
+    cut: CutSpec, stock: Box, where: str = "job", wire_length: float = 0.4,
+    document: LinesDocument | None = None,
 ) -> RefinedCut:
     """Refined frames of ``cut`` (see the module doc): ``spacing`` takes the fewest
     steps whose largest gap inside the stock meets it.  ``wire_length`` [m] (the
-    tool's) places the wire points whose turns are a polygon's corners."""
+    tool's) places the wire points whose turns are a polygon's corners.  ``document``:
+    the cut's input rulings (``cut.surface.document()``) when the caller has them."""
     s = cut.surface
     label = f"{where}: [surface]" if cut.name == "cut" else f"{where}: [cut '{cut.name}'.surface]"
-    doc = s.document()
+    doc = s.document() if document is None else document
     lines, closed = doc.lines, bool(doc.closed)
     if closed and len(lines) > 3 and (len(lines) - 1) in coincident_neighbours(
             lines.plucker, closed=True):  # fmt: skip
@@ -407,25 +414,44 @@ def _translated(F: FloatArray, offset: FloatArray) -> FloatArray:
     return out
 
 
+def job_search(job: Job, search: SearchOptions | None = None) -> SearchOptions:
+    """The search options of ``job``'s passes: ``search`` (default: the planner's), whose
+    motion starts near the job's ``[robot] home`` when it names one and the options no
+    ``q_start``."""
+    options = SearchOptions() if search is None else search
+    if job.robot.home is not None and options.q_start is None:
+        options = dataclasses.replace(options, q_start=job.robot.home)
+    return options
+
+
 def cut_paths(
-    job: Job, cut: CutSpec | None = None, model=None, **search
+    job: Job, cut: CutSpec | None = None, model: RobotModel | None = None,
+    search: SearchOptions | None = None, *, cell: Cell | None = None,
+    document: LinesDocument | None = None,
 ) -> list[CutPath]:
     """The passes of ``cut`` (default: the job's first): one for an open surface or a
-    closed one cut in one pass, two when a loop must be split (:mod:`.closed`)."""
+    closed one cut in one pass, two when a loop must be split (:mod:`.closed`).
+
+    ``search``: the wire-pose search's options (:func:`job_search` of them is used);
+    ``cell``: their clearance cell when the caller built it once for every cut
+    (:meth:`~.wire_pose.SearchOptions.cell`); ``document``: the cut's input rulings
+    when the caller read them (:meth:`~ruledrobot.wirecut.job.spec.SurfaceSpec.document`).
+    """
     cut = job.cut if cut is None else cut
     if model is None:
-        model = job.robot_model()
-    rc = refine_cut(cut, job.stock, str(job.source or "job"), job.tool.wire_length)
+        model = job.robot_model() if cell is None else cell.model
+    options = job_search(job, search)
+    if cell is None:
+        cell = options.cell(model, job.tool, job.stock)
+    rc = refine_cut(cut, job.stock, str(job.source or "job"), job.tool.wire_length, document)
     where = "[cut]" if cut.name == "cut" else f"[cut '{cut.name}']"
     try:
         kerf = kerf_offsets(rc.frames, job.stock, cut.kerf, cut.keep, rc.closed)
     except ValueError as exc:  # name the job file and the cut's section
         raise ValueError(f"{job.source or 'job'}: {where} {exc}") from None
     wire = _translated(rc.frames, kerf.offset)
-    if job.robot.home is not None:
-        search.setdefault("q_start", job.robot.home)
     if rc.closed:
-        return loop_paths(job, cut, model, rc, wire, kerf, **search)
+        return loop_paths(job, cut, rc, wire, kerf, cell, options)
     lead = max(cut.lead_in, cut.lead_out)
     grown = Box(job.stock.centre, job.stock.size + 2.0 * lead, job.stock.rotation)
     _, _, near = chords(wire, grown)
@@ -471,15 +497,17 @@ def cut_paths(
     S = _translated(F, -off)  # the target rulings (the lead-in/out ones lie outside the stock)
     notes = (_extended_note(where, runs),) if runs else ()
     err = np.r_[np.zeros(before), kerf.error[keep], np.zeros(after)]
-    motion = solve_redundancy(F, job.stock, job.tool, model, **search)
+    motion = search_wire_pose(F, job.tool, cell, options)
     return [CutPath(F, motion, rc.steps, (before, after), rc.input_rulings, cut.name,
-                    S, err, kerf.compensated, notes=notes)]  # fmt: skip
+                    S, err, kerf.compensated, notes=notes, cut=cut)]  # fmt: skip
 
 
-def cut_path(job: Job, model=None, **search: float) -> CutPath:
-    """The geometric cut of the job's first cut (see the module doc); ``search`` goes
-    to the redundancy search.  ``model`` defaults to the job's robot (flange, no tool)."""
-    return cut_paths(job, None, model, **search)[0]
+def cut_path(
+    job: Job, model: RobotModel | None = None, search: SearchOptions | None = None
+) -> CutPath:
+    """The geometric cut of the job's first cut (see the module doc); ``search`` the
+    wire-pose search's options.  ``model`` defaults to the job's robot (flange, no tool)."""
+    return cut_paths(job, None, model, search)[0]
 
 
 def chord_ends_in_flange(path: CutPath) -> FloatArray:

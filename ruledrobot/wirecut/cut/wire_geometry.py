@@ -45,11 +45,12 @@ __all__ = [
 ]
 
 
-def wire_frame(tool: ToolSpec) -> FloatArray:
+def wire_frame(tool: ToolSpec | BowTool) -> FloatArray:
     """The wire frame W (4, 4) in the flange frame (see the module doc): origin at the
     wire midpoint, z along the wire, x the bow's depth direction
-    (:meth:`ruledrobot.robot.tool.BowTool.wire_frame`)."""
-    return BowTool.from_spec(tool).wire_frame()
+    (:meth:`ruledrobot.robot.tool.BowTool.wire_frame`); ``tool`` the job's spec or the
+    bow built from it."""
+    return BowTool.of(tool).wire_frame()
 
 
 def chords(frames: ArrayLike, stock: Box) -> tuple[FloatArray, FloatArray, np.ndarray]:
@@ -149,7 +150,7 @@ def flange_poses(wire: ArrayLike, W: ArrayLike) -> FloatArray:
 
 
 def speed_factor(
-    flange: ArrayLike, path_s: ArrayLike, tool: ToolSpec, stock: Box, near: float
+    flange: ArrayLike, path_s: ArrayLike, tool: ToolSpec | BowTool, stock: Box, near: float
 ) -> FloatArray:
     """Metres moved across the wire by its fastest point in (or, within ``near`` m,
     nearest) the stock per unit of path parameter: the time law's feed bound.
@@ -159,9 +160,10 @@ def speed_factor(
     against the block (:func:`ruledrobot.robot.wire.in_stock.feed_chord`,
     :func:`~ruledrobot.robot.wire.in_stock.across_speeds`): where the wire is outside
     but near the block, its point nearest the block, so that the bound meets the
-    chord's without a jump as the wire enters and leaves.  0 further away.
+    chord's without a jump as the wire enters and leaves.  0 further away.  ``tool``: the
+    job's spec or the bow built from it.
     """
-    bow = BowTool.from_spec(tool)
+    bow = BowTool.of(tool)
     ends = wire_ends(np.asarray(flange, dtype=np.float64) @ bow.wire_frame(), bow.wire_length)
     f = feed_chord(ends, stock, near)
     if len(ends) < 2:

@@ -41,13 +41,49 @@ import numpy as np
 from ...geometry.box import Box
 from ...geometry.checks import FloatArray
 from ...io.words import index_ranges
-from ...robot import path_ik, wrap_angle
+from ...robot import RobotModel, path_ik, wrap_angle
 from ...robot.tool import BowTool
 from ..job.spec import ToolSpec
 from .clearance import Cell, clearance
 from .wire_geometry import chords, flange_poses, slide_bounds, wire_poses
 
-__all__ = ["RedundancyResult", "bow_segments", "solve_redundancy"]
+__all__ = ["RedundancyResult", "SearchOptions", "bow_segments", "solve_redundancy"]
+
+STRATEGIES = ("auto", "constant", "varying")
+
+
+@dataclass(frozen=True, eq=False)
+class SearchOptions:
+    """The settings of the wire-pose search (:func:`solve_redundancy`), one value that
+    travels from the plan to every pass (the defaults are the planner's).
+
+    ``rolls``: constant rolls scored; ``sample``: rulings they are scored on;
+    ``singular_min``: least singularity measure; ``jump_threshold`` [rad]: largest joint
+    step between rulings; ``table_z`` [m]: the table top in the base frame (None: no
+    table); ``margin`` [m]: clearance of bow and arm from stock, table and each other;
+    ``strategy``: "auto", "constant" or "varying"; ``q_start`` (6,): joints the motion
+    starts near (the job's ``[robot] home`` when the plan has one).
+    """
+
+    rolls: int = 36
+    sample: int = 80
+    singular_min: float = 0.02
+    jump_threshold: float = 0.5
+    table_z: float | None = 0.0
+    margin: float = 0.005
+    strategy: str = "auto"
+    q_start: FloatArray | None = field(default=None, repr=False)
+
+    def __post_init__(self) -> None:
+        if self.strategy not in STRATEGIES:
+            raise ValueError(
+                f"strategy: expected auto, constant or varying, got {self.strategy!r}"
+            )
+
+    def cell(self, model: RobotModel, tool: ToolSpec | BowTool, stock: Box) -> Cell:
+        """The clearance cell of these options (built once per plan and passed down)."""
+        return Cell.of(model, tool, stock, self.table_z, self.margin, self.singular_min,
+                       self.q_start)  # fmt: skip
 
 
 def bow_segments(tool: ToolSpec) -> FloatArray:
@@ -111,7 +147,7 @@ def solve_redundancy(
     frames: FloatArray,
     stock: Box,
     tool: ToolSpec,
-    model,
+    model: RobotModel,
     *,
     rolls: int = 36,
     sample: int = 80,
@@ -130,13 +166,25 @@ def solve_redundancy(
     stock, table and each other.  ``strategy``: "auto" (constant offset first, then a
     varying roll), "constant" or "varying".  ``q_start`` (6,): joints the motion
     starts near (path IK picks the branch and 2 pi representatives nearest them).
-    See the module doc for the search.
+    See the module doc for the search; :func:`search_wire_pose` is the same with the
+    options as one value and the cell built once by the caller.
     """
-    if strategy not in ("auto", "constant", "varying"):
-        raise ValueError(f"strategy: expected auto, constant or varying, got {strategy!r}")
+    options = SearchOptions(rolls, sample, singular_min, jump_threshold, table_z, margin,
+                            strategy, q_start)  # fmt: skip
+    return search_wire_pose(frames, tool, options.cell(model, tool, stock), options)
+
+
+def search_wire_pose(
+    frames: FloatArray, tool: ToolSpec, cell: Cell, options: SearchOptions
+) -> RedundancyResult:
+    """:func:`solve_redundancy` in ``cell`` (robot, bow, stock, table and thresholds: the
+    cell of ``options``, :meth:`SearchOptions.cell`); ``tool`` gives the wire's length
+    and clearance."""
+    rolls, sample, jump_threshold = options.rolls, options.sample, options.jump_threshold
+    singular_min, strategy, q_start = cell.singular_min, options.strategy, cell.q_start
+    model, stock = cell.model, cell.stock
     F = np.asarray(frames, dtype=np.float64)
     m = F.shape[0]
-    cell = Cell.of(model, tool, stock, table_z, margin, singular_min, q_start)
     c0, c1, hit = chords(F, stock)
     if not hit.any():
         raise ValueError("rulings: none of them crosses the stock; nothing to cut")
@@ -203,23 +251,40 @@ def solve_redundancy(
     if constant and H - L > 1e-6:
         slides += [np.full(m, L + 0.1 * (H - L)), np.full(m, H - 0.1 * (H - L))]
 
-    def score(psi: float, reverse: bool, k: int = 0) -> _Score:
-        _, ik, ok_c, lost = _evaluate(
-            cell, F[idx], np.full(idx.size, psi), slides[k][idx], reverse, jump_threshold * stride
-        )
-        travel = float(np.abs(np.diff(ik.q, axis=0)).sum()) if ik.q.size else np.inf
-        return _Score(float(psi), reverse, k, ok_c, travel, float(np.min(ik.measure)), lost)
+    def scores_of(cands: list[tuple[float, bool, int]]) -> list[_Score]:
+        """Candidates (roll, reverse, slide option) scored on the sampled rulings: path IK
+        one candidate at a time, the clearance rules on all of them in one batch."""
+        poses, iks = [], []
+        for psi, reverse, k in cands:
+            P = flange_poses(wire_poses(F[idx], np.full(idx.size, psi), slides[k][idx], reverse),
+                             cell.W)  # fmt: skip
+            poses.append(P)
+            iks.append(path_ik(model, P, q_start=q_start, jump_threshold=jump_threshold * stride))
+        checks = clearance(cell, np.stack([ik.q for ik in iks]), np.stack(poses))
+        out = []
+        for c, ((psi, reverse, k), ik) in enumerate(zip(cands, iks, strict=True)):
+            masks = {
+                "no continuous IK solution": ~ik.ok,
+                "near a singularity": ik.ok & (ik.measure < singular_min),
+                **{key: ik.ok & v[c] for key, v in checks.items()},
+            }
+            lost = {key: int(v.sum()) for key, v in masks.items()}
+            ok_c = all(v == 0 for v in lost.values())
+            travel = float(np.abs(np.diff(ik.q, axis=0)).sum()) if ik.q.size else np.inf
+            out.append(_Score(float(psi), reverse, k, ok_c, travel, float(np.min(ik.measure)),
+                              lost))  # fmt: skip
+        return out
 
-    scores = [score(psi, rev) for rev in (False, True) for psi in grid]
+    scores = scores_of([(psi, rev, 0) for rev in (False, True) for psi in grid])
     for k in range(1, len(slides)):
         if any(sc.ok for sc in scores):
             break
-        scores += [score(psi, rev, k) for rev in (False, True) for psi in grid]
+        scores += scores_of([(psi, rev, k) for rev in (False, True) for psi in grid])
     step = 2.0 * np.pi / rolls
     if not any(sc.ok for sc in scores):  # refine the roll around the least-bad candidates
-        for sc in sorted(scores, key=lambda sc: sum(sc.lost.values()))[:3]:
-            for frac in (-0.75, -0.5, -0.25, 0.25, 0.5, 0.75):
-                scores.append(score(sc.roll + frac * step, sc.reverse, sc.slide))
+        least_bad = sorted(scores, key=lambda sc: sum(sc.lost.values()))[:3]
+        scores += scores_of([(sc.roll + frac * step, sc.reverse, sc.slide) for sc in least_bad
+                             for frac in (-0.75, -0.5, -0.25, 0.25, 0.5, 0.75)])  # fmt: skip
     # feasible first, then fewest lost rulings, least joint travel, best conditioned
     order = sorted(
         scores, key=lambda sc: (not sc.ok, sum(sc.lost.values()), sc.travel, -sc.min_measure)

@@ -26,10 +26,12 @@ import numpy as np
 
 from ...geometry.angles import wrap_near
 from ...geometry.checks import FloatArray
+from ...robot.arm.model import RobotModel
 from ...robot.tool import BowTool
 from ...robot.wire.in_stock import WireInStock, wire_ends, wire_gap, wire_in_stock
+from ..cut.clearance import Cell
 from ..cut.passes import CutPath
-from ..cut.wire_geometry import speed_factor, wire_frame
+from ..cut.wire_geometry import speed_factor
 from ..job.spec import Job
 from .corners import corner_nodes, corner_stop_mask, time_between_corners
 from .densify import densified, pass_deviation, pass_feed_error, uneven_intervals
@@ -91,7 +93,9 @@ class Motion:
     wire: WireInStock | None = field(default=None, repr=False)
 
 
-def _backed_off(model, q: FloatArray, away: FloatArray, dist: float) -> FloatArray | None:
+def _backed_off(
+    model: RobotModel, q: FloatArray, away: FloatArray, dist: float
+) -> FloatArray | None:
     """Joints nearest ``q`` whose flange is ``dist`` further along ``away`` (unit, base
     frame); None if unreachable or out of limits."""
     P = model.fk(q)
@@ -106,7 +110,7 @@ def _backed_off(model, q: FloatArray, away: FloatArray, dist: float) -> FloatArr
 
 
 def _free_pose(
-    transit: TransitPlanner, model, q: FloatArray, away: FloatArray
+    transit: TransitPlanner, model: RobotModel, q: FloatArray, away: FloatArray
 ) -> FloatArray | None:
     """A pose near ``q`` clear of the stock, the table and the arm, to enter a pass from
     or leave it to: ``LIFT`` (then twice that) further along ``away``, else raised over
@@ -149,7 +153,9 @@ def _across(p: FloatArray, o: FloatArray, z: FloatArray) -> FloatArray:
     return np.linalg.norm(d - (d * z[:, None]).sum(-1, keepdims=True) * z[:, None], axis=-1)
 
 
-def feed_param(job: Job, cp: CutPath, feed_speed: float) -> tuple[FloatArray, float]:
+def feed_param(
+    job: Job, cp: CutPath, feed_speed: float, bow: BowTool | None = None
+) -> tuple[FloatArray, float]:
     """(M,) the path parameter the feed is held in, and ``near`` (m): the distance [m]
     travelled across the wire by the part of it nearest the block — the chord's ends
     inside it — as the speed factor measures it (:func:`~.toolpath.speed_factor`, the
@@ -165,19 +171,20 @@ def feed_param(job: Job, cp: CutPath, feed_speed: float) -> tuple[FloatArray, fl
     a loop, a parameter that changes its measure where the wire enters — would hold
     the feed below the set value by the unevenness (a parameter that switched from
     chord-end to frame-origin travel at the block's face held the wire of a helicoid
-    to 58 % of its feed there, a conoid's to 63 %)."""
+    to 58 % of its feed there, a conoid's to 63 %).  ``bow``: the job's bow when the caller
+    built it (:meth:`~ruledrobot.robot.tool.BowTool.from_spec` of ``job.tool``)."""
     F = cp.frames
     o, z = F[:, :3, 3], F[:, :3, 2]
     step0 = np.maximum(_across(o[:-1, None], o[1:], z[1:]),
                        _across(o[1:, None], o[:-1], z[:-1]))[:, 0]  # fmt: skip
     step0 = np.maximum(step0, 1e-9)  # strictly increasing, also where the wire holds still
     s0 = np.r_[0.0, np.cumsum(step0)]
-    bow = BowTool.from_spec(job.tool)
+    bow = BowTool.of(job.tool if bow is None else bow)
     ends = wire_ends(cp.motion.flange @ bow.wire_frame(), bow.wire_length)
     step = np.empty_like(step0)
     cuts = [0, *(int(c) for c in corner_nodes(F, 0.5 * job.tool.wire_length)), len(F) - 1]
     for a, b in pairwise(cuts):  # between corners: differences never reach across one
-        sf0 = speed_factor(cp.motion.flange[a : b + 1], s0[a : b + 1], job.tool, job.stock,
+        sf0 = speed_factor(cp.motion.flange[a : b + 1], s0[a : b + 1], bow, job.stock,
                            np.inf)  # fmt: skip
         step[a:b] = 0.5 * (sf0[:-1] + sf0[1:]) * step0[a:b]
     step = np.maximum(step, 1e-9)
@@ -189,30 +196,33 @@ def feed_param(job: Job, cp: CutPath, feed_speed: float) -> tuple[FloatArray, fl
     return np.r_[0.0, np.cumsum(step)], near
 
 
-def measure_wire(job: Job, model, t: FloatArray, q: FloatArray) -> WireInStock:
+def measure_wire(
+    job: Job, model: RobotModel, t: FloatArray, q: FloatArray, bow: BowTool | None = None
+) -> WireInStock:
     """The one model of the wire against the job's block along joints ``q`` (M, 6) at
-    times ``t`` (M,) (``model``: the planner's, flange without tool, base frame)."""
-    bow = BowTool.from_spec(job.tool)
+    times ``t`` (M,) (``model``: the planner's, flange without tool, base frame; ``bow``:
+    the job's, when the caller built it)."""
+    bow = BowTool.of(job.tool if bow is None else bow)
     ends = wire_ends(model.fk(q) @ bow.wire_frame(), bow.wire_length)
     return wire_in_stock(t, ends, job.stock)
 
 
-def _chord_in_flange(job: Job, wire: WireInStock) -> FloatArray:
+def _chord_in_flange(bow: BowTool, wire: WireInStock) -> FloatArray:
     """(M, 2, 3) the chord ends as points of the wire in the flange frame (0 outside)."""
-    bow = BowTool.from_spec(job.tool)
     W = bow.wire_frame()
     f = np.nan_to_num(wire.fractions()) - 0.5
     return W[:3, 3] + f[:, :, None] * bow.wire_length * W[:3, 2]
 
 
 def _pass_timing(
-    job: Job, model, cp: CutPath, vel, acc, dt
+    job: Job, model: RobotModel, cp: CutPath, vel: FloatArray, acc: FloatArray, dt: float,
+    bow: BowTool,
 ) -> tuple[CutPath, TimedPath, np.ndarray]:
     """The pass timed at its feed, with rulings added where the timed wire leaves the
     surface between them or its feed strays (:mod:`.densify`); returns the (denser)
     pass too and the samples where the wire stops at a corner (:mod:`.corners`)."""
-    cut = next(c for c in job.cuts if c.name == cp.name)
-    param, near = feed_param(job, cp, cut.feed_speed)
+    cut = cp.cut
+    param, near = feed_param(job, cp, cut.feed_speed, bow)
     cp = dataclasses.replace(cp, param=param)
     for attempt in range(DENSIFY_ROUNDS + 1):
         m = cp.motion
@@ -220,12 +230,12 @@ def _pass_timing(
         corners = corner_nodes(cp.frames, 0.5 * job.tool.wire_length)
 
         def sf(a: int, b: int, m=m, s=s) -> FloatArray:  # one piece between corners
-            return speed_factor(m.flange[a : b + 1], s[a : b + 1], job.tool, job.stock, near)
+            return speed_factor(m.flange[a : b + 1], s[a : b + 1], bow, job.stock, near)
 
         timed = time_between_corners(s, m.q, sf, cut.feed_speed, vel, acc, dt, corners)
         if attempt == DENSIFY_ROUNDS:
             break
-        wire = measure_wire(job, model, timed.t, timed.q)
+        wire = measure_wire(job, model, timed.t, timed.q, bow)
         dev = pass_deviation(cp, timed, wire)
         feed = pass_feed_error(cp, timed, wire, cut.feed_speed)
         bad = np.flatnonzero((dev > DENSIFY_SHARE * cut.wire_tolerance)
@@ -233,31 +243,37 @@ def _pass_timing(
         bad = np.union1d(bad, uneven_intervals(cp, DENSIFY_SHARE * cut.feed_tolerance))
         if not bad.size:
             break
-        cp = densified(cp, bad, model, job.tool, job.stock)
+        cp = densified(cp, bad, model, bow, job.stock)
     return cp, timed, corner_stop_mask(timed, s[corners])
 
 
-def assemble_motion(job: Job, model, passes: list[CutPath]) -> Motion:
+def assemble_motion(
+    job: Job, model: RobotModel, passes: list[CutPath], cell: Cell | None = None
+) -> Motion:
     """Time the passes and join them with approach, pre-heat, transits and retract
-    (``Motion.passes`` are the passes as timed)."""
+    (``Motion.passes`` are the passes as timed).  ``cell``: the plan's clearance cell
+    (its bow; the transits' cell is the same under their rules), built once by the
+    caller (default: built here)."""
     passes = list(passes)
     dt = float(model.control_period)
     vel = model.max_velocity * job.robot.speed_scale
     acc = model.max_acceleration  # the job's [robot] acceleration when it names one
-    W = wire_frame(job.tool)
-    transit = TransitPlanner.of(job, model)
+    if cell is None:
+        cell = Cell.of(model, job.tool, job.stock, 0.0, 0.005, 0.0, None)
+    bow = BowTool.of(job.tool if cell.bow is None else cell.bow)
+    W = bow.wire_frame()
+    transit = TransitPlanner.of(job, model, cell=cell)
     b = _Builder(dt)
     notes: list[str] = []
     timed_passes = []
     for k, cp in enumerate(passes):
-        passes[k], *timing = _pass_timing(job, model, cp, vel, acc, dt)
+        passes[k], *timing = _pass_timing(job, model, cp, vel, acc, dt, bow)
         timed_passes.append(tuple(timing))
     here: FloatArray | None = None
     if job.robot.home is not None:
         here = np.asarray(job.robot.home, dtype=np.float64)
     for k, (cp, (timed, *_)) in enumerate(zip(passes, timed_passes, strict=True)):
-        cut = next(c for c in job.cuts if c.name == cp.name)
-        slow = cut.approach_speed
+        slow = cp.cut.approach_speed
         m = cp.motion
         start, end = m.q[0], m.q[-1]
         mids = (m.flange @ W)[[0, -1], :3, 3]
@@ -285,15 +301,16 @@ def assemble_motion(job: Job, model, passes: list[CutPath]) -> Motion:
         for qa, qb in transit.route(here, home, notes, "home"):
             b.add(joint_move(qa, qb, vel, acc, dt, job.cuts[-1].approach_speed), "retract")
     whole = concatenate(b.parts, dt) if len(b.parts) > 1 else b.parts[0]
-    return _label(job, model, whole, b, passes, timed_passes, notes)
+    return _label(job, model, bow, whole, b, passes, timed_passes, notes)
 
 
-def _label(job, model, whole: TimedPath, b: _Builder, passes, timed_passes, notes) -> Motion:
+def _label(job: Job, model: RobotModel, bow: BowTool, whole: TimedPath, b: _Builder,
+           passes: list[CutPath], timed_passes: list, notes: list[str]) -> Motion:  # fmt: skip
     M = whole.t.size
     labels = np.full(M, "move", dtype=object)
     pass_of = np.full(M, -1, dtype=np.int64)
     s = np.full(M, np.nan)
-    wire = measure_wire(job, model, whole.t, whole.q)
+    wire = measure_wire(job, model, whole.t, whole.q, bow)
     in_stock = wire.inside
     seg = whole.segment
     stop = np.zeros(M, dtype=bool)
@@ -331,5 +348,5 @@ def _label(job, model, whole: TimedPath, b: _Builder, passes, timed_passes, note
     heat = np.zeros(M, dtype=bool)
     if job.tool.heat is not None:
         heat = np.isin(labels.astype(str), ("preheat", "lead_in", "cut", "lead_out"))
-    return Motion(whole, labels, pass_of, s, in_stock, _chord_in_flange(job, wire), heat,
+    return Motion(whole, labels, pass_of, s, in_stock, _chord_in_flange(bow, wire), heat,
                   tuple(notes), tuple(passes), surface, stop & surface, wire)

@@ -22,10 +22,12 @@ from ...geometry import se3
 from ...geometry.angles import wrap_near
 from ...geometry.box import Box
 from ...geometry.checks import FloatArray
+from ...robot.arm.model import RobotModel
 from ...robot.tool import BowTool
 from ...robot.wire.in_stock import WireInStock
 from ..cut.cutpath import CutPath
 from ..cut.wire_geometry import chords, distance_from_rulings, flange_poses, wire_poses
+from ..job.spec import ToolSpec
 from .timing import TimedPath
 
 __all__ = [
@@ -92,10 +94,12 @@ def uneven_intervals(cp: CutPath, share: float) -> np.ndarray:
 MIN_INTERVAL = 2e-4
 
 
-def densified(cp: CutPath, intervals: np.ndarray, model, tool, stock: Box) -> CutPath:
+def densified(
+    cp: CutPath, intervals: np.ndarray, model: RobotModel, tool: ToolSpec | BowTool, stock: Box
+) -> CutPath:
     """``cp`` with a ruling added halfway through each interval ``i`` (between rulings
     ``i`` and ``i + 1``) of ``intervals`` (module doc) that is longer than
-    :data:`MIN_INTERVAL`."""
+    :data:`MIN_INTERVAL`; ``tool``: the job's spec or the bow built from it."""
     m = cp.motion
     idx = np.unique(np.asarray(intervals, dtype=np.intp))
     idx = idx[np.diff(cp.s)[idx] > 2.0 * MIN_INTERVAL]
@@ -107,7 +111,7 @@ def densified(cp: CutPath, intervals: np.ndarray, model, tool, stock: Box) -> Cu
     S_mid = se3.geodesic(S[idx], S[idx + 1], half)
     roll = 0.5 * (m.roll[idx] + m.roll[idx + 1])
     slide = 0.5 * (m.slide[idx] + m.slide[idx + 1])
-    W = BowTool.from_spec(tool).wire_frame()
+    W = BowTool.of(tool).wire_frame()
     P = flange_poses(wire_poses(F_mid, roll, slide, m.reverse), W)
     sols = model.ik(P, check=False)  # (k, 8, 6)
     ref = 0.5 * (m.q[idx] + m.q[idx + 1])

@@ -48,9 +48,9 @@ def _factor_change(plan: Plan, k: int) -> tuple[float, float] | None:
         return None
     cp = plan.passes[p]
     s = cp.s
-    cut = next(c for c in plan.job.cuts if c.name == cp.name)
-    near = feed_param(plan.job, cp, cut.feed_speed)[1]  # the time law's own reach
-    sf = speed_factor(cp.motion.flange, s, plan.job.tool, plan.job.stock, near)
+    bow = plan.bow if plan.bow is not None else plan.job.tool
+    near = feed_param(plan.job, cp, cp.cut.feed_speed, plan.bow)[1]  # the time law's own reach
+    sf = speed_factor(cp.motion.flange, s, bow, plan.job.stock, near)
     i = int(np.clip(np.searchsorted(s, mo.s[k]) - 1, 0, len(s) - 2))
     a, b = max(0, i - 1), min(len(s), i + 3)
     f = sf[a:b]

@@ -24,6 +24,7 @@ import numpy as np
 
 from ...geometry.angles import wrap_near
 from ...geometry.checks import FloatArray
+from ...robot.arm.model import RobotModel
 from ..cut.clearance import Cell, clearance
 from ..job.spec import Job
 
@@ -49,8 +50,16 @@ class TransitPlanner:
     upper: FloatArray
 
     @classmethod
-    def of(cls, job: Job, model, margin: float = 0.005) -> TransitPlanner:
-        cell = Cell.of(model, job.tool, job.stock, 0.0, margin, 0.0, None)
+    def of(
+        cls, job: Job, model: RobotModel, margin: float = 0.005, cell: Cell | None = None
+    ) -> TransitPlanner:
+        """The transits of ``job``: its whole stock an obstacle, the table at z = 0,
+        ``margin`` [m] clearance, no singularity threshold; ``cell``: the plan's cell (its
+        robot, bow and stock: no bow built again), else built here."""
+        if cell is None or cell.bow is None or cell.model is not model:
+            cell = Cell.of(model, job.tool, job.stock, 0.0, margin, 0.0, None)
+        else:
+            cell = cell.with_rules(0.0, margin, 0.0, None)
         corners = np.array([[i, j, k] for i in (-1, 1) for j in (-1, 1) for k in (-1, 1)]) * 0.5
         pts = job.stock.centre + (corners * job.stock.size) @ job.stock.rotation.T
         lo = np.maximum(model.lower, -2.0 * np.pi)

@@ -22,7 +22,7 @@ from ...io.outdir import StagedFolder
 from ...io.trajectory import write_trajectory
 from ...robot.verdict import Verdict
 from ..cut.wire_geometry import chords
-from ..plan import Plan
+from ..plan import Plan, job_source_bytes
 from ..verify import Verification
 from .part_mesh import RESOLUTION, part_mesh, signed_volume
 from .plots import plot_plan
@@ -118,7 +118,8 @@ def write_plan(
 
                 try:
                     coarse = part_mesh(plan.job, plan.passes, VIDEO_RESOLUTION)
-                    scene = Scene.from_job(plan.job, robot=plan.model, part=coarse)
+                    scene = Scene.from_job(plan.job, robot=plan.model, bow=plan.bow,
+                                           part=coarse)
                     mo = plan.motion
                     files["video"] = render_video(scene, folder / "video.mp4", mo.timed.t,
                                                   ver.playback.q,
@@ -131,8 +132,7 @@ def write_plan(
             "plots.png and report.json show this one)")
     files["report"] = atomic_write_text(folder / "report.json",
                                         json.dumps(report, indent=1) + "\n")  # fmt: skip
-    job = plan.job
-    if job.source is not None:
-        data = job.source_bytes if job.source_bytes is not None else Path(job.source).read_bytes()
+    data = plan.source_bytes if plan.source_bytes is not None else job_source_bytes(plan.job)
+    if data is not None:  # the bytes the plan read (and hashed) once
         files["job"] = atomic_write_bytes(folder / "job.toml", data)
     return files

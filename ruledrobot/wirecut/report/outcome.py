@@ -39,7 +39,7 @@ def _cut_sections(plan: Plan, ver: Verification | None) -> tuple[list[dict], lis
     cut_meta = plan.trajectory.meta.cut
     feeds = {f.name: f for f in feed_measures(mo.wire, cut_meta)}
     for cut in plan.job.cuts:
-        ks = [k for k, cp in enumerate(plan.passes) if cp.name == cut.name]
+        ks = [k for k, cp in enumerate(plan.passes) if cp.cut is cut]
         passes = [plan.passes[k] for k in ks]
         rows = np.isin(mo.pass_of, ks) & mo.surface
         interior = rows & ~mo.timed.feed_limited
@@ -109,7 +109,7 @@ def _unreachable(plan: Plan) -> tuple[dict, Verdict]:
     report = {
         "format": REPORT_FORMAT,
         "robot": plan.job.robot.model,
-        "job": job_reference(plan.job),
+        "job": job_reference(plan),
         "input_rulings": cp.input_rulings,
         "refinement_steps": cp.steps,
         "path_rulings": int(sum(len(p.frames) for p in plan.passes)),
@@ -160,7 +160,7 @@ def plan_outcome(plan: Plan, ver: Verification | None) -> tuple[dict, Verdict]:
     report = {
         "format": REPORT_FORMAT,
         "robot": job.robot.model,
-        "job": job_reference(job),
+        "job": job_reference(plan),
         "input_rulings": first["input_rulings"],
         "refinement_steps": first["refinement_steps"],
         "path_rulings": meas.rulings,

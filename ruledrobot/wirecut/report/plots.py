@@ -51,7 +51,7 @@ def plot_plan(path: str | Path, plan: Plan, part=None) -> Path:
     fig = Figure(figsize=(14, 9))
     FigureCanvasAgg(fig)
     ax = fig.add_subplot(2, 2, (1, 3), projection="3d")
-    W = BowTool.from_spec(job.tool).wire_frame()
+    W = BowTool.of(job.tool if plan.bow is None else plan.bow).wire_frame()
     half = 0.5 * job.tool.wire_length
     colours = ["tab:blue", "tab:green", "tab:brown", "tab:pink", "tab:olive", "tab:cyan"]
     for cp in plan.passes:
@@ -100,7 +100,7 @@ def plot_plan(path: str | Path, plan: Plan, part=None) -> Path:
     ax3 = fig.add_subplot(2, 2, 4)
     _phase_bands(ax3, t, mo.labels)
     for cut in job.cuts:
-        ks = [k for k, cp in enumerate(plan.passes) if cp.name == cut.name]
+        ks = [k for k, cp in enumerate(plan.passes) if cp.cut is cut]
         rows = np.isin(mo.pass_of, ks) & mo.surface
         ax3.plot(t[rows], me.feed[rows] * 1e3, ".", ms=1,
                  label=f"{cut.name} (set {cut.feed_speed * 1e3:g})")  # fmt: skip
