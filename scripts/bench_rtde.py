@@ -93,7 +93,7 @@ def _stats(arrivals: np.ndarray, stamps: np.ndarray, period: float) -> dict[str,
 
 
 def _backend(physics: str):
-    from ruledrobot.ursim.physics import MujocoBackend
+    from ruledrobot.ursim.arm.physics import MujocoBackend
 
     return MujocoBackend if physics == "mujoco" else None
 

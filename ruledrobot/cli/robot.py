@@ -293,7 +293,7 @@ def ursim(
     secondary 30002) until Ctrl-C, optionally calibrated and with faults on a timer or on a
     signal (docs/rtde.md)."""
     from ..ursim import serve
-    from ..ursim.arm import emulated_model
+    from ..ursim.arm.emulated import emulated_model
     from ..ursim.faults import FaultSchedule, parse_fault
 
     if physics not in ("kinematic", "mujoco"):
@@ -328,7 +328,7 @@ def ursim(
 
     options: dict = {} if programs is None else {"programs_dir": str(programs)}
     if physics == "mujoco":
-        from ..ursim.physics import MujocoBackend
+        from ..ursim.arm.physics import MujocoBackend
 
         options["backend"] = MujocoBackend
     if arm is not None:

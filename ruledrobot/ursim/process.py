@@ -34,8 +34,8 @@ from numpy.typing import ArrayLike
 from ..protocol.modes import RobotMode, RuntimeState, SafetyMode
 from ..protocol.primary import KinematicsInfo
 from ..robot import Calibration, RobotModel
-from .arm import emulated_model
-from .backend import ArmBackend
+from .arm.backend import ArmBackend
+from .arm.emulated import emulated_model
 from .server import ThreadedEmulator
 
 __all__ = ["EMBEDDED_HOST", "Emulator", "embedded_emulator"]
@@ -407,7 +407,7 @@ def embedded_emulator(
     """The default target of ``ruledrobot run`` and ``demo`` without a robot address: a
     MuJoCo-backed emulator of ``model`` with the arm at ``q0`` (rad), on loopback, closed
     on exit."""
-    from .physics import MujocoBackend
+    from .arm.physics import MujocoBackend
 
     emu = Emulator(host, model, q0=q0, backend=MujocoBackend).start()
     try:

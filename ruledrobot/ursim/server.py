@@ -29,15 +29,15 @@ from numpy.typing import ArrayLike
 
 from ..protocol.modes import RobotMode, RuntimeState, SafetyMode
 from ..robot import Calibration, RobotModel
-from .arm import emulated_model, kinematics_info_of
-from .backend import ArmBackend, KinematicBackend
+from .arm.backend import ArmBackend, KinematicBackend
+from .arm.emulated import emulated_model, kinematics_info_of
 from .clock import ClockStats
-from .controller import Controller
-from .dashboard import DashboardServer
-from .primary_port import PrimaryPublisher, PrimaryServer
-from .rtde_server import RTDEServer
-from .script_port import ScriptPortServer
-from .tcp import try_realtime_priority
+from .controller.machine import Controller
+from .ports.dashboard import DashboardServer
+from .ports.primary import PrimaryPublisher, PrimaryServer
+from .ports.rtde import RTDEServer
+from .ports.script import ScriptPortServer
+from .ports.tcp import try_realtime_priority
 
 __all__ = [
     "CB3_VERSION",

@@ -23,7 +23,7 @@ from ruledrobot.export.verify_program import (
 from ruledrobot.io.trajectory import write_trajectory
 from ruledrobot.robot import load
 from ruledrobot.robot.motion.trajectory import Heat, Phase, Trajectory
-from ruledrobot.ursim.program import parse_call
+from ruledrobot.ursim.script.program import parse_call
 from ruledrobot.wirecut.job.demo import DEMO_JOB
 from ruledrobot.wirecut.job.load import load_job
 from ruledrobot.wirecut.planner import plan

@@ -11,7 +11,7 @@ from ruledrobot.export import run_trajectory
 from ruledrobot.io.trajectory import read_trajectory, write_trajectory
 from ruledrobot.robot import load
 from ruledrobot.robot.motion.trajectory import Trajectory
-from ruledrobot.ursim.physics import MujocoBackend
+from ruledrobot.ursim.arm.physics import MujocoBackend
 from tests.support.emulators import start_emulator
 
 MODEL = "ur5e"

@@ -14,7 +14,7 @@ from ruledrobot.io.trajectory import read_trajectory
 from ruledrobot.robot import load, model_for
 from ruledrobot.robot.motion.trajectory import Payload, Trajectory
 from ruledrobot.ursim import Emulator
-from ruledrobot.ursim.program import Pose, parse_call
+from ruledrobot.ursim.script.program import Pose, parse_call
 from tests.support.emulators import smooth_trajectory
 
 

@@ -20,14 +20,14 @@ import pytest
 
 from ruledrobot.ursim import Emulator, ThreadedEmulator
 from ruledrobot.ursim.faults import FaultSpec, parse_fault
-from ruledrobot.ursim.program import (
+from ruledrobot.ursim.script.functions import bind
+from ruledrobot.ursim.script.program import (
     MAX_LINE_BYTES,
     MAX_PROGRAM_BYTES,
     ProgramSplitter,
     ScriptSyntaxError,
     parse_call,
 )
-from ruledrobot.ursim.script_functions import bind
 from tests.support.emulators import _address, start_emulator
 from tests.support.rawclient import UR_RTDE_RECEIVE_RECIPE, RawRTDEClient
 

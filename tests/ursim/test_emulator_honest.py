@@ -22,7 +22,7 @@ from ruledrobot.export import urscript_program
 from ruledrobot.robot import load
 from ruledrobot.robot.motion.trajectory import Payload, Trajectory
 from ruledrobot.ursim import DEFAULT_Q, Emulator
-from ruledrobot.ursim.controller import Controller
+from ruledrobot.ursim.controller.machine import Controller
 from tests.support.emulators import UR, smooth_trajectory
 from tests.support.rawclient import RawRTDEClient
 

@@ -28,8 +28,8 @@ from ruledrobot.robot.motion.ur_motion import (
     linear_segment,
 )
 from ruledrobot.ursim import DEFAULT_Q, KinematicBackend
-from ruledrobot.ursim.controller import Controller
-from ruledrobot.ursim.program import ProgramSplitter, parse_call, parse_program
+from ruledrobot.ursim.controller.machine import Controller
+from ruledrobot.ursim.script.program import ProgramSplitter, parse_call, parse_program
 from tests.support.rawclient import UR_RTDE_RECEIVE_RECIPE
 
 

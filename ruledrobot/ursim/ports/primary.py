@@ -40,8 +40,8 @@ import threading
 import time
 from collections.abc import Callable, Sequence
 
-from ..protocol.modes import RobotMode, RuntimeState, SafetyMode
-from ..protocol.primary import (
+from ...protocol.modes import RobotMode, RuntimeState, SafetyMode
+from ...protocol.primary import (
     KinematicsInfo,
     RobotModeData,
     Version,
@@ -50,8 +50,8 @@ from ..protocol.primary import (
     robot_state_message,
     version_message,
 )
-from .controller import Controller
-from .script_port import ProgramReceiver
+from ..controller.machine import Controller
+from .script import ProgramReceiver
 from .tcp import Connection, QueuedConnection, TcpServer, writable_fds
 
 __all__ = [

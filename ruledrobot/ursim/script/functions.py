@@ -3,7 +3,7 @@
 A program is checked whole before it starts, as the controller compiles a
 program before running it: every statement must call a function of
 :data:`FUNCTIONS` with arguments of the right kind and range.  Anything else
-raises :class:`~.program.CompileError` naming the line, its text and the
+raises :class:`~ruledrobot.ursim.script.program.CompileError` naming the line, its text and the
 reason, and the program is refused (nothing of it runs).
 
 Arguments are literals (the emulator has no variables), so ranges that the

@@ -7,9 +7,9 @@ import os
 
 import numpy as np
 
-from ..io.calibration import load_calibration
-from ..protocol.primary import KinematicsInfo
-from ..robot import Calibration, RobotModel, load, random_calibration
+from ...io.calibration import load_calibration
+from ...protocol.primary import KinematicsInfo
+from ...robot import Calibration, RobotModel, load, random_calibration
 
 __all__ = ["emulated_model", "kinematics_info_of"]
 

@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..robot import RobotModel
+from ...robot import RobotModel
 from .backend import ArmState, KinematicBackend
 
 __all__ = ["MujocoBackend"]
@@ -24,8 +24,8 @@ class MujocoBackend(KinematicBackend):
     """The kinematic setpoint tracked by the MuJoCo servo model of ``model``."""
 
     def __init__(self, model: RobotModel, **kwargs: object) -> None:
-        from ..sim._mujoco import mujoco
-        from ..sim.mjcf import physics_timestep, robot_mjcf
+        from ...sim._mujoco import mujoco
+        from ...sim.mjcf import physics_timestep, robot_mjcf
 
         self._mj = mj = mujoco()
         self._m = mj.MjModel.from_xml_string(robot_mjcf(model, collisions=False))

@@ -23,7 +23,7 @@ from typing import Protocol, runtime_checkable
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..robot import RobotModel
+from ...robot import RobotModel
 
 __all__ = ["HARDWARE_ACCELERATION", "ArmBackend", "ArmState", "KinematicBackend"]
 

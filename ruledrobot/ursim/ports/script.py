@@ -4,10 +4,10 @@ ur_rtde keeps this connection open for the whole session and writes its
 control script (and re-uploads for path moves) as raw text.  A real
 controller streams realtime-interface data here, which ur_rtde never reads;
 the emulator stays silent.  Each complete program (see
-:class:`~.program.ProgramSplitter`) goes to the controller, where it
+:class:`~ruledrobot.ursim.script.program.ProgramSplitter`) goes to the controller, where it
 replaces the running one.  A program beyond
-:data:`~.program.MAX_PROGRAM_BYTES` (8 MiB) or a line beyond
-:data:`~.program.MAX_LINE_BYTES` (64 KiB) is refused: logged at error level,
+:data:`~ruledrobot.ursim.script.program.MAX_PROGRAM_BYTES` (8 MiB) or a line beyond
+:data:`~ruledrobot.ursim.script.program.MAX_LINE_BYTES` (64 KiB) is refused: logged at error level,
 the connection closed (the stream cannot be resynchronised).
 """
 
@@ -17,8 +17,8 @@ import codecs
 import logging
 from collections.abc import Callable
 
-from .controller import Controller
-from .program import ProgramSplitter
+from ..controller.machine import Controller
+from ..script.program import ProgramSplitter
 from .tcp import Connection, TcpServer
 
 __all__ = ["ProgramReceiver", "ScriptPortServer", "receive_programs"]
@@ -48,7 +48,8 @@ class ScriptPortServer(TcpServer):
 class ProgramReceiver:
     """Cuts one connection's URScript into programs and hands each to the controller
     (``received(text)`` is called first).  :meth:`feed` raises ValueError beyond
-    :data:`~.program.MAX_PROGRAM_BYTES` or :data:`~.program.MAX_LINE_BYTES` (the
+    :data:`~ruledrobot.ursim.script.program.MAX_PROGRAM_BYTES` or
+    :data:`~ruledrobot.ursim.script.program.MAX_LINE_BYTES` (the
     connection must then close: the stream cannot be resynchronised)."""
 
     def __init__(

@@ -37,8 +37,8 @@ from enum import IntEnum
 
 import numpy as np
 
-from ..geometry.se3 import pose_from_ur_vector, ur_vector_from_pose
-from ..robot.motion.ur_motion import (
+from ...geometry.se3 import pose_from_ur_vector, ur_vector_from_pose
+from ...robot.motion.ur_motion import (
     MotionError,
     PathMotion,
     StopMotion,

@@ -44,7 +44,7 @@ import time
 from collections import deque
 from collections.abc import Mapping
 
-from ..protocol.rtde import (
+from ...protocol.rtde import (
     CONTROL_PACKAGE_PAUSE,
     CONTROL_PACKAGE_SETUP_INPUTS,
     CONTROL_PACKAGE_SETUP_OUTPUTS,
@@ -64,8 +64,8 @@ from ..protocol.rtde import (
     parse_names,
     parse_output_setup,
 )
-from ..protocol.rtde_types import TYPE_SIZES
-from .controller import Controller
+from ...protocol.rtde_types import TYPE_SIZES
+from ..controller.machine import Controller
 from .tcp import Connection, QueuedConnection, TcpServer, writable_fds
 
 __all__ = ["RTDEConnection", "RTDEServer", "StreamStats", "due"]

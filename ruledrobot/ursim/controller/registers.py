@@ -2,7 +2,8 @@
 motion (RTDE input/output registers, digital and analog outputs with their log, the
 payload, the popup, the RTDE watchdog).
 
-A mixin of :class:`~.controller.Controller`: it uses the controller's ``lock``,
+A mixin of :class:`~ruledrobot.ursim.controller.machine.Controller`: it uses the
+controller's ``lock``,
 ``values``, ``time`` and program control, and keeps its own state in the attributes
 the controller's constructor sets (``std_do``, ``conf_do``, ``tool_do``,
 ``analog_out``, ``io_log``, ``_watch_*``).  Thread safety as the controller's: every
@@ -19,7 +20,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..protocol.modes import RuntimeState
+from ...protocol.modes import RuntimeState
 
 __all__ = ["IOMixin", "int32"]
 

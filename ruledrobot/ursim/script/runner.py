@@ -20,7 +20,8 @@ with checked arguments in ``Statement.params``), so nothing is skipped:
   ``set_standard_analog_out`` / ``set_analog_out``.
 
 Motion can still fail while the program runs (a pose out of reach): that is a
-runtime error, the program stops (:meth:`~.controller.Controller.program_error`).
+runtime error, the program stops
+(:meth:`~ruledrobot.ursim.controller.machine.Controller.program_error`).
 When the statements run out the program ends (runtime state STOPPED) and a
 servo or speed motion still in force is stopped with ``stopj(4)``.
 """
@@ -31,7 +32,7 @@ import math
 
 import numpy as np
 
-from ..robot.motion.ur_motion import (
+from ...robot.motion.ur_motion import (
     MotionError,
     PathMotion,
     Segment,
@@ -98,7 +99,7 @@ def run_io_statement(c: ProgramHost, st: Statement) -> bool:
 class ScriptRunner:
     """Executes a parsed standalone program on a controller, one period per step.
 
-    The controller is seen through :class:`~.host.ProgramHost`.
+    The controller is seen through :class:`~ruledrobot.ursim.script.host.ProgramHost`.
     """
 
     def __init__(self, host: ProgramHost, program: Program) -> None:

@@ -1,5 +1,5 @@
 """What a running program may use of the controller: the interface between the
-controller (:class:`~.controller.Controller`) and the program runners
+controller (:class:`~ruledrobot.ursim.controller.machine.Controller`) and the program runners
 (:class:`~.handshake.ControlScript` for ur_rtde's control script,
 :class:`~.script_runner.ScriptRunner` for standalone programs).
 
@@ -18,9 +18,9 @@ from typing import Protocol
 
 from numpy.typing import ArrayLike
 
-from ..robot.motion.arm_kinematics import ArmKinematics
-from ..robot.motion.ur_motion import PathMotion, StopMotion
-from .backend import ArmState
+from ...robot.motion.arm_kinematics import ArmKinematics
+from ...robot.motion.ur_motion import PathMotion, StopMotion
+from ..arm.backend import ArmState
 from .program import PathWaypoint
 
 __all__ = ["ProgramHost"]

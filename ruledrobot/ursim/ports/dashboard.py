@@ -11,8 +11,8 @@ from __future__ import annotations
 import logging
 from collections import deque
 
-from ..protocol.modes import RuntimeState
-from .controller import Controller
+from ...protocol.modes import RuntimeState
+from ..controller.machine import Controller
 from .tcp import Connection, TcpServer
 
 __all__ = ["GREETING", "DashboardServer"]

@@ -43,10 +43,10 @@ from threading import RLock
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..protocol.modes import JointMode, RobotMode, RuntimeState, SafetyMode, SafetyStatusBit
-from ..robot import RobotModel
-from ..robot.motion.arm_kinematics import ArmKinematics
-from ..robot.motion.ur_motion import (
+from ...protocol.modes import JointMode, RobotMode, RuntimeState, SafetyMode, SafetyStatusBit
+from ...robot import RobotModel
+from ...robot.motion.arm_kinematics import ArmKinematics
+from ...robot.motion.ur_motion import (
     MotionError,
     PathMotion,
     Segment,
@@ -54,13 +54,13 @@ from ..robot.motion.ur_motion import (
     joint_segment,
     linear_segment,
 )
-from .backend import ArmBackend, ArmState, KinematicBackend
-from .controller_io import IN_DOUBLE, IN_INT, OUT_DOUBLE, OUT_INT, IOMixin
-from .controller_safety import SafetyMixin
-from .handshake import ControlScript
-from .program import CompileError, PathWaypoint, Program, parse_program
-from .script_functions import compile_program
-from .script_runner import ScriptRunner, run_io_statement
+from ..arm.backend import ArmBackend, ArmState, KinematicBackend
+from ..script.functions import compile_program
+from ..script.handshake import ControlScript
+from ..script.program import CompileError, PathWaypoint, Program, parse_program
+from ..script.runner import ScriptRunner, run_io_statement
+from .registers import IN_DOUBLE, IN_INT, OUT_DOUBLE, OUT_INT, IOMixin
+from .safety import SafetyMixin
 
 __all__ = ["DEFAULT_Q", "Controller", "Event"]
 
@@ -306,7 +306,8 @@ class Controller(IOMixin, SafetyMixin):
         return r.line if isinstance(r, ScriptRunner) else 0
 
     def arm_state(self) -> ArmState:
-        """The arm's state after the last period (:class:`~.host.ProgramHost`)."""
+        """The arm's state after the last period (the
+        :class:`~ruledrobot.ursim.script.host.ProgramHost` interface)."""
         return self.backend.state()
 
     # ------------------------------------------------------------ log

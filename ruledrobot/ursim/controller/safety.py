@@ -1,8 +1,8 @@
 """The controller's power and safety: power on and off, brakes, protective and emergency
 stops, their unlocking and release, clearing faults.
 
-A mixin of :class:`~.controller.Controller` (its ``lock``, modes, motion and program
-control); thread safety as the controller's: every method takes ``lock``.
+A mixin of :class:`~ruledrobot.ursim.controller.machine.Controller` (its ``lock``,
+modes, motion and program control); thread safety as the controller's: every method takes ``lock``.
 """
 
 from __future__ import annotations
@@ -11,8 +11,8 @@ import time
 from threading import RLock
 from typing import Any
 
-from ..protocol.modes import RobotMode, SafetyMode
-from ..robot.motion.ur_motion import StopMotion
+from ...protocol.modes import RobotMode, SafetyMode
+from ...robot.motion.ur_motion import StopMotion
 
 __all__ = ["SafetyMixin"]
 

@@ -12,7 +12,7 @@ Two kinds of program matter:
   ``movep(p[...])``) line per waypoint.
 * any other program — e.g. the standalone programs
   :mod:`ruledrobot.export.urscript` writes — is parsed into its top-level
-  statements, which :class:`~.controller.Controller` runs with a small
+  statements, which :class:`~ruledrobot.ursim.controller.machine.Controller` runs with a small
   interpreter (:mod:`.script_runner`; the functions and their argument checks
   are in :mod:`.script_functions`).  A ``sec`` program is a secondary program:
   it runs beside the primary one (no motion, no waiting).
