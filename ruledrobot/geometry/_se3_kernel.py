@@ -1,6 +1,6 @@
 """Compiled (numba) kernel of :func:`ruledrobot.geometry.se3.geodesic` on 4x4 matrices.
 
-:func:`geodesic_rows` is the numpy chunk ``se3._geodesic_matrix_chunk`` written as one
+:func:`geodesic_rows` is the numpy chunk ``screw._geodesic_matrix_chunk`` written as one
 loop over the pairs: the same formulas, the same operations in the same order, every
 intermediate a scalar in a register instead of a 32 kB temporary.  It is bit for bit the
 numpy path: no fused multiply-adds (no ``fastmath``), ``sqrt`` and division are exact
@@ -21,7 +21,7 @@ import math
 import numba as nb
 from numba import types
 
-_SMALL = 1e-6  # sin(phi) below this: the series of sin(t phi)/sin(phi) (se3.ScrewPair)
+_SMALL = 1e-6  # sin(phi) below this: the series of sin(t phi)/sin(phi) (screw.ScrewPair)
 
 # inputs read-only (broadcast views are), output writable; writable inputs convert
 _POSES_IN = types.Array(types.float64, 3, "C", readonly=True)
@@ -32,7 +32,7 @@ _SIG = types.void(_POSES_IN, _POSES_IN, _T_IN, types.float64[:, :, ::1])
 @nb.njit(_SIG, cache=True, nogil=True, error_model="numpy")
 def geodesic_rows(A, B, t, out):
     """``out[i] = A[i] exp(t[i] log(inv(A[i]) B[i]))`` for contiguous (n, 4, 4) ``A``,
-    ``B``, ``out`` and (n,) ``t``; the formulas of ``se3._geodesic_matrix_chunk``."""
+    ``B``, ``out`` and (n,) ``t``; the formulas of ``screw._geodesic_matrix_chunk``."""
     for i in range(A.shape[0]):
         a = A[i]
         b = B[i]
@@ -57,7 +57,7 @@ def geodesic_rows(A, B, t, out):
         px = a00 * dx + a10 * dy + a20 * dz
         py = a01 * dx + a11 * dy + a21 * dz
         pz = a02 * dx + a12 * dy + a22 * dz
-        # Shepperd (se3._quat_from_rot): the row of 4 q q^T with the largest diagonal
+        # Shepperd (screw._quat_from_rot): the row of 4 q q^T with the largest diagonal
         t0 = 1.0 + m00 + m11 + m22
         t1 = 1.0 + m00 - m11 - m22
         t2 = 1.0 - m00 + m11 - m22
@@ -82,7 +82,7 @@ def geodesic_rows(A, B, t, out):
             w, x, y, z = t0, m21 - m12, m02 - m20, m10 - m01
         scale = math.copysign(1.0, w) / math.sqrt(w * w + x * x + y * y + z * z)
         w, x, y, z = w * scale, x * scale, y * scale, z * scale
-        # the screw (se3.ScrewPair.from_relative)
+        # the screw (screw.ScrewPair.from_relative)
         sign = math.copysign(1.0, w)
         w, x, y, z = w * sign, x * sign, y * sign, z * sign
         s = math.sqrt(x * x + y * y + z * z)
@@ -93,7 +93,7 @@ def geodesic_rows(A, B, t, out):
         ax_, ay_, az_ = dot * ux, dot * uy, dot * uz
         qx, qy, qz = px - ax_, py - ay_, pz - az_
         cx, cy, cz = uy * qz - uz * qy, uz * qx - ux * qz, ux * qy - uy * qx
-        # exp(t log D) (se3.ScrewPair.relative_at)
+        # exp(t log D) (screw.ScrewPair.relative_at)
         tphi = ti * phi
         sn = math.sin(tphi)
         cs = math.cos(tphi)
@@ -108,7 +108,7 @@ def geodesic_rows(A, B, t, out):
         ty = ti * ay_ + rc * qy - rs * cy
         tz = ti * az_ + rc * qz - rs * cz
         qw, qx_, qy_, qz_ = cs, sn * ux, sn * uy, sn * uz
-        # rotation of q(t) (se3._rot_from_quat), then A's rotation times it
+        # rotation of q(t) (screw._rot_from_quat), then A's rotation times it
         xx, yy, zz = qx_ * qx_, qy_ * qy_, qz_ * qz_
         xy, xz, yz = qx_ * qy_, qx_ * qz_, qy_ * qz_
         wx, wy, wz = qw * qx_, qw * qy_, qw * qz_
