@@ -24,6 +24,7 @@ from typing import Any
 
 from ..robot.arm.calibration import _COLUMNS, Calibration, CalibrationError, _column
 from .atomic import atomic_write_text
+from .text import json_object, read_user_text
 
 __all__ = ["CALIBRATION_FORMAT", "load_calibration", "save_calibration"]
 
@@ -55,19 +56,8 @@ def load_calibration(path: str | os.PathLike[str]) -> Calibration:
     the field, e.g. ``cal.json: dh.d[2] (joint 3 (elbow)): not a finite number`` or
     ``cal.json: joint 4 (wrist 1): alpha = ... differs from the nominal ...``.
     """
-    p = Path(path)
-    try:
-        text = p.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise CalibrationError(f"{p}: no such calibration file") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise CalibrationError(f"{p}: cannot read ({exc})") from None
-    try:
-        doc = json.loads(text)
-    except json.JSONDecodeError as exc:
-        raise CalibrationError(f"{p}: not JSON (line {exc.lineno}: {exc.msg})") from None
-    if not isinstance(doc, dict):
-        raise CalibrationError(f"{p}: expected a JSON object, got {type(doc).__name__}")
+    p, text = read_user_text(path, "calibration file", CalibrationError)
+    doc = json_object(text, str(p), CalibrationError, "not JSON (line {line}: {msg})")
     fmt = doc.get("format")
     if fmt != CALIBRATION_FORMAT:
         raise CalibrationError(f"{p}: format: expected {CALIBRATION_FORMAT!r}, got {fmt!r}")

@@ -33,7 +33,7 @@ from numpy.typing import ArrayLike
 from ..geometry.checks import FloatArray
 from ..geometry.lines import Lines, plucker_from_point_direction, validate_plucker
 from .atomic import atomic_write_text
-from .text import read_user_text
+from .text import json_object, read_user_text
 from .units import unit_scale
 
 __all__ = ["FORMAT", "LinesDocument", "load_lines", "read_lines_document", "save_lines"]
@@ -94,12 +94,7 @@ def _lines_from_entries(entries: list, where: str) -> Lines:
 
 def _read_json(path: Path, text: str) -> LinesDocument:
     where = str(path)
-    try:
-        doc = json.loads(text)
-    except json.JSONDecodeError as exc:
-        raise ValueError(f"{where}: line {exc.lineno}: not valid JSON ({exc.msg})") from None
-    if not isinstance(doc, dict):
-        raise ValueError(f"{where}: expected a JSON object at the top level")
+    doc = json_object(text, where)
     fmt = doc.get("format", FORMAT)
     if fmt != FORMAT:
         raise ValueError(f"{where}: format {fmt!r} is not supported; expected {FORMAT!r}")

@@ -2,19 +2,40 @@
 
 from __future__ import annotations
 
+import json
 import os
 from pathlib import Path
+from typing import Any
 
-__all__ = ["read_user_text"]
+__all__ = ["json_object", "read_user_text"]
 
 
-def read_user_text(path: str | os.PathLike[str], kind: str = "file") -> tuple[Path, str]:
-    """``(path, text)`` of a utf-8 file; ValueError naming the file when it is missing
-    (``"no such <kind>"``) or unreadable."""
+def read_user_text(
+    path: str | os.PathLike[str], kind: str = "file", error: type[ValueError] = ValueError
+) -> tuple[Path, str]:
+    """``(path, text)`` of a utf-8 file; ``error`` (a ValueError) naming the file when it is
+    missing (``"no such <kind>"``) or unreadable."""
     p = Path(path)
     try:
         return p, p.read_text(encoding="utf-8")
     except FileNotFoundError:
-        raise ValueError(f"{p}: no such {kind}") from None
+        raise error(f"{p}: no such {kind}") from None
     except (OSError, UnicodeDecodeError) as exc:
-        raise ValueError(f"{p}: cannot read ({exc})") from None
+        raise error(f"{p}: cannot read ({exc})") from None
+
+
+def json_object(
+    text: str,
+    where: str,
+    error: type[ValueError] = ValueError,
+    not_json: str = "line {line}: not valid JSON ({msg})",
+) -> dict[str, Any]:
+    """The JSON object ``text`` of the file ``where`` holds; ``error`` naming the file when it
+    is not JSON (``not_json`` with the line and the parser's message) or not an object."""
+    try:
+        doc = json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise error(f"{where}: " + not_json.format(line=exc.lineno, msg=exc.msg)) from None
+    if not isinstance(doc, dict):
+        raise error(f"{where}: expected a JSON object, got {type(doc).__name__}")
+    return doc

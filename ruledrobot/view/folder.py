@@ -19,7 +19,6 @@ missing; a damaged file raises ValueError naming the file and field.
 
 from __future__ import annotations
 
-import json
 import os
 import sys
 from dataclasses import dataclass, field
@@ -32,7 +31,7 @@ from ..io.lines import read_lines_document
 from ..io.mesh import read_stl
 from ..io.outdir import read_manifest
 from ..io.paths import input_path
-from ..io.text import read_user_text
+from ..io.text import json_object, read_user_text
 from ..robot.motion.trajectory import Trajectory
 from ..robot.verdict import Check
 
@@ -93,13 +92,7 @@ class PlanFolder:
 
 def _json(path: Path, kind: str) -> dict[str, Any]:
     p, text = read_user_text(path, kind)
-    try:
-        doc = json.loads(text)
-    except json.JSONDecodeError as exc:
-        raise ValueError(f"{p}: line {exc.lineno}: not valid JSON ({exc.msg})") from None
-    if not isinstance(doc, dict):
-        raise ValueError(f"{p}: expected a JSON object")
-    return doc
+    return json_object(text, str(p))
 
 
 def _job(folder: Path, report: dict[str, Any], notes: list[str]) -> Any:

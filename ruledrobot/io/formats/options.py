@@ -14,13 +14,14 @@ from typing import Any
 
 import numpy as np
 
+from ..fields import FieldReader
 from ..paths import input_path, missing_file
 from ..units import unit_name
 
 __all__ = ["Options"]
 
 
-class Options:
+class Options(FieldReader):
     """Checked access to a mapping of options.
 
     ``where`` prefixes every message (``"job.toml: [surface.gcode]"``); ``cli=True``
@@ -70,8 +71,7 @@ class Options:
             if required:
                 raise self.fail(key, f"missing; {required}")
             return None
-        if isinstance(v, bool) or not isinstance(v, (int, float)) or not np.isfinite(v):
-            raise self.fail(key, f"expected a finite number, got {v!r}")
+        self.finite(key, v)
         if positive and v <= 0:
             raise self.fail(key, f"expected a number > 0, got {v!r}")
         if nonzero and v == 0:
@@ -103,12 +103,6 @@ class Options:
             raise self.fail(key, f"expected one of {', '.join(options)}, got {v!r}")
         return v.lower()
 
-    def boolean(self, key: str, default: bool) -> bool:
-        v = self.get(key, default)
-        if not isinstance(v, bool):
-            raise self.fail(key, f"expected true or false, got {v!r}")
-        return v
-
     def string(self, key: str, default: str | None = None) -> str | None:
         v = self.get(key, default)
         if v is not None and not isinstance(v, str):
@@ -131,18 +125,7 @@ class Options:
 
     def vector(self, key: str, n: int) -> np.ndarray | None:
         v = self.get(key)
-        if v is None:
-            return None
-        if (
-            not isinstance(v, (list, tuple))
-            or len(v) != n
-            or any(isinstance(x, bool) or not isinstance(x, (int, float)) for x in v)
-        ):
-            raise self.fail(key, f"expected a list of {n} numbers, got {v!r}")
-        arr = np.asarray(v, dtype=np.float64)
-        if not np.all(np.isfinite(arr)):
-            raise self.fail(key, "contains NaN or infinity")
-        return arr
+        return None if v is None else self.numbers(key, v, n)
 
     def unit(self, key: str, default: str | None = None) -> str | None:
         v = self.get(key, default)

@@ -15,6 +15,7 @@ import numpy as np
 
 from ...geometry import se3
 from ...geometry.box import Box
+from ...io.fields import FieldReader
 from ...io.paths import input_path, missing_file
 from ...robot.arm.calibration import Calibration
 from ...subdivision.schemes import SCHEME_NAMES
@@ -30,7 +31,7 @@ FOREIGN_KINDS = ("gcode", "airfoil", "dxf", "rhino")
 HEAT_OUTPUTS = {"standard": 8, "configurable": 8, "tool": 2, "analog": 2}
 
 
-class Section:
+class Section(FieldReader):
     """Typed access to one TOML table with errors naming file, section and field."""
 
     def __init__(
@@ -72,8 +73,7 @@ class Section:
         v = self.get(key, default)
         if v is None:
             raise self.fail(key, "missing; expected a number")
-        if isinstance(v, bool) or not isinstance(v, (int, float)) or not np.isfinite(v):
-            raise self.fail(key, f"expected a finite number, got {v!r}")
+        self.finite(key, v)
         if lo is not None and (v < lo or (strict_lo and v == lo)):
             rel = ">" if strict_lo else ">="
             raise self.fail(key, f"expected a number {rel} {lo:g}, got {v!r}")
@@ -85,16 +85,7 @@ class Section:
         v = self.get(key, default)
         if v is None:
             raise self.fail(key, f"missing; expected a list of {n} numbers")
-        if (
-            not isinstance(v, list)
-            or len(v) != n
-            or any(isinstance(x, bool) or not isinstance(x, (int, float)) for x in v)
-        ):
-            raise self.fail(key, f"expected a list of {n} numbers, got {v!r}")
-        arr = np.asarray(v, dtype=np.float64)
-        if not np.all(np.isfinite(arr)):
-            raise self.fail(key, "contains NaN or infinity")
-        return arr
+        return self.numbers(key, v, n, (list,))
 
     def choice(self, key: str, options: tuple[str, ...], default: str) -> str:
         v = self.get(key, default)
@@ -102,12 +93,7 @@ class Section:
             raise self.fail(key, f"expected one of {', '.join(options)}, got {v!r}")
         return str(v)
 
-    def flag(self, key: str, default: bool) -> bool:
-        """``key`` as true or false (``default`` when absent)."""
-        v = self.get(key, default)
-        if not isinstance(v, bool):
-            raise self.fail(key, f"expected true or false, got {v!r}")
-        return v
+    flag = FieldReader.boolean  # ``key`` as true or false (``default`` when absent)
 
     def done(self) -> None:
         extra = sorted(set(self.raw) - self.used)
