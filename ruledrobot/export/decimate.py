@@ -10,6 +10,7 @@ kept.  Used for ``movel``/``movep`` programs and for the runner's path mode.
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Callable
 from dataclasses import dataclass
 from itertools import pairwise
 
@@ -65,11 +66,26 @@ def decimate_tcp_path(
         raise ValueError(f"tcp: expected shape (M, 6) UR pose vectors, got {tcp.shape}")
     if not tolerance > 0 or not angle_tolerance > 0:
         raise ValueError("tolerance and angle_tolerance: must be positive")
-    M = tcp.shape[0]
+    p = tcp[:, :3]
+    R = _rot(tcp[:, 3:]) if tcp.shape[0] > 2 else None
+
+    def split(i: int, j: int) -> int | None:
+        pos, ang = _segment_errors(p, R, i, j)
+        score = np.maximum(pos / tolerance, ang / angle_tolerance)
+        k = int(np.argmax(score))
+        if score[k] > 1.0:
+            return i + 1 + k
+        return (i + j) // 2 if max_segment > 0 and j - i > max_segment else None
+
+    return _kept_samples(tcp.shape[0], split)
+
+
+def _kept_samples(M: int, split: Callable[[int, int], int | None]) -> np.ndarray:
+    """Ramer-Douglas-Peucker on sample indices: from the segment (0, M - 1), split every
+    segment of 3 or more samples where ``split(i, j)`` says (None: keep it whole).
+    Returns the sorted indices kept, first and last included."""
     if M <= 2:
         return np.arange(M)
-    p = tcp[:, :3]
-    R = _rot(tcp[:, 3:])
     keep = np.zeros(M, dtype=bool)
     keep[0] = keep[-1] = True
     stack = [(0, M - 1)]
@@ -77,15 +93,10 @@ def decimate_tcp_path(
         i, j = stack.pop()
         if j - i < 2:
             continue
-        pos, ang = _segment_errors(p, R, i, j)
-        score = np.maximum(pos / tolerance, ang / angle_tolerance)
-        k = int(np.argmax(score))
-        too_long = max_segment > 0 and j - i > max_segment
-        if score[k] > 1.0 or too_long:
-            m = i + 1 + k if score[k] > 1.0 else (i + j) // 2
+        m = split(i, j)
+        if m is not None:
             keep[m] = True
-            stack.append((i, m))
-            stack.append((m, j))
+            stack += [(i, m), (m, j)]
     return np.flatnonzero(keep)
 
 
@@ -123,16 +134,8 @@ def decimate_points(x: np.ndarray, tolerance: float) -> np.ndarray:
     ``tolerance`` (Euclidean) of the straight segment between its kept neighbours, at its
     own fraction of the segment's samples' index (as a joint move passes them)."""
     x = np.asarray(x, dtype=float)
-    M = x.shape[0]
-    if M <= 2:
-        return np.arange(M)
-    keep = np.zeros(M, dtype=bool)
-    keep[0] = keep[-1] = True
-    stack = [(0, M - 1)]
-    while stack:
-        i, j = stack.pop()
-        if j - i < 2:
-            continue
+
+    def split(i: int, j: int) -> int | None:
         a, b = x[i], x[j]
         ab = b - a
         L2 = float(ab @ ab)
@@ -140,10 +143,9 @@ def decimate_points(x: np.ndarray, tolerance: float) -> np.ndarray:
         s = np.clip(((inner - a) @ ab) / L2, 0.0, 1.0) if L2 > 0 else np.zeros(j - i - 1)
         err = np.linalg.norm(inner - (a + s[:, None] * ab), axis=1)
         k = int(np.argmax(err))
-        if err[k] > tolerance:
-            keep[i + 1 + k] = True
-            stack += [(i, i + 1 + k), (i + 1 + k, j)]
-    return np.flatnonzero(keep)
+        return i + 1 + k if err[k] > tolerance else None
+
+    return _kept_samples(x.shape[0], split)
 
 
 def _speed_splits(speed: np.ndarray, i: int, j: int, change: float, floor: float) -> list[int]:

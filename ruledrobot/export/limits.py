@@ -66,22 +66,16 @@ def check_trajectory(
             f"outside the limits [{lo[j]:.6g}, {hi[j]:.6g}] rad of {model.name}"
         )
     v, a = finite_difference_rates(ts, q)
-    vmax = np.asarray(model.max_velocity) * (1.0 + tolerance)
-    bad = np.abs(v) > vmax
-    if bad.any():
-        k, j = np.argwhere(bad)[0]
-        raise ValueError(
-            f"trajectory sample {k + 1} (t = {t[k + 1]:.4f} s): joint q{j + 1} speed "
-            f"{abs(v[k, j]):.4g} rad/s exceeds the limit {model.max_velocity[j]:.4g} rad/s of "
-            f"{model.name}" + (f" at speed_scale {speed_scale:g}" if speed_scale != 1.0 else "")
-        )
-    amax = np.asarray(model.max_acceleration) * (1.0 + tolerance)
-    bad = np.abs(a) > amax
-    if bad.any():
-        k, j = np.argwhere(bad)[0]
-        raise ValueError(
-            f"trajectory sample {k + 1} (t = {t[k + 1]:.4f} s): joint q{j + 1} acceleration "
-            f"{abs(a[k, j]):.4g} rad/s^2 exceeds the limit {model.max_acceleration[j]:.4g} "
-            f"rad/s^2 of {model.name}"
-            + (f" at speed_scale {speed_scale:g}" if speed_scale != 1.0 else "")
-        )
+    scaled = f" at speed_scale {speed_scale:g}" if speed_scale != 1.0 else ""
+    for rate, limit, what, unit in (
+        (v, model.max_velocity, "speed", "rad/s"),
+        (a, model.max_acceleration, "acceleration", "rad/s^2"),
+    ):
+        bad = np.abs(rate) > np.asarray(limit) * (1.0 + tolerance)
+        if bad.any():
+            k, j = np.argwhere(bad)[0]
+            raise ValueError(
+                f"trajectory sample {k + 1} (t = {t[k + 1]:.4f} s): joint q{j + 1} {what} "
+                f"{abs(rate[k, j]):.4g} {unit} exceeds the limit {limit[j]:.4g} {unit} of "
+                f"{model.name}{scaled}"
+            )
