@@ -40,6 +40,13 @@ TREE_ITERATIONS = 1500
 SEED = 20261202
 
 
+def _samples(qa: FloatArray, qb: FloatArray) -> FloatArray:
+    """The checked samples (n, J) of the straight joint move qa -> qb (``RESOLUTION``)."""
+    n = max(2, int(np.ceil(np.abs(qb - qa).max() / RESOLUTION)) + 1)
+    u = np.linspace(0.0, 1.0, n)[:, None]
+    return qa + u * (qb - qa)
+
+
 @dataclass(frozen=True)
 class TransitPlanner:
     """Routes joint moves around the stock for one job's cell."""
@@ -83,9 +90,14 @@ class TransitPlanner:
 
     def clear(self, qa: FloatArray, qb: FloatArray) -> bool:
         """True when every sample of the straight joint move qa -> qb is free."""
-        n = max(2, int(np.ceil(np.abs(qb - qa).max() / RESOLUTION)) + 1)
-        u = np.linspace(0.0, 1.0, n)[:, None]
-        return bool(self.free(qa + u * (qb - qa)).all())
+        return bool(self.free(_samples(qa, qb)).all())
+
+    def clear_moves(self, moves: list[tuple[FloatArray, FloatArray]]) -> np.ndarray:
+        """(K,) :meth:`clear` of each move, their samples checked in one batch."""
+        samples = [_samples(qa, qb) for qa, qb in moves]
+        free = self.free(np.concatenate(samples))
+        ends = np.cumsum([len(x) for x in samples])
+        return np.array([bool(f.all()) for f in np.split(free, ends[:-1])])
 
     def lifted(self, q: FloatArray) -> FloatArray | None:
         """Joints nearest ``q`` with the flange raised until the bow and wire are CLEAR
@@ -107,22 +119,29 @@ class TransitPlanner:
         return best if model.within_limits(best) else None
 
     def _tree(self, qa: FloatArray, qb: FloatArray) -> list[FloatArray] | None:
-        """RRT-connect from ``qa`` to ``qb`` (module doc); the waypoints, or None."""
+        """RRT-connect from ``qa`` to ``qb`` (module doc); the waypoints, or None.
+
+        The moves are checked in batches, the route is the one checking them one at a
+        time finds: an iteration whose extension is blocked changes no tree, so the
+        extensions of the iterations up to the next unblocked one are made and checked
+        together (1, 2, 4, ... of them), and so are the moves of a greedy connection."""
         rng = np.random.default_rng(SEED)
         trees = [([qa], [-1]), ([qb], [-1])]
+        drawn: list[FloatArray] = []  # random samples drawn ahead, in the order they are used
 
-        def extend(tree, target) -> int | None:
-            nodes, parents = tree
-            arr = np.asarray(nodes)
+        def step(tree, target) -> tuple[int, FloatArray]:
+            """The node of ``tree`` nearest ``target`` (max norm) and the new node one
+            ``TREE_STEP`` from it towards ``target`` (``target`` itself when nearer)."""
+            arr = np.asarray(tree[0])
             i = int(np.argmin(np.abs(arr - target).max(axis=1)))
             d = target - arr[i]
             span = float(np.abs(d).max())
-            new = target if span <= TREE_STEP else arr[i] + d * (TREE_STEP / span)
-            if not self.clear(arr[i], new):
-                return None
-            nodes.append(new)
-            parents.append(i)
-            return len(nodes) - 1
+            return i, target if span <= TREE_STEP else arr[i] + d * (TREE_STEP / span)
+
+        def add(tree, i: int, new: FloatArray) -> int:
+            tree[0].append(new)
+            tree[1].append(i)
+            return len(tree[0]) - 1
 
         def path(tree, k) -> list[FloatArray]:
             nodes, parents = tree
@@ -132,20 +151,53 @@ class TransitPlanner:
                 k = parents[k]
             return out
 
-        for it in range(TREE_ITERATIONS):
-            a, b = trees[it % 2], trees[1 - it % 2]
-            k = extend(a, rng.uniform(self.lower, self.upper))
-            if k is None:
-                continue
-            target = a[0][k]
-            while True:  # connect the other tree greedily towards the new node
-                j = extend(b, target)
-                if j is None:
+        def connect(tree, target) -> int | None:
+            """Greedy: extend ``tree`` towards ``target`` until a move is blocked or it is
+            reached (the node reached, else None).  Each extension starts at the node
+            the last one added (strictly the nearest to the target in the max norm, as
+            :func:`step` would find it): the chain of moves is made first, as
+            :func:`step` makes each, and their samples checked in batches."""
+            i, new = step(tree, target)
+            cur, moves = tree[0][i], []
+            while True:
+                moves.append((cur, new))
+                if np.allclose(new, target):
                     break
-                if np.allclose(b[0][j], target):
-                    pa, pb = path(a, k), path(b, j)
-                    route = pa[::-1] + pb[1:] if it % 2 == 0 else pb[::-1] + pa[1:]
-                    return self._shortcut(route)
+                cur = new
+                d = target - cur
+                span = float(np.abs(d).max())
+                new = target if span <= TREE_STEP else cur + d * (TREE_STEP / span)
+            done, size = 0, 1
+            while done < len(moves):  # batches of 1, 2, 4, ... moves: little checked past a block
+                ok = self.clear_moves(moves[done : done + size])
+                for _, node in moves[done : done + (len(ok) if ok.all() else int(np.argmin(ok)))]:
+                    i = add(tree, i, node)
+                if not ok.all():
+                    return None
+                done, size = done + size, 2 * size
+            return i
+
+        it, size = 0, 1
+        while it < TREE_ITERATIONS:
+            size = min(size, TREE_ITERATIONS - it)
+            while len(drawn) < size:
+                drawn.append(rng.uniform(self.lower, self.upper))
+            tries = [step(trees[(it + m) % 2], drawn[m]) for m in range(size)]
+            ok = self.clear_moves([(trees[(it + m) % 2][0][i], new)
+                                   for m, (i, new) in enumerate(tries)])  # fmt: skip
+            if not ok.any():  # no tree changed: the next iterations see the same trees
+                it, drawn, size = it + size, drawn[size:], 2 * size
+                continue
+            m = int(np.argmax(ok))
+            it, drawn, size = it + m, drawn[m + 1 :], 1
+            a, b = trees[it % 2], trees[1 - it % 2]
+            k = add(a, *tries[m])
+            j = connect(b, a[0][k])  # the other tree greedily towards the new node
+            if j is not None:
+                pa, pb = path(a, k), path(b, j)
+                route = pa[::-1] + pb[1:] if it % 2 == 0 else pb[::-1] + pa[1:]
+                return self._shortcut(route)
+            it += 1
         return None
 
     def _shortcut(self, route: list[FloatArray]) -> list[FloatArray]:

@@ -45,7 +45,7 @@ def plot_plan(path: str | Path, plan: Plan, part=None) -> Path:
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
     from matplotlib.patches import Patch
-    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+    from mpl_toolkits.mplot3d.art3d import Line3DCollection, Poly3DCollection
 
     job, mo, me = plan.job, plan.motion, plan.measured
     fig = Figure(figsize=(14, 9))
@@ -54,6 +54,8 @@ def plot_plan(path: str | Path, plan: Plan, part=None) -> Path:
     W = BowTool.of(job.tool if plan.bow is None else plan.bow).wire_frame()
     half = 0.5 * job.tool.wire_length
     colours = ["tab:blue", "tab:green", "tab:brown", "tab:pink", "tab:olive", "tab:cyan"]
+    # the many short segments of each kind as one collection each (an artist per
+    # segment made the 3-D panel the slowest part of the picture)
     for cp in plan.passes:
         m, h = cp.motion, cp.motion.hit
         c0, c1 = m.chord[:, 0], m.chord[:, 1]
@@ -61,19 +63,19 @@ def plot_plan(path: str | Path, plan: Plan, part=None) -> Path:
         stride = max(1, int(h.sum()) // 60)
         a = S[h, :3, 3] + c0[h, None] * S[h, :3, 2]
         b = S[h, :3, 3] + c1[h, None] * S[h, :3, 2]
-        colour = colours[[c.name for c in job.cuts].index(cp.name) % len(colours)]
-        for p, q in zip(a[::stride], b[::stride], strict=True):
-            ax.plot(*np.c_[p, q], color=colour, lw=0.6)
+        k = next(i for i, c in enumerate(job.cuts) if c is cp.cut)
+        ax.add_collection3d(Line3DCollection(np.stack([a[::stride], b[::stride]], axis=1),
+                                             colors=colours[k % len(colours)],
+                                             linewidths=0.6))  # fmt: skip
         if cp.compensated:
             F = cp.frames
             mid = F[h, :3, 3] + (0.5 * (c0 + c1))[h, None] * F[h, :3, 2]
             ax.plot(*mid.T, color="tab:red", lw=1.0)
         G = m.flange @ W
         ends = np.stack([G[:, :3, 3] - half * G[:, :3, 2], G[:, :3, 3] + half * G[:, :3, 2]], 1)
-        for e in ends[:: max(1, len(ends) // 10)]:
-            ax.plot(*e.T, color="tab:orange", lw=1.2)
-    for e in stock_edges(job):
-        ax.plot(*e.T, color="0.4", lw=0.8)
+        ax.add_collection3d(Line3DCollection(ends[:: max(1, len(ends) // 10)],
+                                             colors="tab:orange", linewidths=1.2))  # fmt: skip
+    ax.add_collection3d(Line3DCollection(stock_edges(job), colors="0.4", linewidths=0.8))
     if part is not None:
         tri = part.vertices[part.faces]
         step = max(1, len(tri) // 15000)  # a few thousand facets draw in a second
