@@ -3,12 +3,13 @@ and the placement search.
 
 Prints figures; asserts nothing.  Targets: for 2,000 refined rulings, planning
 (redundancy + IK + timing) < 1 s and the whole ``ruledrobot plan`` without video
-< 5 s on this 2-core machine (issue "Wire-cutting planner"); for the built-in part
-(three cuts, one closed), the whole plan without video under a tenth of the time the
-cut takes on the robot (issue "Real parts"); at least 1,000 candidate placements
-scored per minute for a 2,000-ruling job (issue 13).
+< 5 s on this 2-core machine (issue "Wire-cutting planner"); for the built-in demo and
+part (three cuts, one closed), planned in at most 0.05 of the time their motion takes
+on the robot (issue 25; a tenth for the whole plan in issue "Real parts"); at least
+1,000 candidate placements scored per minute for a 2,000-ruling job (issue 13).
 
     .venv/bin/python scripts/bench_plan.py            # all
+    .venv/bin/python scripts/bench_plan.py ratio      # the demo and the part against their motion
     .venv/bin/python scripts/bench_plan.py place      # the placement search only
 """
 
@@ -80,36 +81,54 @@ def main() -> None:
         _part(Path(tmp))
 
 
-def _part(tmp: Path) -> None:
-    """The built-in part: stages of the plan against the duration of the motion."""
+def _part(tmp: Path, repeat: int = 3) -> None:
+    """The built-in demo and part: the stages of a plan against the duration of its motion
+    (issue 25: each planned in at most 0.05 of it), best of ``repeat`` warm runs."""
+    for name, text in (("demo", DEMO_JOB), ("part", PART_JOB)):
+        _stages(tmp, name, text, repeat)
+
+
+def _stages(tmp: Path, name: str, text: str, repeat: int) -> None:
+    import os
+
     from ruledrobot.wirecut.plan import make_plan
     from ruledrobot.wirecut.report.outcome import plan_outcome
     from ruledrobot.wirecut.verify import verify_plan
 
-    p = tmp / "part.toml"
-    p.write_text(PART_JOB)
+    p = tmp / f"{name}.toml"
+    p.write_text(text)
     job = load_job(p)
-    t0 = time.perf_counter()
-    planned = make_plan(job)
-    t1 = time.perf_counter()
-    ver = verify_plan(planned)
-    t2 = time.perf_counter()
-    plan_outcome(planned, ver)
-    t3 = time.perf_counter()
-    result = plan(job, tmp / "part_out")
-    t4 = time.perf_counter()
+    plan(job, tmp / f"{name}_warm")  # imports and compiled kernels loaded: warm runs below
+    best = {"planning": np.inf, "verification": np.inf, "outcome": np.inf, "whole": np.inf}
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        planned = make_plan(job)
+        t1 = time.perf_counter()
+        ver = verify_plan(planned)
+        t2 = time.perf_counter()
+        plan_outcome(planned, ver)
+        t3 = time.perf_counter()
+        result = plan(job, tmp / f"{name}_out")
+        t4 = time.perf_counter()
+        for key, dt in (("planning", t1 - t0), ("verification", t2 - t1),
+                        ("outcome", t3 - t2), ("whole", t4 - t3)):  # fmt: skip
+            best[key] = min(best[key], dt)
     motion = planned.motion.timed.t[-1]
     cutting = float(np.sum(planned.motion.surface) * planned.model.control_period)
-    print(f"\npart demo: {len(job.cuts)} cuts ({', '.join(c.name for c in job.cuts)}), "
+    load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
+    print(f"\n{name}: {len(job.cuts)} cut(s) ({', '.join(c.name for c in job.cuts)}), "
           f"{len(planned.passes)} passes, {sum(len(cp.frames) for cp in planned.passes)} "
-          f"rulings, verdict {'PASS' if result.feasible else 'FAIL'}")  # fmt: skip
-    print(f"  planning (rulings, passes, transits, timing, measurement): {t1 - t0:7.2f} s")
-    print(f"  MuJoCo verification:                                       {t2 - t1:7.2f} s")
-    print(f"  report and verdict:                                        {t3 - t2:7.2f} s")
-    print(f"  whole plan with files, part mesh, no video:                {t4 - t3:7.2f} s")
+          f"rulings, verdict {'PASS' if result.feasible else 'FAIL'}; best of {repeat} warm "
+          f"runs, load average {load:.1f} on {os.cpu_count()} cores")  # fmt: skip
+    print(f"  planning (rulings, passes, transits, timing, measurement): {best['planning']:7.2f} s")
+    print(f"  MuJoCo verification:                                       "
+          f"{best['verification']:7.2f} s")  # fmt: skip
+    print(f"  report and verdict:                                        {best['outcome']:7.2f} s")
+    print(f"  whole plan with files, part mesh, no video:                {best['whole']:7.2f} s")
     print(f"  the motion on the robot: {motion:.1f} s, of which the wire on the surfaces "
           f"{cutting:.1f} s")
-    print(f"  whole plan / motion on the robot: {(t4 - t3) / motion:.3f} (target < 0.1)")
+    print(f"  planning / motion on the robot:   {best['planning'] / motion:.3f} (target <= 0.05)")
+    print(f"  whole plan / motion on the robot: {best['whole'] / motion:.3f} (target <= 0.05)")
 
 
 def bench_place() -> None:
@@ -185,6 +204,10 @@ def _place_on_workers() -> None:
 
 
 if __name__ == "__main__":
-    if sys.argv[1:] != ["place"]:
-        main()
-    bench_place()
+    if sys.argv[1:] == ["ratio"]:
+        with tempfile.TemporaryDirectory() as tmp:
+            _part(Path(tmp))
+    else:
+        if sys.argv[1:] != ["place"]:
+            main()
+        bench_place()
