@@ -23,7 +23,7 @@ from .meshquery import MeshQuery
 from .model import CarveCut, CutMeasure
 from .quadric import fit_region
 from .readers import PartMesh
-from .rough import Loop, choose_loops, loop_lines
+from .rough import SEAMS, Loop, choose_loops, loop_lines
 from .segment import MIN_FACES, Region, segment
 
 __all__ = ["CutPlan", "find_cuts", "prefer_direction"]
@@ -56,6 +56,13 @@ def prefer_direction(stock: Box) -> FloatArray:
         return np.array([0.0, 1.0, 0.0])
     d = np.cross([0.0, 0.0, 1.0], c)
     return d / np.linalg.norm(d)
+
+
+def radial_direction(stock: Box) -> FloatArray:
+    """The horizontal direction from the robot's base to the block (x when above it)."""
+    c = np.array([stock.centre[0], stock.centre[1], 0.0])
+    n = np.linalg.norm(c)
+    return c / n if n > 1e-6 else np.array([1.0, 0.0, 0.0])
 
 
 def find_cuts(part: PartMesh, stock: Box, query: MeshQuery, tolerance: float,
@@ -106,7 +113,8 @@ def find_cuts(part: PartMesh, stock: Box, query: MeshQuery, tolerance: float,
         hull = part.vertices[ConvexHull(part.vertices).vertices]
         standoff = 0.5 * tolerance
         progress(f"choosing {rough_cuts} roughing loops")
-        loops, k1 = choose_loops(hull, stock, rough_cuts, standoff, seams=True)
+        loops, k1 = choose_loops(hull, stock, rough_cuts, standoff, seams=SEAMS,
+                                 radial=radial_direction(stock))
         progress("choosing the baseline's directions")
         base, k2 = choose_loops(hull, stock, rough_cuts, standoff, seams=False)
         kept = k1[-1] if k1 else kept

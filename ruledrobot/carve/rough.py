@@ -33,7 +33,8 @@ from ..geometry.box import Box
 from ..geometry.checks import FloatArray
 from ..geometry.lines import Lines
 
-__all__ = ["Loop", "choose_loops", "fibonacci_axes", "loop_lines", "seam_normals"]
+__all__ = ["Loop", "choose_loops", "fibonacci_axes", "loop_lines", "ruling_elevation",
+           "ruling_tilt", "seam_normals"]
 
 SAMPLES = 96
 AMPLITUDES = (0.0, 0.3, 0.6, 0.9)
@@ -41,6 +42,18 @@ WAVES = (2, 3)
 PHASES = (0.0, 0.5)  # fractions of a half wave
 #: voxels on the block for the choice (the grid step follows)
 VOXELS = 30_000
+#: largest angle [deg] between a loop's rulings and the horizontal: a wire more nearly
+#: upright puts the bow's lower arm into the table (a loop about (-0.29, 0.19, 0.94) on
+#: the ellipsoid: 2.8 mm deep on the approach; one about (0.58, -0.26, 0.77) planned PASS)
+MAX_ELEVATION = 55.0
+#: whether carve's own loops include seams: off, since a seam's rulings pivot about
+#: points in the block (consecutive supporting planes meet near the part), and the
+#: planner's feed checks failed on every seam loop planned (the ellipsoid's: 3-16 mm/s
+#: against 12 +- 5 %) while its great circles across the reach passed
+SEAMS = False
+#: largest angle [deg] between a loop's rulings and the vertical plane across the arm's
+#: reach (normal to the horizontal direction from the robot's base to the block)
+MAX_TILT = 40.0
 
 
 @dataclass(frozen=True)
@@ -104,7 +117,21 @@ def loop_lines(loop: Loop, centre: FloatArray) -> Lines:
     return Lines.from_point_direction(p, d)
 
 
-def _candidates(hull: FloatArray, standoff: float, axes: FloatArray, seams: bool
+def ruling_tilt(normals: FloatArray, radial: FloatArray) -> float:
+    """The largest angle [deg] between a loop's rulings (consecutive planes of
+    ``normals`` (K, 3) meet in them) and the plane normal to ``radial`` (3,)."""
+    d = np.cross(normals, np.roll(normals, -1, axis=0))
+    d /= np.linalg.norm(d, axis=1)[:, None]
+    return float(np.degrees(np.arcsin(np.clip(np.abs(d @ radial).max(), 0.0, 1.0))))
+
+
+def ruling_elevation(normals: FloatArray) -> float:
+    """The largest angle [deg] between a loop's rulings and the horizontal plane."""
+    return ruling_tilt(normals, np.array([0.0, 0.0, 1.0]))
+
+
+def _candidates(hull: FloatArray, standoff: float, axes: FloatArray, seams: bool,
+                radial: FloatArray | None = None, max_tilt: float = MAX_TILT
                 ) -> list[Loop]:  # fmt: skip
     out = []
     for a in axes:
@@ -113,6 +140,9 @@ def _candidates(hull: FloatArray, standoff: float, axes: FloatArray, seams: bool
             shapes += [(A, k, ph) for A in AMPLITUDES[1:] for k in WAVES for ph in PHASES]
         for A, k, ph in shapes:
             n = seam_normals(a, A, k, ph)
+            if radial is not None and (ruling_tilt(n, radial) > max_tilt
+                                       or ruling_elevation(n) > MAX_ELEVATION):
+                continue
             h = (hull @ n.T).max(axis=0) + standoff
             out.append(Loop(a, A, k, ph, n, h))
     return out
@@ -127,7 +157,8 @@ def _voxels(stock: Box, count: int) -> tuple[FloatArray, float]:
 
 
 def choose_loops(hull: FloatArray, stock: Box, count: int, standoff: float,
-                 seams: bool = True, axes: FloatArray | None = None
+                 seams: bool = True, axes: FloatArray | None = None,
+                 radial: FloatArray | None = None, max_tilt: float = MAX_TILT
                  ) -> tuple[list[Loop], list[float]]:  # fmt: skip
     """``count`` loops about the part's hull vertices ``hull`` (H, 3) [m], chosen greedily
     (module doc); with ``seams=False`` great circles only (the baseline).  Also the
@@ -139,7 +170,7 @@ def choose_loops(hull: FloatArray, stock: Box, count: int, standoff: float,
     eq = ConvexHull(hull).equations
     in_hull = np.all(pts @ eq[:, :3].T + eq[:, 3] <= 0.0, axis=1)
     alive = (pts[~in_hull] - stock.centre).astype(np.float32)
-    cands = _candidates(hull, standoff, axes, seams)
+    cands = _candidates(hull, standoff, axes, seams, radial, max_tilt)
     planes = [(c.normals.T.astype(np.float32), (c.support - c.normals @ stock.centre)
                .astype(np.float32)) for c in cands]  # fmt: skip
     chosen, kept = [], []

@@ -105,12 +105,16 @@ def plan(
         show(out)
 
 
-@app.command(epilog="Example:  ruledrobot demo --out out/demo     or:  ruledrobot demo --part")
+@app.command(epilog="Example:  ruledrobot demo --out out/demo     or:  ruledrobot demo --part"
+             "     or:  ruledrobot demo --carve")
 def demo(
     out: Path | None = typer.Option(None, "--out", "-o",
                                     help="Output folder [default: out/demo, out/part]."),
     part: bool = typer.Option(False, "--part", help="The part demo: three cuts (one all the "
                               "way round), kerf compensated, the wire's heat switched."),
+    carve: bool = typer.Option(False, "--carve", help="The carve demo: a hyperboloid column "
+                               "made from its closed form, carved (ruledrobot carve), each "
+                               "job planned; no video or streaming."),
     video: bool = typer.Option(True, "--video/--no-video", help="Render video.mp4 too."),
     stream: bool = typer.Option(
         True, "--stream/--no-stream", help="Stream the cut to the embedded RTDE emulator."
@@ -128,6 +132,9 @@ def demo(
     from .robot import say_program_size
     from .robot import stream as stream_run
 
+    if carve:
+        _demo_carve(out if out is not None else Path("out/carve-demo"))
+        return
     out = out if out is not None else Path("out/part" if part else "out/demo")
     if part:
         console.print("[bold]ruledrobot demo --part[/]: a foam plug in three cuts (saddle top, "
@@ -158,3 +165,38 @@ def demo(
             raise typer.Exit(code=1)
     console.print(f"job file: {out / 'job.toml'} (edit it and run: ruledrobot plan)",
                   highlight=False, markup=False)  # fmt: skip
+
+
+def _demo_carve(out: Path) -> None:
+    """``demo --carve``: the column's STL and cell into ``out/part``, carved into
+    ``out/carve``, each job planned into ``out/plan`` (``out/planN`` for setup N); the
+    verdicts.  Exit 1 when carve or a plan fails, 2 on bad input."""
+    from ..carve import carve as run_carve
+    from ..carve.demo import write_demo_cell
+    from .carve import print_carve
+
+    console.print("[bold]ruledrobot demo --carve[/]: a hyperboloid column from its closed form, "
+                  "carved from the foam block and planned, UR5e")  # fmt: skip
+    try:
+        cell = write_demo_cell(out / "part")
+        console.print(f"wrote {cell} and {cell.parent / 'column.stl'}  (the part and its cell)",
+                      highlight=False, markup=False)  # fmt: skip
+        with console.status("carving") as status:
+            res = run_carve(cell, out / "carve", progress=lambda msg: status.update(msg))
+    except (OSError, ValueError) as exc:
+        raise fail(str(exc)) from None
+    print_carve(res.report)
+    jobs = sorted(p for k, p in res.files.items() if k.startswith("job"))
+    verdicts = []
+    for k, job in enumerate(jobs, start=1):
+        where = out / ("plan" if len(jobs) == 1 else f"plan{k}")
+        console.print(f"[bold]planning {job}[/]", highlight=False)
+        try:
+            _run_plan(job, where)
+            verdicts.append((job, True))
+        except typer.Exit:
+            verdicts.append((job, False))
+    for job, ok in verdicts:
+        console.print(f"{job}: {'PASS' if ok else 'FAIL'}", highlight=False, markup=False)
+    if not res.ok or not all(ok for _, ok in verdicts):
+        raise typer.Exit(code=1)

@@ -12,6 +12,18 @@ its faces lie within a fraction of the grid step of the surfaces.  How close the
 kept surface is to the target is measured on the wire's path (:mod:`.kerf`), not on
 this mesh.
 
+A ruling runs on past the strip of the surface it bounds where it crosses the waste (a
+roughing loop's rulings, each the line where two supporting planes meet, cross the
+waste beyond the strip: fins), and a waste point nearest such a fin takes the fin's
+side.  So the sign near the surface is checked against the surface's own partition of
+the stock (:func:`_settle_sides`): the grid points within half a grid step of the
+surface (by the samples' tangent planes) wall the stock into pieces that no path of
+grid neighbours crosses the surface between, each piece takes the side most of its
+points take, and a point of the wall on the part's side counts only within a few grid
+steps of a piece of the part (a fin's wall lies in the waste).  Where the nearest
+sample is right everywhere — a surface that bounds its sides everywhere in the stock,
+as every cut of the demos — nothing changes.
+
 Cuts without ``keep`` name no part side and are left out (a note says so).
 """
 
@@ -93,12 +105,15 @@ def _surface_samples(
 
 
 def _cut_sdf(pts: FloatArray, nrm: FloatArray, world: FloatArray, shape: tuple[int, ...],
-             band: float) -> FloatArray:  # fmt: skip
+             band: float, domain: np.ndarray | None = None, step: float | None = None
+             ) -> FloatArray:  # fmt: skip
     """Signed distance on a grid (``world`` (N, 3), ``shape`` the grid's) to one surface
     sampled by ``pts`` (P, 3) with waste-side normals ``nrm``, exact within ``band`` of it
     and ``+-band`` beyond: a nearest-neighbour search far from a thin sampled surface
     visits nearly every sample (a point on a column's axis is as far from all of them),
-    so far cells take the sign of their connected region instead."""
+    so far cells take the sign of their connected region instead.  With ``domain`` (the
+    grid points in the stock) and ``step`` (the grid's), the sides are settled by the
+    surface's partition of the stock (:func:`_settle_sides`)."""
     from scipy import ndimage
     from scipy.spatial import cKDTree
 
@@ -116,6 +131,51 @@ def _cut_sdf(pts: FloatArray, nrm: FloatArray, world: FloatArray, shape: tuple[i
         rim = ndimage.binary_dilation(region) & ~far
         side = float(np.sign(np.nansum(np.sign(d[rim])))) if rim.any() else 1.0
         out[region] = band * (side if side != 0.0 else 1.0)
+    if domain is not None and step is not None:
+        out = _settle_sides(out, np.where(far, np.inf, np.abs(d)), domain, step)
+    return out
+
+
+#: a grid point is in the surface's wall within this fraction of the grid step of it
+WALL = 0.75
+#: a wall point on the part's side counts as part within this many grid steps of a piece
+#: of the part
+WALL_REACH = 2
+#: a piece takes a side when the signs of its points near the surface add up to this
+#: fraction of their number (70:30); a piece split more evenly is left as it is (a wall
+#: with a gap, where rulings miss the stock: the pieces are not the surface's sides)
+DECISIVE = 0.4
+
+
+def _settle_sides(f: FloatArray, plane: FloatArray, domain: np.ndarray, step: float
+                  ) -> FloatArray:  # fmt: skip
+    """The signed distance ``f`` (grid) with its sides settled by the surface's partition
+    of the stock (module doc): ``plane`` the distance to the nearest sample's tangent
+    plane (inf far from the surface), ``domain`` the grid points in the stock, ``step``
+    the grid step.  A segment between grid neighbours that crosses the surface has an
+    end within half a step of it, so the wall (points within ``WALL`` steps) leaves no
+    path between the pieces; a piece takes the side of the most of its points near the
+    surface when they agree enough (``DECISIVE``), and a point of the wall on the part's
+    side stays part only within ``WALL_REACH`` steps of a piece of the part (where no
+    piece is part, nothing changes: a part thinner than the wall)."""
+    from scipy import ndimage
+
+    wall = plane <= WALL * step
+    pieces, count = ndimage.label(domain & ~wall)
+    if count == 0:
+        return f
+    near = np.isfinite(plane) & (pieces > 0)
+    votes = np.bincount(pieces[near], weights=np.sign(f[near]), minlength=count + 1)
+    voters = np.bincount(pieces[near], minlength=count + 1)
+    side = np.where(np.abs(votes) >= DECISIVE * np.maximum(voters, 1), np.sign(votes), 0.0)
+    side[0] = 0.0
+    piece_side = side[pieces]
+    out = np.where((piece_side != 0.0) & (np.sign(f) != piece_side), piece_side * np.abs(f), f)
+    part = piece_side < 0.0
+    if part.any():
+        kept = ndimage.binary_dilation(part, iterations=WALL_REACH)
+        fin = wall & domain & (out < 0.0) & ~kept
+        out = np.where(fin, -out, out)
     return out
 
 
@@ -128,13 +188,26 @@ def part_sdf(job: Job, passes: tuple[CutPath, ...], world: FloatArray,
     q = np.abs(local) - 0.5 * stock.size
     out = np.linalg.norm(np.maximum(q, 0.0), axis=1) + np.minimum(q.max(axis=1), 0.0)
     out = out.reshape(shape)
+    domain = out <= 0.0
+    step = _grid_step(world, shape)
     for cut in job.cuts:
         if cut.keep is None:
             continue
         pts, nrm = _surface_samples([cp for cp in passes if cp.name == cut.name], stock, cut.keep)
         if len(pts):
-            out = np.maximum(out, _cut_sdf(pts, nrm, world, shape, band))
+            out = np.maximum(out, _cut_sdf(pts, nrm, world, shape, band, domain, step))
     return out
+
+
+def _grid_step(world: FloatArray, shape: tuple[int, ...]) -> float | None:
+    """The step of a regular grid of points ``world`` with ``shape`` (the distance between
+    neighbours along each axis, the largest), or None when not one grid."""
+    if len(shape) != 3 or min(shape) < 2:
+        return None
+    g = world.reshape(*shape, 3)
+    steps = [float(np.linalg.norm(np.take(g, 1, axis=k)[0, 0] - np.take(g, 0, axis=k)[0, 0]))
+             for k in range(3)]  # fmt: skip
+    return max(steps)
 
 
 def part_mesh(

@@ -1,0 +1,43 @@
+"""``ruledrobot demo --carve``: the column made from its closed form, carved, planned: PASS."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+from typer.testing import CliRunner
+
+from ruledrobot.carve.demo import column_mesh
+from ruledrobot.cli import app
+from ruledrobot.io.lines import read_lines_document
+
+
+def test_the_demo_column_is_closed_and_on_its_closed_form():
+    v, f = column_mesh()
+    edges = np.sort(np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]]), axis=1)
+    _, count = np.unique(edges, axis=0, return_counts=True)
+    assert (count == 2).all()
+    side = np.abs(v[:, 0]) + np.abs(v[:, 2]) > 1e-9
+    x, y, z = v[side].T
+    assert np.allclose(x**2 + z**2, 0.06**2 * (1 + y**2 / 0.3**2), atol=1e-12)
+
+
+def test_demo_carve_carves_the_column_in_one_exact_loop_and_plans_it(tmp_path):
+    out = tmp_path / "demo"
+    res = CliRunner().invoke(app, ["demo", "--carve", "--out", str(out)])
+    assert res.exit_code == 0, res.output
+    report = json.loads((out / "carve" / "carve.json").read_text())
+    assert [c["kind"] for c in report["cuts"]] == ["exact"]
+    assert abs(report["whole"]["excess"]) < 0.03
+    # every ruling point in the block on the closed form (part frame at the block's centre)
+    lines = read_lines_document(out / "carve" / f"{report['cuts'][0]['name']}.json").lines
+    t = np.linspace(-0.07, 0.07, 15)
+    p = (lines.point[:, None] + t[None, :, None] * lines.direction[:, None]).reshape(-1, 3)
+    x, y, z = (p - [0.5, 0.0, 0.3]).T
+    inside = np.abs(y) <= 0.1
+    F = x**2 + z**2 - 0.06**2 * (1 + y**2 / 0.3**2)
+    g = 2 * np.sqrt(x**2 + z**2 + (0.06**2 * y / 0.3**2) ** 2)
+    assert (np.abs(F) / g)[inside].max() < 5e-4
+    plan = json.loads((out / "plan" / "report.json").read_text())
+    assert plan["verdict"]["ok"]
+    assert "carve/job.toml: PASS" in res.output.replace("\\", "/")
