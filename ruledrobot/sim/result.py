@@ -262,7 +262,10 @@ class PlaybackResult:
         J = self.robot.n_joints
         labels = [f"q{i + 1}" for i in range(J)]
 
-        fig = Figure(figsize=(9, 8), constrained_layout=True)
+        # fixed margins (where constrained layout put the axes of the planner's plots):
+        # a layout engine measures every tick label first, a third of the drawing time
+        fig = Figure(figsize=(9, 8))
+        fig.subplots_adjust(left=0.09, right=0.99, bottom=0.06, top=0.95, hspace=0.07)
         ax = fig.subplots(3, 1, sharex=True)
         ax[0].plot(t, self.joint_error() * 1e3, lw=0.8)
         ax[0].set_ylabel("joint error [mrad]")
@@ -278,7 +281,8 @@ class PlaybackResult:
         fig.suptitle(f"{self.robot.name}: tracking ({self.feedforward} feed-forward)")
         paths = {"tracking_plot": _save_fig(fig, out / "tracking.png")}
 
-        fig = Figure(figsize=(9, 6), constrained_layout=True)
+        fig = Figure(figsize=(9, 6))
+        fig.subplots_adjust(left=0.075, right=0.99, bottom=0.08, top=0.93, hspace=0.06)
         ax = fig.subplots(2, 1, sharex=True)
         lim_t = np.where(np.isfinite(self.robot.max_torque), self.robot.max_torque, np.inf)
         ax[0].plot(t, np.abs(self.torque) / lim_t, lw=0.8)

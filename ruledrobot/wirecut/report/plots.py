@@ -116,7 +116,10 @@ def plot_plan(path: str | Path, plan: Plan, part=None) -> Path:
     leg = ax3.legend(fontsize=7, loc="lower right")
     ax3.add_artist(leg)
     ax3.legend(handles=handles, fontsize=7, loc="upper right", title="phase")
-    fig.tight_layout()
+    # fixed margins (where tight_layout put the panels): measuring every label first
+    # took a fifth of the picture's time
+    fig.subplots_adjust(left=0.011, right=0.989, bottom=0.065, top=0.962, wspace=0.14,
+                        hspace=0.213)  # fmt: skip
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=90)
     return atomic_write_bytes(path, buf.getvalue())
