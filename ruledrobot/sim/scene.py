@@ -330,23 +330,12 @@ def scene_mjcf(
                 contype=0,
                 conaffinity=0,
             )
-        if floor:
-            T = np.eye(4)
-            T[:3, 3] = [table.centre[0], table.centre[1], top - legs_h]
-            placed(
-                world,
-                "geom",
-                _in_base(model, T),
-                name="floor",
-                type="plane",
-                size=[4 * reach, 4 * reach, 0.05],
-                material="floor",
-                contype=0,
-                conaffinity=0,
-            )
-    elif floor:
+        floor_at = [table.centre[0], table.centre[1], top - legs_h]  # under the legs
+    else:
+        floor_at = [0.0, 0.0, -0.001]
+    if floor:
         T = np.eye(4)
-        T[:3, 3] = [0.0, 0.0, -0.001]
+        T[:3, 3] = floor_at
         placed(
             world,
             "geom",
