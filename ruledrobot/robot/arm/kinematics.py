@@ -93,6 +93,36 @@ def _write_pose(frame: Frame, out: FloatArray) -> None:
     flat[:, 15] = 1.0
 
 
+def _chain(
+    q: FloatArray, alpha: FloatArray, theta_offset: FloatArray, base: FloatArray | None
+) -> tuple[FloatArray, FloatArray, list[tuple[float, float]], Frame]:
+    """What every pass along the chain needs: cos and sin of the joint angles (J, n),
+    contiguous rows per joint; (cos, sin) of each DH twist; the start frame (the base)."""
+    theta = np.ascontiguousarray((q + theta_offset).T)
+    twists = [(_snap(float(np.cos(al))), _snap(float(np.sin(al)))) for al in alpha]
+    return np.cos(theta), np.sin(theta), twists, _start_frame(np.eye(4) if base is None else base)
+
+
+def _walk(
+    frame: Frame,
+    ct: FloatArray,
+    st: FloatArray,
+    d: FloatArray,
+    a: FloatArray,
+    twists: list[tuple[float, float]],
+    rows: slice = slice(None),
+    before: list[Frame] | None = None,
+) -> Frame:
+    """The frame after the last joint, from ``frame`` before joint 1; ``rows`` the poses
+    (columns of ``ct``, ``st``) of this pass; ``before``, when given, gets the frame before
+    each joint."""
+    for j, (ca, sa) in enumerate(twists):
+        if before is not None:
+            before.append(frame)
+        frame = _joint_step(frame, ct[j, rows], st[j, rows], float(d[j]), float(a[j]), ca, sa)
+    return frame
+
+
 def dh_fk(
     q: FloatArray,
     d: FloatArray,
@@ -117,16 +147,10 @@ def dh_fk(
     """
     n = q.shape[0]
     out = np.empty((n, 4, 4))
-    theta = np.ascontiguousarray((q + theta_offset).T)  # (J, n), contiguous rows per joint
-    ct, st = np.cos(theta), np.sin(theta)
-    twists = [(_snap(float(np.cos(al))), _snap(float(np.sin(al)))) for al in alpha]
-    start = _start_frame(np.eye(4) if base is None else base)
+    ct, st, twists, start = _chain(q, alpha, theta_offset, base)
     for lo in range(0, n, _CHUNK):
         hi = min(lo + _CHUNK, n)
-        frame = start
-        for j in range(theta.shape[0]):
-            ca, sa = twists[j]
-            frame = _joint_step(frame, ct[j, lo:hi], st[j, lo:hi], float(d[j]), float(a[j]), ca, sa)
+        frame = _walk(start, ct, st, d, a, twists, slice(lo, hi))
         if tool is not None:
             frame = _apply_tool(frame, tool)
         _write_pose(_broadcast(frame, hi - lo), out[lo:hi])
@@ -148,16 +172,14 @@ def dh_skeleton(
     :func:`dh_fk`.
     """
     n = q.shape[0]
-    theta = np.ascontiguousarray((q + theta_offset).T)
-    ct, st = np.cos(theta), np.sin(theta)
-    frame = _start_frame(np.eye(4) if base is None else base)
-    pts = [frame[3]]
-    for j in range(theta.shape[0]):
-        p, z = frame[3], frame[2]
+    ct, st, twists, start = _chain(q, alpha, theta_offset, base)
+    frames: list[Frame] = []
+    frames.append(_walk(start, ct, st, d, a, twists, before=frames))  # J + 1 frames
+    pts = [start[3]]
+    for j in range(len(twists)):
+        p, z = frames[j][3], frames[j][2]
         pts.append([p[k] + float(d[j]) * z[k] for k in range(3)])
-        ca, sa = _snap(float(np.cos(alpha[j]))), _snap(float(np.sin(alpha[j])))
-        frame = _joint_step(frame, ct[j], st[j], float(d[j]), float(a[j]), ca, sa)
-        pts.append(frame[3])
+        pts.append(frames[j + 1][3])
     out = np.empty((n, len(pts), 3))
     for i, pt in enumerate(pts):
         for k in range(3):
@@ -188,19 +210,12 @@ def dh_jacobian(
     """
     n, J = q.shape
     out = np.empty((n, 6, J))
-    theta = np.ascontiguousarray((q + theta_offset).T)
-    ct, st = np.cos(theta), np.sin(theta)
-    twists = [(_snap(float(np.cos(al))), _snap(float(np.sin(al)))) for al in alpha]
-    start = _start_frame(np.eye(4) if base is None else base)
+    ct, st, twists, start = _chain(q, alpha, theta_offset, base)
     for lo in range(0, n, _CHUNK):
         hi = min(lo + _CHUNK, n)
-        m = hi - lo
-        frame = _broadcast(start, m)
-        axes = []
-        for j in range(J):
-            axes.append((frame[2], frame[3]))  # z_{j}, p_{j} of the frame before joint j+1
-            ca, sa = twists[j]
-            frame = _joint_step(frame, ct[j, lo:hi], st[j, lo:hi], float(d[j]), float(a[j]), ca, sa)
+        before: list[Frame] = []
+        frame = _walk(_broadcast(start, hi - lo), ct, st, d, a, twists, slice(lo, hi), before)
+        axes = [(f[2], f[3]) for f in before]  # z_{j}, p_{j} of the frame before joint j+1
         if tool is not None:
             frame = _apply_tool(frame, tool)
         pe = frame[3]
