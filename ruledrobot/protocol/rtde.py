@@ -177,8 +177,42 @@ class RecipeKey:
         return isinstance(other, RecipeKey) and other.items == self.items
 
 
+class _Recipe:
+    """What both recipes share: their types checked and compiled, the reply to their setup
+    and the size of their struct (the dataclasses below set the attributes)."""
+
+    recipe_id: int
+    types: list[str]
+    ok: bool
+    too_large: bool
+    _struct: struct.Struct | None
+    _counts: list[int]
+
+    def _compile(self, head: str, around: int) -> None:
+        """``ok`` (every name known, the package fits in :data:`MAX_PACKET_SIZE` with
+        ``around`` bytes beside the struct), ``too_large``, and when ok the struct ``head`` +
+        the fields and the scalars per field."""
+        self.ok = "NOT_FOUND" not in self.types
+        if not self.ok:
+            return
+        fmt = head + "".join(TYPE_FORMATS[t] for t in self.types)
+        if around + struct.calcsize(fmt) > MAX_PACKET_SIZE:
+            self.ok = False
+            self.too_large = True
+            return
+        self._struct = struct.Struct(fmt)
+        self._counts = _counts(self.types)
+
+    def _size(self) -> int:
+        return self._struct.size if self._struct is not None else 0
+
+    def reply(self) -> bytes:
+        """The ``O`` / ``I`` reply payload: recipe id (0 = invalid), comma-separated types."""
+        return bytes([self.recipe_id if self.ok else 0]) + ",".join(self.types).encode("ascii")
+
+
 @dataclass
-class OutputRecipe:
+class OutputRecipe(_Recipe):
     """An output recipe: names, their types, and a precompiled packer.
 
     ``ok`` is False when some name is unknown (the reply lists ``NOT_FOUND``)
@@ -200,24 +234,12 @@ class OutputRecipe:
     def __post_init__(self) -> None:
         self.key = RecipeKey((str(self.recipe_id), *self.names))  # equal recipes, one package
         self.types = [output_type(n) or "NOT_FOUND" for n in self.names]
-        self.ok = "NOT_FOUND" not in self.types
-        if self.ok:
-            fmt = ">HBB" + "".join(TYPE_FORMATS[t] for t in self.types)
-            if struct.calcsize(fmt) > MAX_PACKET_SIZE:
-                self.ok = False
-                self.too_large = True
-                return
-            self._struct = struct.Struct(fmt)
-            self._counts = _counts(self.types)
-
-    def reply(self) -> bytes:
-        """The ``O`` reply payload: recipe id, comma-separated types."""
-        return bytes([self.recipe_id if self.ok else 0]) + ",".join(self.types).encode("ascii")
+        self._compile(">HBB", 0)  # the header and the recipe id in the struct
 
     @property
     def size(self) -> int:
         """Data package size in bytes including the header."""
-        return self._struct.size if self._struct is not None else 0
+        return self._size()
 
     def pack(self, state: Mapping[str, object]) -> bytes:
         """A complete data package (header + recipe id + fields) from ``state``.
@@ -241,7 +263,7 @@ class OutputRecipe:
 
 
 @dataclass
-class InputRecipe:
+class InputRecipe(_Recipe):
     """An input recipe: names, types, and the decoder of the client's data packages.
 
     ``ok`` is False when some name is unknown (reply ``NOT_FOUND``, id 0) or
@@ -259,23 +281,12 @@ class InputRecipe:
 
     def __post_init__(self) -> None:
         self.types = [input_type(n) or "NOT_FOUND" for n in self.names]
-        self.ok = "NOT_FOUND" not in self.types
-        fmt = ">" + "".join(TYPE_FORMATS[t] for t in self.types if t != "NOT_FOUND")
-        if self.ok and HEADER_SIZE + 1 + struct.calcsize(fmt) > MAX_PACKET_SIZE:
-            self.ok = False
-            self.too_large = True
-        if self.ok:
-            self._struct = struct.Struct(">" + "".join(TYPE_FORMATS[t] for t in self.types))
-            self._counts = _counts(self.types)
-
-    def reply(self) -> bytes:
-        """The ``I`` reply payload: recipe id (0 = invalid), comma-separated types."""
-        return bytes([self.recipe_id if self.ok else 0]) + ",".join(self.types).encode("ascii")
+        self._compile(">", HEADER_SIZE + 1)  # the fields only
 
     @property
     def payload_size(self) -> int:
         """Size of the fields (without the recipe id byte)."""
-        return self._struct.size if self._struct is not None else 0
+        return self._size()
 
     def unpack(self, fields: bytes) -> dict[str, object]:
         """Decode the fields (after the recipe id byte) into ``{name: value}``.
