@@ -464,17 +464,40 @@ class TcpServer:
     def recv_loop(
         self, conn: Connection, on_data: Callable[[bytes], None], bufsize: int = 65536
     ) -> None:
-        """Read until the peer closes, the server stops or ``on_data`` raises."""
-        if conn.sock.gettimeout() == 0.0:
-            self._recv_nonblocking(conn, on_data, bufsize)
+        """Read until the peer closes, the server stops or ``on_data`` raises (a
+        non-blocking socket: also when the connection is closing)."""
+        if conn.sock.gettimeout() != 0.0:  # recv waits up to the socket's timeout
+            self._recv(conn, on_data, bufsize, None, (TimeoutError,))
             return
+        with selectors.DefaultSelector() as sel:
+            try:
+                sel.register(conn.sock, selectors.EVENT_READ)
+            except (OSError, ValueError):
+                return
+            self._recv(conn, on_data, bufsize, lambda: bool(sel.select(IDLE_WAIT)),
+                       (BlockingIOError, InterruptedError))  # fmt: skip
+
+    def _recv(
+        self,
+        conn: Connection,
+        on_data: Callable[[bytes], None],
+        bufsize: int,
+        ready: Callable[[], bool] | None,
+        again: tuple[type[OSError], ...],
+    ) -> None:
+        """The receive loop: ``ready`` (non-blocking sockets) waits for data, ``again`` are
+        the errors of a ``recv`` that found none."""
         while not self._stop.is_set() and not conn.closed:
+            if ready is not None and conn.closing:
+                return
             if self.frozen.is_set():
                 self._stop.wait(POLL)
                 continue
+            if ready is not None and not ready():
+                continue
             try:
                 data = conn.sock.recv(bufsize)
-            except TimeoutError:
+            except again:
                 continue
             except OSError:
                 return
@@ -482,31 +505,6 @@ class TcpServer:
                 return
             conn.last_rx = time.monotonic()
             on_data(data)
-
-    def _recv_nonblocking(
-        self, conn: Connection, on_data: Callable[[bytes], None], bufsize: int
-    ) -> None:
-        with selectors.DefaultSelector() as sel:
-            try:
-                sel.register(conn.sock, selectors.EVENT_READ)
-            except (OSError, ValueError):
-                return
-            while not self._stop.is_set() and not conn.closed and not conn.closing:
-                if self.frozen.is_set():
-                    self._stop.wait(POLL)
-                    continue
-                if not sel.select(IDLE_WAIT):
-                    continue
-                try:
-                    data = conn.sock.recv(bufsize)
-                except (BlockingIOError, InterruptedError):
-                    continue
-                except OSError:
-                    return
-                if not data:
-                    return
-                conn.last_rx = time.monotonic()
-                on_data(data)
 
     # ------------------------------------------------------------ for subclasses
 
