@@ -29,6 +29,11 @@ from .segment import Region
 __all__ = ["NORMAL_ANGLE", "Fit", "fit_region"]
 
 NORMAL_ANGLE = np.radians(10.0)
+#: weight of the normal rows against the vertices' (:func:`_normal_rows`): they choose
+#: among quadrics the vertices cannot tell apart, and barely move one they fix (a
+#: faceted mesh's vertex normals are approximate; at weight 1 they tilted a saddle's fit
+#: enough to change its rulings and slow the planned wire to 10.2 mm/s of 12)
+NORMAL_WEIGHT = 1e-3
 #: a tangent-plane eigenvalue this small relative to the other is zero (developables)
 FLAT = 1e-3
 
@@ -109,6 +114,24 @@ def _plane(region: Region) -> tuple[FloatArray, float, float]:
     return n, float(n @ c), float(np.abs((region.points - c) @ n).max())
 
 
+def _normal_rows(x: FloatArray, y: FloatArray, z: FloatArray, n: FloatArray) -> FloatArray:
+    """Rows (3P, 10) of ``(A x + b) x n = 0`` in the monomial coefficients: the
+    quadric's gradient along each vertex normal ``n`` (P, 3).  Vertices on a few
+    curves alone do not fix a quadric — a faceted cylinder's or cone's all lie on its
+    two rims, where ``x^2 + y^2 - r^2`` and ``z (z - h)`` both vanish, and the fit came
+    out as any mix of the two (a cylinder fitted to 4e-14 mm was refused as its normals
+    disagreed); the normals tell them apart."""
+    o, e = np.zeros_like(x), np.ones_like(x)
+    # v = A x + b = G q with G (P, 3, 10), q = [a00 a11 a22 a01 a02 a12 b0 b1 b2 c]
+    G = np.stack([
+        np.stack([x, o, o, y, z, o, e, o, o, o], axis=1),
+        np.stack([o, y, o, x, o, z, o, e, o, o], axis=1),
+        np.stack([o, o, z, o, x, y, o, o, e, o], axis=1),
+    ], axis=1)  # fmt: skip
+    rows = np.cross(np.moveaxis(G, 2, 1), n[:, None, :], axis=2)  # (P, 10, 3)
+    return np.moveaxis(rows, 2, 1).reshape(-1, 10)
+
+
 def fit_region(region: Region, tolerance: float) -> Fit:
     """The plane or quadric of a region within ``tolerance`` [m] (module doc)."""
     n, d, res = _plane(region)
@@ -122,7 +145,8 @@ def fit_region(region: Region, tolerance: float) -> Fit:
     x, y, z = ((P - c0) / s).T
     D = np.stack([x * x, y * y, z * z, 2 * x * y, 2 * x * z, 2 * y * z,
                   2 * x, 2 * y, 2 * z, np.ones_like(x)], axis=1)  # fmt: skip
-    q = np.linalg.svd(D, full_matrices=False)[2][-1]
+    q = np.linalg.svd(np.vstack([D, NORMAL_WEIGHT * _normal_rows(x, y, z, region.normals)]),
+                      full_matrices=False)[2][-1]  # fmt: skip
     A_ = np.array([[q[0], q[3], q[4]], [q[3], q[1], q[5]], [q[4], q[5], q[2]]])
     b_ = q[6:9]
     # back to metres: x' = (x - c0) / s
