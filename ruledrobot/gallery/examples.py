@@ -11,7 +11,6 @@ import numpy as np
 from ..algorithms import refine
 from ..geometry.checks import FloatArray
 from ..geometry.lines import Lines, plucker_transform
-from ..geometry.mesh import strip_mesh
 from ..geometry.ruled import RuledSurface
 from ..geometry.surfaces import (
     SURFACES,
@@ -23,7 +22,7 @@ from ..geometry.surfaces import (
     hyperboloid_residual,
     mobius_band,
 )
-from .scene import _check, _Example, _manifold_residuals, _record, _Scene, _segments, _thin
+from .scene import _check, _Example, _manifold_residuals, _picture, _record
 
 # --------------------------------------------------------------------------
 # example 1: cylindroid, projection algorithm
@@ -62,13 +61,8 @@ def _example_cylindroid() -> _Example:
         measurements={"striction_z_span_over_2c": z_span, "c": c},
     )
     s0 = RuledSurface(lines, closed=True).striction_points()
-    scene = _Scene(
-        record["title"],
-        _segments(lines, s0, 1.0),
-        mesh=strip_mesh(surf, half_width=1.0),
-        rulings=_thin(res.lines, s, 1.0, every=4),
-        points=[(s, "crimson", "refined striction points")],
-    )
+    scene = _picture(record["title"], lines, s0, surf, s, 1.0, 4,
+                     points=[(s, "crimson", "refined striction points")])
     return _Example(record, scene)
 
 
@@ -171,14 +165,9 @@ def _example_helical_developable() -> _Example:
     )
     s0 = RuledSurface(lines).striction_points()
     helix = _helix(np.linspace(u0, u1, 400), r, h)
-    scene = _Scene(
-        record["title"] + ", 12 input lines",
-        _segments(lines, s0, 0.6),
-        mesh=strip_mesh(res.surface(), half_width=0.6),
-        rulings=_thin(res.lines, s, 0.6, every=4),
-        curves=[(helix, "black", "helix (curve of regression)")],
-        points=[(s, "crimson", "refined striction points")],
-    )
+    scene = _picture(record["title"] + ", 12 input lines", lines, s0, res.surface(), s, 0.6, 4,
+                     curves=[(helix, "black", "helix (curve of regression)")],
+                     points=[(s, "crimson", "refined striction points")])
     return _Example(record, scene)
 
 
@@ -224,13 +213,8 @@ def _example_four_lines() -> _Example:
     s0 = RuledSurface(lines).striction_points()
     s = res.striction
     assert s is not None
-    scene = _Scene(
-        record["title"],
-        _segments(lines, s0, 0.7),
-        mesh=strip_mesh(res.surface(), half_width=0.7, centre=s),
-        rulings=_thin(res.lines, s, 0.7, every=2),
-        curves=[(s, "crimson", "refined striction curve")],
-    )
+    scene = _picture(record["title"], lines, s0, res.surface(), s, 0.7, 2, mesh_centre=s,
+                     curves=[(s, "crimson", "refined striction curve")])
     return _Example(record, scene)
 
 
@@ -344,13 +328,10 @@ def _example_mobius() -> _Example:
     half = 0.4 * radius
     p0 = res.lines.point
     centre = p0 + np.einsum("ni,ni->n", b - p0, x[:, :3])[:, None] * x[:, :3]
-    scene = _Scene(
-        record["title"],
-        _segments(lines, spec.points_directions(u, radius=radius)[0], half),
-        mesh=strip_mesh(res.surface(), half_width=half, centre=centre),
-        rulings=_thin(res.lines, centre, half, every=2),
-        curves=[(circle, "black", "centre circle"), (s, "crimson", "refined striction curve")],
-    )
+    scene = _picture(record["title"], lines, spec.points_directions(u, radius=radius)[0],
+                     res.surface(), centre, half, 2, mesh_centre=centre,
+                     curves=[(circle, "black", "centre circle"),
+                             (s, "crimson", "refined striction curve")])
     return _Example(record, scene)
 
 
@@ -391,13 +372,8 @@ def _example_hyperboloid() -> _Example:
     s0 = RuledSurface(lines).striction_points()
     surf = res.surface()
     s = surf.striction_points()
-    scene = _Scene(
-        record["title"],
-        _segments(lines, s0, 1.0),
-        mesh=strip_mesh(surf, half_width=1.0),
-        rulings=_thin(res.lines, s, 1.0, every=4),
-        curves=[(origin, "crimson", "DH frame origins")],
-    )
+    scene = _picture(record["title"], lines, s0, surf, s, 1.0, 4,
+                     curves=[(origin, "crimson", "DH frame origins")])
     return _Example(record, scene)
 
 
@@ -456,13 +432,8 @@ def _example_helical_surface() -> _Example:
     s0 = RuledSurface(lines).striction_points()
     surf = res.surface()
     s = surf.striction_points()
-    scene = _Scene(
-        record["title"],
-        _segments(lines, s0, 0.8),
-        mesh=strip_mesh(surf, half_width=0.8),
-        rulings=_thin(res.lines, s, 0.8, every=2),
-        curves=[(origin, "crimson", "DH frame origins")],
-    )
+    scene = _picture(record["title"], lines, s0, surf, s, 0.8, 2,
+                     curves=[(origin, "crimson", "DH frame origins")])
     return _Example(record, scene)
 
 

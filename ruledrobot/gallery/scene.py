@@ -10,7 +10,8 @@ import numpy as np
 
 from ..geometry.checks import FloatArray
 from ..geometry.lines import Lines
-from ..geometry.mesh import Mesh
+from ..geometry.mesh import Mesh, strip_mesh
+from ..geometry.ruled import RuledSurface
 
 # --------------------------------------------------------------------------
 # bookkeeping
@@ -63,6 +64,29 @@ def _segments(lines: Lines, centres: FloatArray, half: float) -> FloatArray:
 
 def _thin(lines: Lines, centres: FloatArray, half: float, every: int = 1) -> FloatArray:
     return _segments(lines[::every], centres[::every], half)
+
+
+def _picture(
+    title: str,
+    lines: Lines,
+    input_centres: FloatArray,
+    surface: RuledSurface,
+    centres: FloatArray,
+    half: float,
+    every: int,
+    mesh_centre: str | FloatArray = "striction",
+    **shown: Any,
+) -> _Scene:
+    """A refinement's picture: the input ``lines`` about ``input_centres``, the strip of the
+    refined ``surface`` about ``mesh_centre``, every ``every``-th refined ruling about
+    ``centres``, each ``half`` (m) to either side; ``shown``: the curves and points."""
+    return _Scene(
+        title,
+        _segments(lines, input_centres, half),
+        mesh=strip_mesh(surface, half_width=half, centre=mesh_centre),
+        rulings=_thin(surface.lines, centres, half, every=every),
+        **shown,
+    )
 
 
 def _record(
