@@ -103,8 +103,10 @@ def _wrap(x):
 
 
 @_jit
-def _joint(V, ln, j, d, a, ca, sa, x0, x1, x2, y0, y1, y2, z0, z1, z2, p0, p1, p2):
-    """Frame ``j + 1`` from frame ``j`` (axes x, y, z and origin p) of lane ``ln``."""
+def _joint(V, ln, j, d, a, ca, sa, frame):
+    """Frame ``j + 1`` from frame ``j`` (axes x, y, z and origin p, 12 numbers) of lane
+    ``ln``."""
+    x0, x1, x2, y0, y1, y2, z0, z1, z2, p0, p1, p2 = frame
     cj = V[(_C + j) * _L + ln]
     sj = V[(_S + j) * _L + ln]
     xr0 = cj * x0 + sj * y0
@@ -126,14 +128,16 @@ def _joint(V, ln, j, d, a, ca, sa, x0, x1, x2, y0, y1, y2, z0, z1, z2, p0, p1, p
 
 
 @_jit
-def _store_frame(V, ln, k, z0, z1, z2, p0, p1, p2):
-    """Axis and origin of frame ``k + 1`` of lane ``ln``."""
+def _stored(V, ln, k, frame):
+    """Store the axis and origin of frame ``k + 1`` of lane ``ln``; returns the frame."""
+    z0, z1, z2, p0, p1, p2 = frame[6], frame[7], frame[8], frame[9], frame[10], frame[11]
     V[(_FR + 6 * k) * _L + ln] = z0
     V[(_FR + 6 * k + 1) * _L + ln] = z1
     V[(_FR + 6 * k + 2) * _L + ln] = z2
     V[(_FR + 6 * k + 3) * _L + ln] = p0
     V[(_FR + 6 * k + 4) * _L + ln] = p1
     V[(_FR + 6 * k + 5) * _L + ln] = p2
+    return frame
 
 
 @_jit
@@ -161,32 +165,14 @@ def _forward(V, ch):
         pt0 = k1 * t3 + n1 * t7
         pt1 = k1 * t7 - n1 * t3
         pt2 = V[(_TG + 11) * _L + ln]
-        # frame 1: Tz(d1) Tx(a1) Rx(alpha1)
-        x0, x1, x2 = 1.0, 0.0, 0.0
-        y0, y1, y2 = 0.0, c0, s0
-        z0, z1, z2 = 0.0, -s0, c0
-        p0, p1, p2 = a0, 0.0, d0
-        _store_frame(V, ln, 0, z0, z1, z2, p0, p1, p2)
-        x0, x1, x2, y0, y1, y2, z0, z1, z2, p0, p1, p2 = _joint(
-            V, ln, 1, d1, a1, c1, s1, x0, x1, x2, y0, y1, y2, z0, z1, z2, p0, p1, p2
-        )
-        _store_frame(V, ln, 1, z0, z1, z2, p0, p1, p2)
-        x0, x1, x2, y0, y1, y2, z0, z1, z2, p0, p1, p2 = _joint(
-            V, ln, 2, d2, a2, c2, s2, x0, x1, x2, y0, y1, y2, z0, z1, z2, p0, p1, p2
-        )
-        _store_frame(V, ln, 2, z0, z1, z2, p0, p1, p2)
-        x0, x1, x2, y0, y1, y2, z0, z1, z2, p0, p1, p2 = _joint(
-            V, ln, 3, d3, a3, c3, s3, x0, x1, x2, y0, y1, y2, z0, z1, z2, p0, p1, p2
-        )
-        _store_frame(V, ln, 3, z0, z1, z2, p0, p1, p2)
-        x0, x1, x2, y0, y1, y2, z0, z1, z2, p0, p1, p2 = _joint(
-            V, ln, 4, d4, a4, c4, s4, x0, x1, x2, y0, y1, y2, z0, z1, z2, p0, p1, p2
-        )
-        _store_frame(V, ln, 4, z0, z1, z2, p0, p1, p2)
-        q0, q1, q2 = p0, p1, p2  # the wrist point p5
-        x0, x1, x2, y0, y1, y2, z0, z1, z2, p0, p1, p2 = _joint(
-            V, ln, 5, d5, a5, c5, s5, x0, x1, x2, y0, y1, y2, z0, z1, z2, p0, p1, p2
-        )
+        # frame 1: Tz(d1) Tx(a1) Rx(alpha1); frames 2..5 stored, the wrist point p5
+        f = _stored(V, ln, 0, (1.0, 0.0, 0.0, 0.0, c0, s0, 0.0, -s0, c0, a0, 0.0, d0))
+        f = _stored(V, ln, 1, _joint(V, ln, 1, d1, a1, c1, s1, f))
+        f = _stored(V, ln, 2, _joint(V, ln, 2, d2, a2, c2, s2, f))
+        f = _stored(V, ln, 3, _joint(V, ln, 3, d3, a3, c3, s3, f))
+        f = _stored(V, ln, 4, _joint(V, ln, 4, d4, a4, c4, s4, f))
+        q0, q1, q2 = f[9], f[10], f[11]
+        x0, x1, x2, y0, y1, y2, z0, z1, z2, p0, p1, p2 = _joint(V, ln, 5, d5, a5, c5, s5, f)
         ep0, ep1, ep2 = pt0 - p0, pt1 - p1, pt2 - p2
         # rotation error: x cross x_t + y cross y_t = omega + (z . omega) z for small omega
         er0 = (x1 * xt2 - x2 * xt1) + (y1 * yt2 - y2 * yt1)
@@ -220,6 +206,19 @@ def _column(V, ln, k):
 
 
 @_jit
+def _minus(f, r, s):
+    """Row ``r`` minus ``f`` times row ``s`` (4 entries each: an elimination step)."""
+    return r[0] - f * s[0], r[1] - f * s[1], r[2] - f * s[2], r[3] - f * s[3]
+
+
+@_jit
+def _minus2(f, g, r, s, t):
+    """Row ``r`` minus ``f`` times row ``s`` and ``g`` times row ``t`` (4 entries each)."""
+    return (r[0] - (f * s[0] + g * t[0]), r[1] - (f * s[1] + g * t[1]),
+            r[2] - (f * s[2] + g * t[2]), r[3] - (f * s[3] + g * t[3]))  # fmt: skip
+
+
+@_jit
 def _step(V):
     """Damped block elimination of ``J dq = e`` in every lane (see ``calibrated_ik``).
 
@@ -247,15 +246,9 @@ def _step(V):
         p0 = u0 / (u0 * u0 + mu2)
         f4 = u4 * p0
         m21 -= p0 * m01
-        m23 -= p0 * m03
-        m24 -= p0 * m04
-        m25 -= p0 * m05
-        b2 -= p0 * b0
+        m23, m24, m25, b2 = _minus(p0, (m23, m24, m25, b2), (m03, m04, m05, b0))
         m41 -= f4 * m01
-        m43 -= f4 * m03
-        m44 -= f4 * m04
-        m45 -= f4 * m05
-        b4 -= f4 * b0
+        m43, m44, m45, b4 = _minus(f4, (m43, m44, m45, b4), (m03, m04, m05, b0))
         # block 1: rows (omega x, omega z) x columns (q5, q6); rows 3, 4, 5 below
         det = m11 * m22 - m12 * m21
         f = det / (det * det + mu2)
@@ -266,28 +259,17 @@ def _step(V):
         h1 = m41 * P01
         k0 = m51 * P00
         k1 = m51 * P01
-        m33 -= g0 * m13 + g1 * m23
-        m34 -= g0 * m14 + g1 * m24
-        m35 -= g0 * m15 + g1 * m25
-        b3 -= g0 * b1 + g1 * b2
-        m43 -= h0 * m13 + h1 * m23
-        m44 -= h0 * m14 + h1 * m24
-        m45 -= h0 * m15 + h1 * m25
-        b4 -= h0 * b1 + h1 * b2
-        m53 -= k0 * m13 + k1 * m23
-        m54 -= k0 * m14 + k1 * m24
-        m55 -= k0 * m15 + k1 * m25
-        b5 -= k0 * b1 + k1 * b2
+        row1, row2 = (m13, m14, m15, b1), (m23, m24, m25, b2)
+        m33, m34, m35, b3 = _minus2(g0, g1, (m33, m34, m35, b3), row1, row2)
+        m43, m44, m45, b4 = _minus2(h0, h1, (m43, m44, m45, b4), row1, row2)
+        m53, m54, m55, b5 = _minus2(k0, k1, (m53, m54, m55, b5), row1, row2)
         # block 2: pivot m33; rows 4, 5
         p3 = m33 / (m33 * m33 + mu2)
         f43 = m43 * p3
         f53 = m53 * p3
-        m44 -= f43 * m34
-        m45 -= f43 * m35
-        b4 -= f43 * b3
-        m54 -= f53 * m34
-        m55 -= f53 * m35
-        b5 -= f53 * b3
+        row3 = (m33, m34, m35, b3)  # column q4 of rows 4, 5 is not read again
+        _, m44, m45, b4 = _minus(f43, (m43, m44, m45, b4), row3)
+        _, m54, m55, b5 = _minus(f53, (m53, m54, m55, b5), row3)
         # block 3: rows (v5 x, v5 z) x columns (q2, q3)
         det = m44 * m55 - m45 * m54
         f = det / (det * det + mu2)
