@@ -177,16 +177,18 @@ class RecipeKey:
         return isinstance(other, RecipeKey) and other.items == self.items
 
 
+@dataclass
 class _Recipe:
-    """What both recipes share: their types checked and compiled, the reply to their setup
-    and the size of their struct (the dataclasses below set the attributes)."""
+    """What both recipes share: their id and names, their types checked and compiled, the
+    reply to their setup and the size of their struct (``__post_init__`` sets the types)."""
 
     recipe_id: int
-    types: list[str]
-    ok: bool
-    too_large: bool
-    _struct: struct.Struct | None
-    _counts: list[int]
+    names: list[str]
+    types: list[str] = field(init=False)
+    ok: bool = field(init=False)
+    too_large: bool = field(init=False, default=False)
+    _struct: struct.Struct | None = field(init=False, repr=False, default=None)
+    _counts: list[int] = field(init=False, repr=False, default_factory=list)
 
     def _compile(self, head: str, around: int) -> None:
         """``ok`` (every name known, the package fits in :data:`MAX_PACKET_SIZE` with
@@ -221,15 +223,8 @@ class OutputRecipe(_Recipe):
     such a recipe can never be started.
     """
 
-    recipe_id: int
-    names: list[str]
     frequency: float
     key: RecipeKey = field(init=False, repr=False)
-    types: list[str] = field(init=False)
-    ok: bool = field(init=False)
-    too_large: bool = field(init=False, default=False)
-    _struct: struct.Struct | None = field(init=False, repr=False, default=None)
-    _counts: list[int] = field(init=False, repr=False, default_factory=list)
 
     def __post_init__(self) -> None:
         self.key = RecipeKey((str(self.recipe_id), *self.names))  # equal recipes, one package
@@ -270,14 +265,6 @@ class InputRecipe(_Recipe):
     when no data package of it could be sent (larger than
     :data:`MAX_PACKET_SIZE`; ``too_large``, id 0).
     """
-
-    recipe_id: int
-    names: list[str]
-    types: list[str] = field(init=False)
-    ok: bool = field(init=False)
-    too_large: bool = field(init=False, default=False)
-    _struct: struct.Struct | None = field(init=False, repr=False, default=None)
-    _counts: list[int] = field(init=False, repr=False, default_factory=list)
 
     def __post_init__(self) -> None:
         self.types = [input_type(n) or "NOT_FOUND" for n in self.names]
