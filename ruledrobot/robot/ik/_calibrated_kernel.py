@@ -103,27 +103,25 @@ def _wrap(x):
 
 
 @_jit
+def _turn(c, s, u0, u1, u2, v0, v1, v2):
+    """Axes ``u``, ``v`` of a frame turned by the angle of cos ``c``, sin ``s`` about the third
+    axis: ``c u + s v``, ``c v - s u``."""
+    return (c * u0 + s * v0, c * u1 + s * v1, c * u2 + s * v2,
+            c * v0 - s * u0, c * v1 - s * u1, c * v2 - s * u2)  # fmt: skip
+
+
+@_jit
 def _joint(V, ln, j, d, a, ca, sa, frame):
     """Frame ``j + 1`` from frame ``j`` (axes x, y, z and origin p, 12 numbers) of lane
     ``ln``."""
     x0, x1, x2, y0, y1, y2, z0, z1, z2, p0, p1, p2 = frame
     cj = V[(_C + j) * _L + ln]
     sj = V[(_S + j) * _L + ln]
-    xr0 = cj * x0 + sj * y0
-    xr1 = cj * x1 + sj * y1
-    xr2 = cj * x2 + sj * y2
-    yr0 = cj * y0 - sj * x0
-    yr1 = cj * y1 - sj * x1
-    yr2 = cj * y2 - sj * x2
+    xr0, xr1, xr2, yr0, yr1, yr2 = _turn(cj, sj, x0, x1, x2, y0, y1, y2)  # Rz(theta)
     p0 = p0 + d * z0 + a * xr0
     p1 = p1 + d * z1 + a * xr1
     p2 = p2 + d * z2 + a * xr2
-    y0 = ca * yr0 + sa * z0
-    y1 = ca * yr1 + sa * z1
-    y2 = ca * yr2 + sa * z2
-    z0 = ca * z0 - sa * yr0
-    z1 = ca * z1 - sa * yr1
-    z2 = ca * z2 - sa * yr2
+    y0, y1, y2, z0, z1, z2 = _turn(ca, sa, yr0, yr1, yr2, z0, z1, z2)  # Rx(alpha)
     return xr0, xr1, xr2, y0, y1, y2, z0, z1, z2, p0, p1, p2
 
 
