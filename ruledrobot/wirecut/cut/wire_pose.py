@@ -47,7 +47,9 @@ from ..job.spec import ToolSpec
 from .clearance import Cell, clearance
 from .wire_geometry import chords, flange_poses, slide_bounds, wire_poses
 
-__all__ = ["RedundancyResult", "SearchOptions", "bow_segments", "solve_redundancy"]
+__all__ = [
+    "RedundancyResult", "SearchOptions", "bow_segments", "search_wire_pose", "solve_redundancy",
+]
 
 STRATEGIES = ("auto", "constant", "varying")
 
@@ -412,7 +414,7 @@ def _ladder_roll(
 
 
 def _follow_branch(
-    model, P: FloatArray, branch: np.ndarray, q_start: FloatArray | None
+    model: RobotModel, P: FloatArray, branch: np.ndarray, q_start: FloatArray | None
 ) -> FloatArray | None:
     """Joints (M, 6) of flange poses P on the given IK branches, unwrapped along the path
     and shifted by whole turns towards ``q_start`` (else into the limits); None when a
