@@ -49,7 +49,6 @@ __all__ = [
     "ServoGains",
     "default_armature",
     "default_damping",
-
     "robot_mjcf",
 ]
 

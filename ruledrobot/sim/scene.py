@@ -63,6 +63,7 @@ class CutJob(Protocol):
 
     def robot_model(self) -> RobotModel: ...
 
+
 #: Geom names of the scene's static objects and of the wire.
 WIRE_GEOM = "wire"
 STOCK_GEOM = "stock"
@@ -153,8 +154,7 @@ class Scene:
 
     @classmethod
     def from_job(
-        cls, job: CutJob, robot: RobotModel | None = None, bow: BowTool | None = None,
-        **kw: Any,
+        cls, job: CutJob, robot: RobotModel | None = None, bow: BowTool | None = None, **kw: Any
     ) -> Scene:
         """The cell of a cut job (:class:`CutJob`: ``ruledrobot.wirecut.job.spec.Job``):
         ``job.robot_model()`` (model, calibration; unless ``robot`` is given) placed at the
@@ -184,6 +184,19 @@ class Scene:
 
 def _in_base(model: RobotModel, T: FloatArray) -> FloatArray:
     return np.asarray(model.base) @ T
+
+
+def _block_geom(
+    world: ET.Element, model: RobotModel, block: Box, name: str, rgba: str, *, conaffinity: int
+) -> ET.Element:
+    """A block of the cell (the table, the stock) as a colliding box geom of the world body.
+
+    ``block`` is given in the robot base frame and placed at ``model.base @ block.pose``
+    (4, 4); the geom's ``size`` is MuJoCo's half edge lengths [m]; ``contype`` 1 and
+    ``conaffinity`` as given (the collision classes of the module doc).
+    """
+    return placed(world, "geom", _in_base(model, block.pose), name=name, type="box",
+                  size=0.5 * block.size, rgba=rgba, contype=1, conaffinity=conaffinity)  # fmt: skip
 
 
 def scene_mjcf(
@@ -296,17 +309,7 @@ def scene_mjcf(
     )
 
     if table is not None:
-        placed(
-            world,
-            "geom",
-            _in_base(model, table.pose),
-            name=TABLE_GEOM,
-            type="box",
-            size=0.5 * table.size,
-            rgba=_TABLE_RGBA,
-            contype=1,
-            conaffinity=3,
-        )
+        _block_geom(world, model, table, TABLE_GEOM, _TABLE_RGBA, conaffinity=3)
         top = table.centre[2] - 0.5 * table.size[2]
         legs_h = 0.71
         half = 0.5 * table.size
@@ -349,17 +352,8 @@ def scene_mjcf(
         )
 
     if stock is not None:
-        placed(
-            world,
-            "geom",
-            _in_base(model, stock.pose),
-            name=STOCK_GEOM,
-            type="box",
-            size=0.5 * stock.size,
-            rgba=_STOCK_RGBA if part is None else _STOCK_WITH_PART_RGBA,
-            contype=1,
-            conaffinity=1,
-        )
+        rgba = _STOCK_RGBA if part is None else _STOCK_WITH_PART_RGBA
+        _block_geom(world, model, stock, STOCK_GEOM, rgba, conaffinity=1)
     if part is not None and len(part.faces):
         v = np.asarray(part.vertices, dtype=np.float64)
         f = np.asarray(part.faces, dtype=np.int64)
