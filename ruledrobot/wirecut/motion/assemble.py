@@ -27,6 +27,7 @@ import numpy as np
 from ...geometry.angles import wrap_near
 from ...geometry.checks import FloatArray
 from ...robot.arm.model import RobotModel
+from ...robot.arm.nearest import nearest_ik
 from ...robot.tool import BowTool
 from ...robot.wire.in_stock import WireInStock, wire_ends, wire_gap, wire_in_stock
 from ..cut.clearance import Cell
@@ -100,13 +101,7 @@ def _backed_off(
     frame); None if unreachable or out of limits."""
     P = model.fk(q)
     P[:3, 3] += dist * away
-    sols = model.ik(P)
-    sols = sols[~np.isnan(sols).any(axis=1)]
-    if not len(sols):
-        return None
-    sols = wrap_near(sols, q)
-    best = sols[np.argmin(np.abs(sols - q).max(axis=1))]
-    return best if model.within_limits(best) else None
+    return nearest_ik(model, P, q)
 
 
 def _free_pose(

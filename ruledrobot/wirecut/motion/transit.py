@@ -22,9 +22,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...geometry.angles import wrap_near
 from ...geometry.checks import FloatArray
 from ...robot.arm.model import RobotModel
+from ...robot.arm.nearest import nearest_ik
 from ..cut.clearance import Cell, clearance
 from ..job.spec import Job
 
@@ -110,13 +110,7 @@ class TransitPlanner:
         if rise <= 0.0:
             return q
         P[2, 3] += rise
-        sols = model.ik(P)
-        sols = sols[~np.isnan(sols).any(axis=1)]
-        if not len(sols):
-            return None
-        sols = wrap_near(sols, q)
-        best = sols[np.argmin(np.abs(sols - q).max(axis=1))]
-        return best if model.within_limits(best) else None
+        return nearest_ik(model, P, q)
 
     def _tree(self, qa: FloatArray, qb: FloatArray) -> list[FloatArray] | None:
         """RRT-connect from ``qa`` to ``qb`` (module doc); the waypoints, or None.
