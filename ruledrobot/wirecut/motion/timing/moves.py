@@ -8,8 +8,9 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ....geometry.checks import as_limits, as_number, as_shaped
+from ....geometry.checks import as_number, as_shaped
 from ....robot.motion.rates import trajectory_limits_report
+from .inputs import as_factor, as_rate_limits
 from .result import TimedPath
 from .tolerances import CONTINUITY_TOL, MAX_SAMPLES, FloatArray
 
@@ -46,12 +47,8 @@ def joint_move(
     a0 = as_shaped(q0, "q0", (None,))
     J = a0.shape[0]
     a1 = as_shaped(q1, "q1", (J,))
-    vlim = as_limits(vel_limits, "vel_limits", J)
-    alim = as_limits(acc_limits, "acc_limits", J)
-    dt = as_number(dt, "dt")
-    k_s = as_number(speed_scale, "speed_scale")
-    if k_s > 1.0:
-        raise ValueError(f"speed_scale: expected a factor in (0, 1], got {k_s}")
+    vlim, alim, dt = as_rate_limits(vel_limits, acc_limits, dt, J)
+    k_s = as_factor(speed_scale, "speed_scale")
     delta = a1 - a0
     D = np.abs(delta)
     moving = D > 0
@@ -125,9 +122,7 @@ def dwell(
     (e.g. while the wire heats).  ``s_of_t`` runs 0…1 over the hold."""
     a = as_shaped(q, "q", (None,))
     J = a.shape[0]
-    vlim = as_limits(vel_limits, "vel_limits", J)
-    alim = as_limits(acc_limits, "acc_limits", J)
-    dt = as_number(dt, "dt")
+    vlim, alim, dt = as_rate_limits(vel_limits, acc_limits, dt, J)
     duration = as_number(duration, "duration", allow_zero=True)
     n = max(1, math.ceil(duration / dt - 1e-9)) + 1
     if n > MAX_SAMPLES:

@@ -7,7 +7,8 @@ from dataclasses import replace
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ....geometry.checks import as_limits, as_number, as_shaped, check_increasing
+from ....geometry.checks import as_number, as_shaped, check_increasing
+from .inputs import as_factor, as_rate_limits
 from .problem import _prepare, _Problem
 from .result import TimedPath
 from .sampling import _sample_law, _timed_from_law
@@ -78,12 +79,8 @@ def time_path(
         i = int(neg[0])
         raise ValueError(f"speed_factor[{i}]: expected a value >= 0, got {sf[i]}")
     feed = as_number(feed_speed, "feed_speed")
-    vlim = as_limits(vel_limits, "vel_limits", J)
-    alim = as_limits(acc_limits, "acc_limits", J)
-    dt = as_number(dt, "dt")
-    safety = as_number(safety, "safety")
-    if safety > 1.0:
-        raise ValueError(f"safety: expected a factor in (0, 1], got {safety}")
+    vlim, alim, dt = as_rate_limits(vel_limits, acc_limits, dt, J)
+    safety = as_factor(safety, "safety")
     if solver not in ("toppra", "reachability"):
         raise ValueError(f"solver: expected 'toppra' or 'reachability', got {solver!r}")
     use_toppra = solver == "toppra"
