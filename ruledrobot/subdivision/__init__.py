@@ -182,14 +182,10 @@ def refine_plucker(
     plucker : ndarray, shape (N, 6)
         Plücker coordinates ``[l, m]`` of the rulings (``|l| = 1``,
         ``l · m = 0``, Eq. 1); ``l`` unit direction, ``m`` moment [m].
-    scheme : Scheme
-        The subdivision scheme.
-    steps : int
-        Number of refinement steps.
-    closed : bool
-        Whether the sequence is periodic.
-    flip : bool
-        Close with an orientation flip (Möbius band); only with ``closed``.
+    scheme, steps, closed, flip
+        The scheme, the number of steps, whether the sequence is periodic and
+        whether it closes with a flip (only with ``closed``), as in
+        :func:`~ruledrobot.subdivision.engine.refine_sequence`.
 
     Returns
     -------
