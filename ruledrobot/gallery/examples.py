@@ -8,7 +8,7 @@ from typing import Any
 
 import numpy as np
 
-from ..algorithms import refine
+from ..algorithms import RefineResult, refine
 from ..geometry.checks import FloatArray
 from ..geometry.lines import Lines, plucker_transform
 from ..geometry.ruled import RuledSurface
@@ -22,7 +22,22 @@ from ..geometry.surfaces import (
     hyperboloid_residual,
     mobius_band,
 )
-from .scene import _check, _Example, _manifold_residuals, _picture, _record
+from .scene import _check, _Example, _manifold_residuals, _picture, _record, _Scene
+
+# --------------------------------------------------------------------------
+# the line-manifold checks of examples 3, 4 and 5
+# --------------------------------------------------------------------------
+
+
+def _manifold_checks(x: FloatArray, prefix: str = "") -> list[dict[str, Any]]:
+    """The two checks that refined Plücker rows ``x`` (M, 6) lie on the line manifold:
+    ``max | |l| - 1 | < 1e-12`` and ``max |l . m| < 1e-12`` [m], named after ``prefix``."""
+    lm, lmm = _manifold_residuals(x)
+    return [
+        _check(f"{prefix}max | |l| - 1 |", lm, "<", 1e-12),
+        _check(f"{prefix}max |l . m|", lmm, "<", 1e-12),
+    ]
+
 
 # --------------------------------------------------------------------------
 # example 1: cylindroid, projection algorithm
@@ -198,9 +213,7 @@ def _example_four_lines() -> _Example:
             )
         )
     assert res is not None
-    lm, lmm = _manifold_residuals(res.lines.plucker)
-    checks.append(_check("4 steps: max | |l| - 1 |", lm, "<", 1e-12))
-    checks.append(_check("4 steps: max |l . m|", lmm, "<", 1e-12))
+    checks.extend(_manifold_checks(res.lines.plucker, "4 steps: "))
     record = _record(
         "four_lines",
         "Example 3: four lines (seed 7), combined algorithm (four_point, 1/2/4 steps)",
@@ -284,15 +297,13 @@ def _example_mobius() -> _Example:
     assert s is not None
     # the same measure for coarser and finer input (Chaikin: O(h^2) expected)
     others = {str(k): _mobius_errors(k, radius, steps)[1:3] for k in (8, 16)}
-    lm, lmm = _manifold_residuals(x)
     last_first = float(x[-1, :3] @ x[0, :3])
     checks = [
         _check("result closed with a flip (res.flip)", float(res.flip), "==", 1.0),
         _check(
             "l_last . l_first (last refined ruling points against the first)", last_first, "<", 0.0
         ),
-        _check("max | |l| - 1 |", lm, "<", 1e-12),
-        _check("max |l . m|", lmm, "<", 1e-12),
+        *_manifold_checks(x),
         _check(
             "max distance refined striction point -> exact ruling at nearest parameter (m)",
             dist,
@@ -336,6 +347,26 @@ def _example_mobius() -> _Example:
 
 
 # --------------------------------------------------------------------------
+# examples 5 and 6: the picture of a DH refinement
+# --------------------------------------------------------------------------
+
+
+def _dh_picture(
+    title: str, lines: Lines, res: RefineResult, origins: FloatArray, half: float, every: int
+) -> _Scene:
+    """The picture of a DH refinement (examples 5 and 6).
+
+    The input ``lines`` about their striction points, the refined strip and every
+    ``every``-th refined ruling about the refined striction points, each ``half`` [m]
+    to either side, and the refined DH frames' ``origins`` (M, 3) [m, world] as a curve.
+    """
+    s0 = RuledSurface(lines).striction_points()
+    surf = res.surface()
+    curves = [(origins, "crimson", "DH frame origins")]
+    return _picture(title, lines, s0, surf, surf.striction_points(), half, every, curves=curves)
+
+
+# --------------------------------------------------------------------------
 # example 5: hyperboloid of revolution, DH algorithm
 # --------------------------------------------------------------------------
 
@@ -350,7 +381,6 @@ def _example_hyperboloid() -> _Example:
     v = np.array([-1.0, 0.0, 1.0])
     pts = origin[:, None, :] + v[None, :, None] * res.lines.direction[:, None, :]
     resid = float(np.abs(hyperboloid_residual(pts, a=a, c=c)).max())
-    lm, lmm = _manifold_residuals(res.lines.plucker)
     checks = [
         _check(
             "max |quadric residual| at 3 points per refined ruling (v = -1, 0, 1 m) (m)",
@@ -358,8 +388,7 @@ def _example_hyperboloid() -> _Example:
             "<",
             1e-9,
         ),
-        _check("max | |l| - 1 |", lm, "<", 1e-12),
-        _check("max |l . m|", lmm, "<", 1e-12),
+        *_manifold_checks(res.lines.plucker),
     ]
     record = _record(
         "hyperboloid",
@@ -369,12 +398,7 @@ def _example_hyperboloid() -> _Example:
         checks,
         measurements={"a": a, "c": c, "u_range": [0.0, float(np.pi)]},
     )
-    s0 = RuledSurface(lines).striction_points()
-    surf = res.surface()
-    s = surf.striction_points()
-    scene = _picture(record["title"], lines, s0, surf, s, 1.0, 4,
-                     curves=[(origin, "crimson", "DH frame origins")])
-    return _Example(record, scene)
+    return _Example(record, _dh_picture(record["title"], lines, res, origin, 1.0, 4))
 
 
 # --------------------------------------------------------------------------
@@ -428,13 +452,7 @@ def _example_helical_surface() -> _Example:
             "dphi": dphi,
         },
     )
-    origin = frames[:, :3, 3]
-    s0 = RuledSurface(lines).striction_points()
-    surf = res.surface()
-    s = surf.striction_points()
-    scene = _picture(record["title"], lines, s0, surf, s, 0.8, 2,
-                     curves=[(origin, "crimson", "DH frame origins")])
-    return _Example(record, scene)
+    return _Example(record, _dh_picture(record["title"], lines, res, frames[:, :3, 3], 0.8, 2))
 
 
 _EXAMPLES: tuple[Callable[[], _Example], ...] = (
