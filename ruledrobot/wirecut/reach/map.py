@@ -34,13 +34,7 @@ from .grid import (
     planner_slides,
     sample_rulings,
 )
-from .margins import (
-    DEFAULT_RULES,
-    Reason,
-    Rules,
-    clearance_margins,
-    kinematic_margins,
-)
+from .margins import DEFAULT_RULES, Reason, Rules, clearance_margins, kinematic_margins
 
 __all__ = ["PassMap", "ReachMap", "classify", "job_cell", "map_pass", "reach_map"]
 
