@@ -133,11 +133,15 @@ def as_limits(value: ArrayLike, name: str, n: int) -> FloatArray:
     return arr
 
 
-def as_point(value: ArrayLike, name: str) -> FloatArray:
-    """A read-only point or vector (3,) in metres; ValueError naming ``name`` otherwise."""
+def as_point(value: ArrayLike, name: str, *, what: str = "m") -> FloatArray:
+    """A read-only point or vector (3,), finite; ValueError naming ``name`` otherwise.
+
+    ``what`` says in the message what the three numbers are: ``"m"`` (a point or an
+    offset in metres, the default) or ``"x, y, z"`` (any vector).
+    """
     v = as_float_array(value, name)
     if v.shape != (3,):
-        raise ValueError(f"{name}: expected 3 numbers (m), got shape {v.shape}")
+        raise ValueError(f"{name}: expected 3 numbers ({what}), got shape {v.shape}")
     return readonly(v)
 
 

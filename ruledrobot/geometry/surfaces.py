@@ -59,7 +59,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ._arrays import norm
-from .checks import FloatArray, as_float_array
+from .checks import FloatArray, as_float_array, as_point
 from .lines import Lines, plucker_from_point_direction
 
 __all__ = [
@@ -122,10 +122,7 @@ def _finite(value: Any, name: str) -> float:
 
 
 def _vector3(value: Any, name: str) -> FloatArray:
-    arr = as_float_array(value, name)
-    if arr.shape != (3,):
-        raise ValueError(f"{name}: expected 3 numbers (x, y, z), got shape {arr.shape}")
-    return arr
+    return as_point(value, name, what="x, y, z")
 
 
 def _direction3(value: Any, name: str) -> FloatArray:
