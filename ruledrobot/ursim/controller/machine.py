@@ -46,19 +46,12 @@ from numpy.typing import ArrayLike
 from ...protocol.modes import JointMode, RobotMode, RuntimeState, SafetyMode, SafetyStatusBit
 from ...robot import RobotModel
 from ...robot.motion.arm_kinematics import ArmKinematics
-from ...robot.motion.ur_motion import (
-    MotionError,
-    PathMotion,
-    Segment,
-    StopMotion,
-    joint_segment,
-    linear_segment,
-)
+from ...robot.motion.ur_motion import MotionError, PathMotion, Segment, StopMotion
 from ..arm.backend import ArmBackend, ArmState, KinematicBackend
 from ..script.functions import compile_program
 from ..script.handshake import ControlScript
 from ..script.program import CompileError, PathWaypoint, Program, parse_program
-from ..script.runner import ScriptRunner, run_io_statement
+from ..script.runner import ScriptRunner, move_segment, run_io_statement
 from .registers import IN_DOUBLE, IN_INT, OUT_DOUBLE, OUT_INT, IOMixin
 from .safety import SafetyMixin
 
@@ -370,17 +363,8 @@ class Controller(IOMixin, SafetyMixin):
         segs: list[Segment] = []
         for wp in waypoints:
             target = np.asarray(wp.target, dtype=float)
-            if wp.kind == "movej":
-                if wp.pose:
-                    qt = self.kin.ik_nearest(target, q)
-                    if qt is None:
-                        raise MotionError(f"path: movej pose p{list(wp.target)} out of reach")
-                    target = qt
-                seg = joint_segment(q, target, wp.v, wp.a, wp.r, self.kin)
-            else:
-                if not wp.pose:
-                    target = np.asarray(self.kin.tcp_vector(target.tolist()))
-                seg = linear_segment(q, target, wp.v, wp.a, wp.r, self.kin)
+            seg = move_segment(self.kin, q, wp.kind, target, wp.pose, wp.v, wp.a, wp.r,
+                               f"path: movej pose p{list(wp.target)} out of reach")  # fmt: skip
             segs.append(seg)
             q = seg.q_end
         return PathMotion(q0, segs)

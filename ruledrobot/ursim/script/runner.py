@@ -32,6 +32,7 @@ import math
 
 import numpy as np
 
+from ...robot.motion.arm_kinematics import ArmKinematics
 from ...robot.motion.ur_motion import (
     MotionError,
     PathMotion,
@@ -43,7 +44,7 @@ from ...robot.motion.ur_motion import (
 from .host import ProgramHost
 from .program import Pose, Program, Statement
 
-__all__ = ["ScriptRunner", "run_io_statement"]
+__all__ = ["ScriptRunner", "move_segment", "run_io_statement"]
 
 _MOVES = ("movej", "movel", "movep")
 
@@ -57,6 +58,47 @@ def _target(v: object) -> tuple[np.ndarray, bool]:
 
 def _float(st: Statement, key: str) -> float:
     return float(st.params[key])  # type: ignore[arg-type]
+
+
+def move_segment(
+    kin: ArmKinematics,
+    q: np.ndarray,
+    kind: str,
+    target: np.ndarray,
+    pose: bool,
+    v: float,
+    a: float,
+    r: float,
+    unreachable: str,
+) -> Segment:
+    """The segment of one move of a blended path, as the controller plans it: the one
+    reading of ``movej`` / ``movel`` / ``movep`` for programs and injected paths.
+
+    Parameters
+    ----------
+    kin : the arm's kinematics (FK with the current TCP, IK nearest a configuration).
+    q : (6,) joint positions [rad] the move starts from (the previous segment's end).
+    kind : ``"movej"`` (joint interpolation, :func:`joint_segment`); ``"movel"`` and
+        ``"movep"`` move the TCP on a line (:func:`linear_segment`).
+    target : (6,) joint positions [rad], or with ``pose`` a UR pose vector
+        ``[x, y, z, rx, ry, rz]`` [m, rad] of the TCP in the robot base frame.
+    pose : whether ``target`` is a pose: ``movej`` to a pose goes to its IK solution
+        nearest ``q``; ``movel`` / ``movep`` to joints go to the TCP pose of those joints.
+    v, a : speed and acceleration (rad/s, rad/s^2 for ``movej``; m/s, m/s^2 otherwise).
+    r : blend radius [m].
+    unreachable : the :class:`MotionError`'s message when a ``movej`` pose has no IK
+        solution (``linear_segment`` raises its own for a line out of reach).
+    """
+    if kind == "movej":
+        if pose:
+            qt = kin.ik_nearest(target, q)
+            if qt is None:
+                raise MotionError(unreachable)
+            target = qt
+        return joint_segment(q, target, v, a, r, kin)
+    if not pose:
+        target = np.asarray(kin.tcp_vector(target.tolist()))
+    return linear_segment(q, target, v, a, r, kin)
 
 
 def run_io_statement(c: ProgramHost, st: Statement) -> bool:
@@ -152,20 +194,10 @@ class ScriptRunner:
         while self.pc < len(stmts) and stmts[self.pc].name in _MOVES:
             st = stmts[self.pc]
             self.pc += 1
-            linear = st.name != "movej"
-            target, pose = _target(st.params["q" if not linear else "pose"])
+            target, pose = _target(st.params["q" if st.name == "movej" else "pose"])
             a, v, r = _float(st, "a"), _float(st, "v"), _float(st, "r")
-            if linear:
-                if not pose:
-                    target = np.asarray(self.kin.tcp_vector(target.tolist()))
-                seg = linear_segment(q, target, v, a, r, self.kin)
-            else:
-                if pose:
-                    qt = self.kin.ik_nearest(target, q)
-                    if qt is None:
-                        raise MotionError(f"line {st.line}: movej: pose out of reach")
-                    target = qt
-                seg = joint_segment(q, target, v, a, r, self.kin)
+            seg = move_segment(self.kin, q, st.name, target, pose, v, a, r,
+                               f"line {st.line}: movej: pose out of reach")  # fmt: skip
             segs.append(seg)
             q = seg.q_end
             if r <= 0.0:
