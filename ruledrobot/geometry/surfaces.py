@@ -321,90 +321,98 @@ def _sampson(F: FloatArray, grad: FloatArray) -> FloatArray:
     return np.where(F == 0.0, 0.0, F / safe)
 
 
-_FLOAT = _finite
+_Check = Callable[[Any, str], Any]
+"""A parameter's check: ``(value, name) -> checked value``; ValueError naming ``name``."""
+
+_TURN = (0.0, 2.0 * np.pi)
+
+
+def _surface(
+    name: str,
+    description: str,
+    family: Callable[..., PointsDirections],
+    params: Mapping[str, tuple[Any, _Check]],
+    *,
+    closure: Closure = "open",
+    domain: tuple[float, float] = _TURN,
+    residual: Callable[..., FloatArray] | None = None,
+) -> SurfaceSpec:
+    """A :class:`SurfaceSpec` whose ``params`` give each parameter once, as ``name:
+    (default, check)``; the domain is one turn ``[0, 2 pi)`` unless given."""
+    defaults = {k: default for k, (default, _) in params.items()}
+    checks = {k: check for k, (_, check) in params.items()}
+    return SurfaceSpec(name, description, defaults, domain, closure, family, checks, residual)
+
+
 _SPECS: dict[str, SurfaceSpec] = {
     s.name: s
     for s in (
-        SurfaceSpec(
+        _surface(
             "cylindroid",
             "Plücker conoid z (x^2+y^2) = 2 c x y: ruling u through (0, 0, c sin 2u) along "
             "(cos u, sin u, 0); ruling u + pi is ruling u reversed",
-            {"c": 0.5},
-            (0.0, np.pi),
-            "flip",
             _cylindroid_pd,
-            {"c": _nonzero},
-            cylindroid_residual,
+            {"c": (0.5, _nonzero)},
+            closure="flip",
+            domain=(0.0, np.pi),
+            residual=cylindroid_residual,
         ),
-        SurfaceSpec(
+        _surface(
             "hyperbolic_paraboloid",
             "z = x y / c, rulings x = u: through (u, 0, 0) along (0, 1, u/c)",
-            {"c": 1.0},
-            (-1.0, 1.0),
-            "open",
             _hyperbolic_paraboloid_pd,
-            {"c": _nonzero},
-            hyperbolic_paraboloid_residual,
+            {"c": (1.0, _nonzero)},
+            domain=(-1.0, 1.0),
+            residual=hyperbolic_paraboloid_residual,
         ),
-        SurfaceSpec(
+        _surface(
             "hyperboloid",
             "(x^2+y^2)/a^2 - z^2/c^2 = 1: ruling u through (a cos u, a sin u, 0) along "
             "(-a sin u, a cos u, c)",
-            {"a": 1.0, "c": 1.0},
-            (0.0, 2.0 * np.pi),
-            "closed",
             _hyperboloid_pd,
-            {"a": _positive, "c": _positive},
-            hyperboloid_residual,
+            {"a": (1.0, _positive), "c": (1.0, _positive)},
+            closure="closed",
+            residual=hyperboloid_residual,
         ),
-        SurfaceSpec(
+        _surface(
             "helicoid",
             "ruling u through (0, 0, pitch u) along (cos u, sin u, 0)",
-            {"pitch": 0.2},
-            (0.0, 2.0 * np.pi),
-            "open",
             _helicoid_pd,
-            {"pitch": _nonzero},
-            helicoid_residual,
+            {"pitch": (0.2, _nonzero)},
+            residual=helicoid_residual,
         ),
-        SurfaceSpec(
+        _surface(
             "helical_surface",
             "the line (point, direction) moved by the helical motion: rotation u about z "
             "and translation pitch u along z",
-            {"point": (1.0, 0.0, 0.0), "direction": (0.0, 1.0, 1.0), "pitch": 0.2},
-            (0.0, 2.0 * np.pi),
-            "open",
             _helical_surface_pd,
-            {"point": _vector3, "direction": _direction3, "pitch": _FLOAT},
+            {
+                "point": ((1.0, 0.0, 0.0), _vector3),
+                "direction": ((0.0, 1.0, 1.0), _direction3),
+                "pitch": (0.2, _finite),
+            },
         ),
-        SurfaceSpec(
+        _surface(
             "helical_developable",
             "tangents of the helix (r cos u, r sin u, h u): through it along "
             "(-r sin u, r cos u, h); r = radius, h = pitch (m/rad)",
-            {"radius": 1.0, "pitch": 0.3},
-            (0.0, 2.0 * np.pi),
-            "open",
             _helical_developable_pd,
-            {"radius": _positive, "pitch": _FLOAT},
+            {"radius": (1.0, _positive), "pitch": (0.3, _finite)},
         ),
-        SurfaceSpec(
+        _surface(
             "conoid",
             "right conoid: ruling u through (0, 0, height sin(waves u)) along (cos u, sin u, 0)",
-            {"height": 0.5, "waves": 3},
-            (0.0, 2.0 * np.pi),
-            "closed",
             _conoid_pd,
-            {"height": _FLOAT, "waves": _positive_int},
+            {"height": (0.5, _finite), "waves": (3, _positive_int)},
+            closure="closed",
         ),
-        SurfaceSpec(
+        _surface(
             "mobius_band",
             "ruling u through (R cos u, R sin u, 0) along "
             "(cos(u/2) cos u, cos(u/2) sin u, sin(u/2)); ruling u + 2 pi is ruling u reversed",
-            {"radius": 1.0},
-            (0.0, 2.0 * np.pi),
-            "flip",
             _mobius_pd,
-            {"radius": _positive},
+            {"radius": (1.0, _positive)},
+            closure="flip",
         ),
     )
 }
