@@ -15,8 +15,8 @@ planes 1.52 L, and the block left when the swept surface itself (the strips betw
 consecutive rulings, voxels of 1.5 mm) is flooded from the part 1.48 L (1.42 L against
 1.48 L at amplitude 0.6, 1.15 L against 1.20 L at 0.9 with three waves; the flood loses
 one voxel layer at the surface); the planes are what the wire leaves.  The zero level
-of the largest of both is meshed by marching cubes on a grid of ``resolution``, as
-:func:`ruledrobot.wirecut.part_mesh` does (values kept off zero at grid points, faces
+of the largest of both is meshed by the planner's own :func:`ruledrobot.wirecut.stock_mesh`
+(marching cubes on a grid of ``resolution``, values kept off zero at grid points, faces
 turned outwards): a closed 2-manifold.
 """
 
@@ -37,10 +37,6 @@ __all__ = ["SurfacePass", "carved_mesh", "ruling_frames"]
 
 #: refinement steps of the rulings before meshing
 STEPS = 2
-#: most grid points, and distances kept off zero by this fraction of the grid step (as
-#: the planner's part mesh)
-MAX_POINTS = 5_000_000
-SNAP = 0.005
 
 
 @dataclass(frozen=True)
@@ -83,31 +79,19 @@ def carved_mesh(cuts: tuple[CarveCut, ...], stock: Box, loops: tuple[Loop, ...] 
                 resolution: float = 0.002) -> Mesh | None:  # fmt: skip
     """The block kept by the exact ``cuts`` and the roughing ``loops`` as a closed mesh
     [m, base frame] (module doc); None when nothing is kept."""
-    from skimage.measure import marching_cubes
-
     from ..subdivision import subdivide
-    from ..wirecut import part_sdf, signed_volume
+    from ..wirecut import part_sdf, stock_mesh
 
-    h = max(resolution, float(np.prod(stock.size + 4 * resolution) / MAX_POINTS) ** (1 / 3))
-    counts = np.ceil((stock.size + 4.0 * h) / h).astype(int) + 1
-    axes = [(np.arange(c) - (c - 1) / 2.0) * h for c in counts]
-    X, Y, Z = np.meshgrid(*axes, indexing="ij")
-    world = np.stack([X, Y, Z], axis=-1).reshape(-1, 3) @ stock.rotation.T + stock.centre
     passes = []
     for c in cuts:
         fine = subdivide(c.lines, scheme="four_point", steps=STEPS, closed=c.closed)
         passes.append(SurfacePass(c.name, ruling_frames(fine, stock.centre), c.closed))
     job = _Job(tuple(_Cut(c.name, c.keep) for c in cuts), stock)
-    f = part_sdf(job, tuple(passes), world, tuple(counts), 3.0 * h)  # type: ignore[arg-type]
-    for loop in loops:
-        f = np.maximum(f, (world @ loop.normals.T - loop.support).max(axis=1).reshape(f.shape))
-    eps = SNAP * h
-    f = np.where(np.abs(f) < eps, np.where(f < 0.0, -eps, eps), f)
-    if f.min() >= 0.0:
-        return None
-    verts, faces, _, _ = marching_cubes(f, level=0.0, spacing=(h, h, h))
-    verts = verts + np.array([a[0] for a in axes])
-    faces = faces.astype(np.int64)
-    if signed_volume(verts, faces) < 0.0:
-        faces = faces[:, ::-1]
-    return Mesh(verts @ stock.rotation.T + stock.centre, faces)
+
+    def sdf(world: FloatArray, shape: tuple[int, ...], h: float) -> FloatArray:
+        f = part_sdf(job, tuple(passes), world, shape, 3.0 * h)  # type: ignore[arg-type]
+        for loop in loops:
+            f = np.maximum(f, (world @ loop.normals.T - loop.support).max(axis=1).reshape(shape))
+        return f
+
+    return stock_mesh(stock, resolution, sdf)

@@ -257,6 +257,8 @@ class PlaybackResult:
         matplotlib.use("Agg", force=False)
         from matplotlib.figure import Figure
 
+        from ..io.pictures import thinned_series
+
         out = Path(out_dir)
         t = self.t
         J = self.robot.n_joints
@@ -267,12 +269,13 @@ class PlaybackResult:
         fig = Figure(figsize=(9, 8))
         fig.subplots_adjust(left=0.09, right=0.99, bottom=0.06, top=0.95, hspace=0.07)
         ax = fig.subplots(3, 1, sharex=True)
-        ax[0].plot(t, self.joint_error() * 1e3, lw=0.8)
+        ax[0].plot(*thinned_series(t, self.joint_error() * 1e3), lw=0.8)
         ax[0].set_ylabel("joint error [mrad]")
         ax[0].legend(labels, ncol=J, fontsize=7, loc="upper right")
-        ax[1].plot(t, self.tcp_position_error() * 1e3, lw=0.8, color="C3")
+        ax[1].plot(*thinned_series(t, self.tcp_position_error() * 1e3), lw=0.8, color="C3")
         ax[1].set_ylabel("TCP position error [mm]")
-        ax[2].plot(t, np.degrees(self.tcp_orientation_error()), lw=0.8, color="C4")
+        ax[2].plot(*thinned_series(t, np.degrees(self.tcp_orientation_error())), lw=0.8,
+                   color="C4")
         ax[2].set_ylabel("TCP orientation error [deg]")
         ax[2].set_xlabel("time [s]")
         for c in self.collisions:
@@ -285,11 +288,11 @@ class PlaybackResult:
         fig.subplots_adjust(left=0.075, right=0.99, bottom=0.08, top=0.93, hspace=0.06)
         ax = fig.subplots(2, 1, sharex=True)
         lim_t = np.where(np.isfinite(self.robot.max_torque), self.robot.max_torque, np.inf)
-        ax[0].plot(t, np.abs(self.torque) / lim_t, lw=0.8)
+        ax[0].plot(*thinned_series(t, np.abs(self.torque) / lim_t), lw=0.8)
         ax[0].axhline(1.0, color="k", ls="--", lw=0.8)
         ax[0].set_ylabel("|torque| / limit")
         ax[0].legend(labels, ncol=J, fontsize=7, loc="upper right")
-        ax[1].plot(t, np.abs(self.qd) / self.robot.max_velocity, lw=0.8)
+        ax[1].plot(*thinned_series(t, np.abs(self.qd) / self.robot.max_velocity), lw=0.8)
         ax[1].axhline(1.0, color="k", ls="--", lw=0.8)
         ax[1].set_ylabel("|speed| / limit")
         ax[1].set_xlabel("time [s]")

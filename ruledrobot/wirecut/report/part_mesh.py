@@ -29,6 +29,8 @@ Cuts without ``keep`` name no part side and are left out (a note says so).
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 
 from ...geometry.box import Box
@@ -39,7 +41,7 @@ from ..cut.kerf import ruling_normals, waste_sign
 from ..cut.wire_geometry import chords
 from ..job.spec import Job
 
-__all__ = ["RESOLUTION", "part_mesh", "part_sdf", "signed_volume"]
+__all__ = ["RESOLUTION", "GridSDF", "part_mesh", "part_sdf", "signed_volume", "stock_mesh"]
 
 #: grid step of the part mesh [m] and spacing of the surface samples along a ruling
 RESOLUTION = 0.002
@@ -117,8 +119,11 @@ def _cut_sdf(pts: FloatArray, nrm: FloatArray, world: FloatArray, shape: tuple[i
     from scipy import ndimage
     from scipy.spatial import cKDTree
 
-    dist, k = cKDTree(pts).query(world, distance_upper_bound=band)
-    near = np.isfinite(dist)
+    near = np.zeros(len(world), dtype=bool)
+    k = np.zeros(len(world), dtype=np.intp)
+    ask = np.flatnonzero(_within_reach(pts, world, shape, band))
+    dist, k[ask] = cKDTree(pts).query(world[ask], distance_upper_bound=band, workers=-1)
+    near[ask] = np.isfinite(dist)
     d = np.full(len(world), np.nan)
     kn = k[near]
     d[near] = np.einsum("ij,ij->i", world[near] - pts[kn], nrm[kn])
@@ -134,6 +139,34 @@ def _cut_sdf(pts: FloatArray, nrm: FloatArray, world: FloatArray, shape: tuple[i
     if domain is not None and step is not None:
         out = _settle_sides(out, np.where(far, np.inf, np.abs(d)), domain, step)
     return out
+
+
+def _within_reach(pts: FloatArray, world: FloatArray, shape: tuple[int, ...], band: float
+                  ) -> np.ndarray:  # fmt: skip
+    """Which grid points (N,) may lie within ``band`` of a sample of ``pts`` (P, 3): the
+    grid cells holding a sample (clipped to the grid), grown by ``band`` in steps and one
+    more.  Only these are asked of the k-d tree: the others are farther than ``band``
+    from every sample and would come back without a neighbour, so the answer is the
+    same in a fraction of the time.  Every point when ``world`` is not one regular grid
+    of ``shape`` with square corners."""
+    from scipy import ndimage
+
+    every = np.ones(len(world), dtype=bool)
+    if len(shape) != 3 or min(shape) < 2 or len(pts) == 0:
+        return every
+    g = world.reshape(*shape, 3)
+    origin = g[0, 0, 0]
+    axes = np.stack([g[1, 0, 0], g[0, 1, 0], g[0, 0, 1]]) - origin  # (3, 3): a step each
+    steps = np.linalg.norm(axes, axis=1)
+    unit = axes / np.maximum(steps, 1e-300)[:, None]
+    if steps.min() <= 0.0 or np.abs(unit @ unit.T - np.eye(3)).max() > 1e-9:
+        return every
+    top = np.array(shape) - 1
+    cell = np.clip(np.floor((pts - origin) @ (unit.T / steps)), 0, top).astype(np.intp)
+    seeds = np.zeros(shape, dtype=np.uint8)
+    seeds[cell[:, 0], cell[:, 1], cell[:, 2]] = 1
+    grow = int(np.ceil(band / steps.min())) + 1
+    return ndimage.maximum_filter(seeds, size=2 * grow + 1, mode="constant").ravel() > 0
 
 
 #: a grid point is in the surface's wall within this fraction of the grid step of it
@@ -217,16 +250,34 @@ def part_mesh(
     cut names its kept side or nothing of the stock is kept."""
     if all(c.keep is None for c in job.cuts):
         return None
+    return stock_mesh(job.stock, resolution,
+                      lambda world, shape, h: part_sdf(job, passes, world, shape, 3.0 * h))
+
+
+#: a signed distance on a grid: ``sdf(world (N, 3) [m], shape, step [m]) -> (shape)``
+GridSDF = Callable[[FloatArray, tuple[int, ...], float], FloatArray]
+
+
+def stock_mesh(stock: Box, resolution: float, sdf: GridSDF) -> Mesh | None:
+    """The zero level of ``sdf`` (negative inside) as a closed triangle mesh in the base
+    frame [m], marched on a grid over ``stock`` and 2 steps beyond it; None when ``sdf``
+    is nowhere negative.
+
+    The grid step is ``resolution`` [m], grown so that the grid holds at most
+    ``MAX_POINTS``; the distances are kept off zero at grid points
+    (:func:`_off_grid_points`), marched by scikit-image's marching cubes (Lewiner) and
+    the faces turned to wind counter-clockwise seen from outside.  The planner's part
+    (:func:`part_mesh`) and the carved block (:mod:`ruledrobot.carve.carved`) are both
+    this mesh of their own distance."""
     from skimage.measure import marching_cubes
 
-    stock = job.stock
     h = max(resolution, float(np.prod(stock.size + 4 * resolution) / MAX_POINTS) ** (1 / 3))
     counts = np.ceil((stock.size + 4.0 * h) / h).astype(int) + 1
     axes = [(np.arange(c) - (c - 1) / 2.0) * h for c in counts]
     X, Y, Z = np.meshgrid(*axes, indexing="ij")
     local = np.stack([X, Y, Z], axis=-1).reshape(-1, 3)
     world = local @ stock.rotation.T + stock.centre
-    f = _off_grid_points(part_sdf(job, passes, world, tuple(counts), 3.0 * h), h)
+    f = _off_grid_points(sdf(world, tuple(counts), h), h)
     if f.min() >= 0.0:
         return None
     verts, faces, _, _ = marching_cubes(f, level=0.0, spacing=(h, h, h))

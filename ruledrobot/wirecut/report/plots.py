@@ -11,6 +11,7 @@ import numpy as np
 
 from ...geometry.checks import FloatArray
 from ...io.atomic import atomic_write_bytes
+from ...io.pictures import thinned_series
 from ...robot.tool import BowTool
 from ..plan import Plan
 
@@ -93,7 +94,7 @@ def plot_plan(path: str | Path, plan: Plan, part=None) -> Path:
     ax2 = fig.add_subplot(2, 2, 2)
     _phase_bands(ax2, t, mo.labels)
     for j in range(6):
-        ax2.plot(t, mo.timed.q[:, j], label=f"q{j + 1}")
+        ax2.plot(*thinned_series(t, mo.timed.q[:, j]), label=f"q{j + 1}")
     model = plan.model
     lim = ", ".join(f"{hi:.3g}" if np.isfinite(hi) else "inf" for hi in model.upper)
     ax2.set_title(f"joint positions (rad); limits ± [{lim}]", fontsize=9)
@@ -111,8 +112,9 @@ def plot_plan(path: str | Path, plan: Plan, part=None) -> Path:
     ax3.set_title("feed of the wire inside the stock (mm/s), measured on the samples",
                   fontsize=9)  # fmt: skip
     ax3.set_xlabel("t (s)")
+    present = set(np.unique(mo.labels).astype(str))  # once, not once per phase colour
     handles = [Patch(color=c, alpha=0.3, label=n) for n, c in PHASE_COLOURS.items()
-               if n in set(mo.labels.astype(str))]  # fmt: skip
+               if n in present]  # fmt: skip
     leg = ax3.legend(fontsize=7, loc="lower right")
     ax3.add_artist(leg)
     ax3.legend(handles=handles, fontsize=7, loc="upper right", title="phase")

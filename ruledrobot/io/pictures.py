@@ -1,0 +1,54 @@
+"""Time series thinned for a picture: what a line plot of ``N`` samples draws in a few
+hundred pixel columns, in a fraction of the points (the M4 aggregation: Jugel et al.,
+"M4: a visualization-oriented time series data aggregation", PVLDB 7(10), 2014).
+
+Per bucket of consecutive samples the first, the lowest, the highest and the last are
+kept in their order; a line through them crosses every pixel the whole line crosses in a
+column as wide as the bucket.  The planner's and the playback's plots of 60,000-sample
+motions draw 8,000 points a series instead, and the same picture.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..geometry.checks import FloatArray
+
+__all__ = ["BUCKETS", "thinned_series"]
+
+#: buckets per series: more than two per pixel column of the widest plot (14 in at 100 dpi)
+BUCKETS = 3000
+
+
+def thinned_series(t: FloatArray, y: FloatArray, buckets: int = BUCKETS
+                   ) -> tuple[FloatArray, FloatArray]:  # fmt: skip
+    """``t`` (N,) and ``y`` (N,) or (N, J) thinned to at most ``4 * buckets`` samples per
+    series (module doc), for ``ax.plot(*thinned_series(t, y))``.
+
+    Returns
+    -------
+    t_kept, y_kept : ndarray
+        (M,) and (M,) for a single series; (M, J) each for ``J`` series (each column its
+        own samples).  The input itself when it is short enough or holds a NaN or an
+        infinity (a gap drawn as a gap).
+    """
+    t = np.asarray(t, dtype=float)
+    y = np.asarray(y, dtype=float)
+    n = len(t)
+    size = -(-n // buckets)  # samples per bucket, rounded up
+    if size < 5 or not np.isfinite(y).all():
+        return t, y
+    one = y.ndim == 1
+    Y = y[:, None] if one else y
+    m = -(-n // size)  # buckets; the last one filled up with the last sample
+    idx = np.minimum(np.arange(m * size), n - 1).reshape(m, size)
+    V = Y[idx]  # (m, size, J)
+    first = idx[:, :1, None] + np.zeros((1, 1, Y.shape[1]), dtype=np.intp)
+    last = idx[:, -1:, None] + np.zeros((1, 1, Y.shape[1]), dtype=np.intp)
+    low = idx[:, 0, None, None] + np.argmin(V, axis=1)[:, None, :]
+    high = idx[:, 0, None, None] + np.argmax(V, axis=1)[:, None, :]
+    keep = np.sort(np.concatenate([first, low, high, last], axis=1), axis=1)  # (m, 4, J)
+    keep = keep.reshape(m * 4, -1)
+    cols = np.arange(Y.shape[1])[None, :]
+    tk, yk = t[keep], Y[keep, cols]
+    return (tk[:, 0], yk[:, 0]) if one else (tk, yk)
