@@ -2,7 +2,8 @@
 
 ``x^2 + z^2 = a^2 (1 + y^2 / c^2)`` for ``|y| <= length / 2`` (the axis along y, across the
 arm's reach, as the part demo's plug), capped by flat ends that are faces of the block:
-a 200 x 200 x 150 mm foam block in front of a UR5e.  :func:`write_demo_cell` writes the
+a 200 x 200 x 150 mm foam block in front of a UR5e (the part demo's cell,
+:data:`ruledrobot.io.demo_cell.DEMO_CELL`).  :func:`write_demo_cell` writes the
 part as a binary STL in millimetres and a cell file naming it; ``ruledrobot carve`` then
 finds the column's rulings from the mesh alone and cuts them as one closed loop.
 """
@@ -15,11 +16,13 @@ import numpy as np
 
 from ..geometry.checks import FloatArray
 from ..io.atomic import atomic_write_text
+from ..io.demo_cell import DEMO_CELL
 from ..io.mesh import write_stl
 
 __all__ = ["CELL", "column_mesh", "write_demo_cell"]
 
-CELL = """\
+CELL = (
+    """\
 # ruledrobot demo --carve: a hyperboloid column (a = {a_mm:g} mm, c = {c_mm:g} mm, {l_mm:g} mm
 # long, axis along y) carved from the demo's block.  Units: m, rad, s.
 # Carve it:  ruledrobot carve cell.toml --out DIR   then plan DIR/job.toml
@@ -31,22 +34,14 @@ pose = [0.5, 0.0, 0.3, 0.0, 0.0, 0.0]
 tolerance = 0.0005
 rough_cuts = 4
 
-[stock]
-centre = [0.5, 0.0, 0.3]
-size = [0.2, 0.2, 0.15]
-
-[robot]
-model = "ur5e"
-
-[tool]
-wire_start = [-0.2, 0.0, 0.25]
-wire_end = [0.2, 0.0, 0.25]
-clearance = 0.02
-
+"""
+    + DEMO_CELL
+    + """
 [cut]
 feed_speed = 0.012
 approach_speed = 0.6
 """
+)
 
 
 def column_mesh(a: float = 0.06, c: float = 0.3, length: float = 0.2, around: int = 64,

@@ -1,7 +1,10 @@
 """The built-in demo jobs: one cut (a hyperbolic paraboloid through a foam block in front of a
-UR5e) and a part (three cuts, the last one all the way round, kerf compensated, heat switched)."""
+UR5e) and a part (three cuts, the last one all the way round, kerf compensated, heat switched)
+in the cell the carve demo shares (:data:`ruledrobot.io.demo_cell.DEMO_CELL`)."""
 
 from __future__ import annotations
+
+from ...io.demo_cell import DEMO_CELL
 
 DEMO_JOB = """\
 # ruledrobot demo job: a hyperbolic paraboloid (z = x y / c) cut through a foam
@@ -42,7 +45,8 @@ approach_speed = 0.3
 kerf = 0.0008
 """
 
-PART_JOB = """\
+PART_JOB = (
+    """\
 # ruledrobot part demo: a foam block trimmed on top by a saddle and on one side by a
 # twisted face, then a plug cut all the way round a horizontal axis -- the part is the
 # plug, a hyperboloid band with a saddle top and a flat side.  Every cut keeps the
@@ -50,17 +54,9 @@ PART_JOB = """\
 # digital output 0, with a one-second pre-heat before each cut.  Units: m, rad, s.
 # Copy this file, edit it, and run:  ruledrobot plan my_part.toml --out my_part
 
-[stock]
-centre = [0.5, 0.0, 0.3]
-size = [0.2, 0.2, 0.15]
-
-[robot]
-model = "ur5e"
-
-[tool]
-wire_start = [-0.2, 0.0, 0.25]
-wire_end = [0.2, 0.0, 0.25]
-clearance = 0.02
+"""
+    + DEMO_CELL
+    + """\
 mass = 1.0
 heat = { output = "standard:0", preheat = 1.0 }
 
@@ -102,3 +98,4 @@ rulings = 16
 pose = [0.5, 0.0, 0.3, 1.5707963267948966, 0.0, 0.0]     # axis along y
 steps = 5
 """
+)
