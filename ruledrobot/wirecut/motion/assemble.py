@@ -203,10 +203,13 @@ def measure_wire(
 
 
 def _chord_in_flange(bow: BowTool, wire: WireInStock) -> FloatArray:
-    """(M, 2, 3) the chord ends as points of the wire in the flange frame (0 outside)."""
+    """(M, 2, 3) the chord ends as points of the wire in the flange frame (0 outside).
+
+    The fractions are NaN outside the stock: the points there are zeroed, not the
+    fractions (a fraction 0 is the wire's start point, ``W`` origin ``- L / 2``)."""
     W = bow.wire_frame()
-    f = np.nan_to_num(wire.fractions()) - 0.5
-    return W[:3, 3] + f[:, :, None] * bow.wire_length * W[:3, 2]
+    ends = W[:3, 3] + (wire.fractions() - 0.5)[:, :, None] * bow.wire_length * W[:3, 2]
+    return np.where(wire.inside[:, None, None], ends, 0.0)
 
 
 def _pass_timing(

@@ -112,9 +112,6 @@ def test_the_chord_ends_lie_on_the_wire_and_the_blocks_faces(assembled):
     assert (on_face | at_wire_end).all()
 
 
-@pytest.mark.xfail(strict=True, reason="Motion.ends and _chord_in_flange say '0 outside the "
-                   "stock'; outside, the ends are the wire's start point (NaN fractions -> 0, "
-                   "minus 0.5: the wire end at -L/2), not zeros")  # fmt: skip
 def test_the_chord_ends_are_zero_outside_the_stock_as_documented(assembled):
     _, _, _, mo = assembled
     np.testing.assert_array_equal(mo.ends[~mo.in_stock], 0.0)
