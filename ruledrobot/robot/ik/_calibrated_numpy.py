@@ -312,29 +312,23 @@ def _take(part, keep):
     return tuple(v[keep] if isinstance(v, np.ndarray) else v for v in part)
 
 
-def refine_solutions(
-    d: FloatArray,
-    a: FloatArray,
-    alpha: FloatArray,
-    offset: FloatArray,
+def refine(
+    table: tuple[FloatArray, FloatArray, FloatArray, FloatArray],
     flange: FloatArray,
     seeds: FloatArray,
-    seed_offset: FloatArray,
+    shift: FloatArray,
     *,
     tol: float,
     max_iter: int,
 ) -> tuple[FloatArray, np.ndarray, FloatArray, np.ndarray]:
-    """Refine seeds (n, 8, 6) (NaN rows = none) on a calibrated DH chain.
+    """:func:`calibrated.refine_solutions` in numpy (its inputs and results).
 
-    ``seeds`` are DH angles of a table with offsets ``seed_offset`` (the nominal one:
-    joint positions ``seeds - seed_offset``); ``d, a, alpha, offset`` the calibrated
-    table; ``flange`` (n, 4, 4) the flange poses in the robot base frame.  Returns joint
-    positions (n, 8, 6) in (-pi, pi] (NaN where not converged), converged (n, 8),
-    residual (n, 8) and iterations (n, 8).
+    ``table`` the calibrated DH table ``(d, a, alpha, offset)`` (6,) each [m, m, rad, rad];
+    ``shift`` (6,) [rad] the calibrated offsets minus those of the seeds' table, turning
+    the seeds (n, 8, 6) into DH angles of the calibrated table.
     """
     n = flange.shape[0]
-    ch = _Chain(d, a, alpha, offset)
-    shift = ch.offset - np.asarray(seed_offset, dtype=np.float64)
+    ch = _Chain(*table)
     flat_seed = seeds.reshape(n * 8, 6)
     pairs = np.flatnonzero(~np.isnan(flat_seed[:, 0]))
     theta = np.full((n * 8, 6), np.nan)

@@ -242,17 +242,16 @@ def refine_solutions(
     (same iteration and rules) as :func:`uses_kernel` says.
     """
     n = flange.shape[0]
+    off = np.asarray(offset, dtype=np.float64)
+    shift = off - np.asarray(seed_offset, dtype=np.float64)
     if not uses_kernel(n):
         from . import _calibrated_numpy
 
-        return _calibrated_numpy.refine_solutions(
-            d, a, alpha, offset, flange, seeds, seed_offset, tol=tol, max_iter=max_iter
-        )
+        table = (d, a, alpha, off)
+        return _calibrated_numpy.refine(table, flange, seeds, shift, tol=tol, max_iter=max_iter)
     from . import _calibrated_kernel as _kernel  # numba
 
     ch = np.array([d, a, np.cos(alpha), np.sin(alpha)], dtype=np.float64)
-    off = np.asarray(offset, dtype=np.float64)
-    shift = off - np.asarray(seed_offset, dtype=np.float64)
     theta = np.empty((n, 8, 6))
     conv = np.empty((n, 8), dtype=bool)
     res = np.empty((n, 8))
