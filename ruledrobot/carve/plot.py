@@ -9,6 +9,7 @@ import numpy as np
 
 from ..geometry.box import Box
 from ..io.atomic import atomic_open
+from ..io.axes3d import cube_axes
 from .measure import chord_samples
 from .plan_cuts import CutPlan
 from .readers import PartMesh
@@ -27,15 +28,7 @@ def _mesh(ax, vertices, faces, color, alpha) -> None:
 
 
 def _frame(ax, stock: Box, title: str) -> None:
-    c = stock.centre * 1e3
-    r = 0.5 * float(np.linalg.norm(stock.size)) * 1e3
-    ax.set_xlim(c[0] - r, c[0] + r)
-    ax.set_ylim(c[1] - r, c[1] + r)
-    ax.set_zlim(c[2] - r, c[2] + r)
-    ax.set_box_aspect((1, 1, 1))
-    ax.set_xlabel("x mm")
-    ax.set_ylabel("y mm")
-    ax.set_zlabel("z mm")
+    cube_axes(ax, stock.centre * 1e3, 0.5 * float(np.linalg.norm(stock.size)) * 1e3, "mm")
     ax.set_title(title, fontsize=9)
 
 

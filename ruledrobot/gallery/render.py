@@ -7,6 +7,7 @@ from typing import Any
 
 import numpy as np
 
+from ..io.axes3d import cube_axes
 from .scene import _Scene
 
 # --------------------------------------------------------------------------
@@ -43,13 +44,7 @@ def _render(scene: _Scene, checks: list[dict[str, Any]]) -> bytes:
     allpts = np.concatenate(bounds)
     lo, hi = allpts.min(axis=0), allpts.max(axis=0)
     mid, half = 0.5 * (lo + hi), 0.5 * float((hi - lo).max()) or 1.0
-    ax.set_xlim(mid[0] - half, mid[0] + half)
-    ax.set_ylim(mid[1] - half, mid[1] + half)
-    ax.set_zlim(mid[2] - half, mid[2] + half)
-    ax.set_box_aspect((1.0, 1.0, 1.0))
-    ax.set_xlabel("x (m)")
-    ax.set_ylabel("y (m)")
-    ax.set_zlabel("z (m)")
+    cube_axes(ax, mid, half, "(m)")
     ax.legend(loc="upper left", fontsize=7)
     ok = all(c["passed"] for c in checks)
     fig.suptitle(scene.title, fontsize=9)
