@@ -38,7 +38,12 @@ in numpy (:mod:`ruledrobot.robot.ik._calibrated_numpy`, see :func:`uses_kernel`)
    converge within ``max_iter`` iterations, or stall (8 iterations without reducing
    their best residual by 30 %), are NaN rows flagged in :class:`CalibratedIKSolutions`.
    A branch keeps its identity: the iteration starts at the nominal solution of the
-   branch and moves by about the calibration's size.
+   branch and moves by about the calibration's size, more next to a singularity (the
+   calibration moves it: a UR3 seed 3.4 mm outside the nominal shoulder cylinder can
+   end next to the calibrated one, 0.24 rad away).  There the nominal flags of the
+   solution may differ from the branch's; the branch is the one the calibration, grown
+   from zero, carries the seed to without crossing a singularity, so ``det J`` keeps
+   its sign.
 
 Sines and cosines come from a branch-free polynomial (Cody-Waite reduction by pi/2,
 the fdlibm kernels; within 1 ulp of libm here), so that the lane loops vectorise.
