@@ -21,7 +21,11 @@ random angles in [-10, 10]).
 
 Imported by the first calibrated IK of more than ``calibrated_ik.NUMPY_POSES`` poses (or
 ``calibrated_ik.load_kernels``), so that ``import ruledrobot`` does not load numba;
-compiled once and cached next to this file (``cache=True``).
+compiled once and cached next to this file (``cache=True``).  The cache is checked against
+this file alone (numba does not see a change in a function or a global of another module
+it compiled in), so the kernels import nothing of the project: the closed form's formulas
+and tolerances are ``analytic_ik``'s written again in scalar code, and
+``tests/robot/test_calibrated_kernel.py`` holds the two to the same seeds.
 """
 
 from __future__ import annotations
