@@ -8,7 +8,8 @@ their tables): the transform from frame ``i-1`` to frame ``i`` is ::
 and the flange pose in the robot base frame is ``A_1 A_2 ... A_n``.  Joint ``i``
 turns about the z axis of frame ``i-1``.
 
-Both functions work on *component arrays*: the three axes and the origin of
+:class:`DHChain` (the table, the base and the tool) gives the poses, the Jacobian and
+the skeleton of joint positions.  They work on *component arrays*: the three axes and the origin of
 the running frame are kept as 12 arrays of shape ``(n,)`` and updated in
 closed form per joint (a loop over the joints, never over poses), which is
 cheaper than ``n`` batched 4x4 matrix products and keeps every intermediate
@@ -16,6 +17,9 @@ contiguous.  Long batches are processed in cache-sized chunks.
 """
 
 from __future__ import annotations
+
+from collections.abc import Iterator
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -123,109 +127,95 @@ def _walk(
     return frame
 
 
-def dh_fk(
-    q: FloatArray,
-    d: FloatArray,
-    a: FloatArray,
-    alpha: FloatArray,
-    theta_offset: FloatArray,
-    base: FloatArray | None = None,
-    tool: FloatArray | None = None,
-) -> FloatArray:
-    """Flange (or TCP) poses of a standard-DH chain.
-
-    Parameters
-    ----------
-    q : (n, J) joint positions [rad] (already validated, J = number of joints).
-    d, a, alpha, theta_offset : (J,) DH parameters [m, m, rad, rad].
-    base : optional 4x4 pose of the robot base in the world frame.
-    tool : optional 4x4 pose of the TCP in the flange frame.
-
-    Returns
-    -------
-    (n, 4, 4) poses ``base @ A_1(q_1) ... A_J(q_J) @ tool``.
-    """
-    n = q.shape[0]
-    out = np.empty((n, 4, 4))
-    ct, st, twists, start = _chain(q, alpha, theta_offset, base)
-    for lo in range(0, n, _CHUNK):
-        hi = min(lo + _CHUNK, n)
-        frame = _walk(start, ct, st, d, a, twists, slice(lo, hi))
-        if tool is not None:
-            frame = _apply_tool(frame, tool)
-        _write_pose(_broadcast(frame, hi - lo), out[lo:hi])
-    return out
-
-
-def dh_skeleton(
-    q: FloatArray,
-    d: FloatArray,
-    a: FloatArray,
-    alpha: FloatArray,
-    theta_offset: FloatArray,
-    base: FloatArray | None = None,
-) -> FloatArray:
-    """The DH skeleton of configurations ``q`` (n, J): points (n, 2J + 1, 3) [m].
-
-    Point 0 is the base origin; joint ``i`` adds the point ``d_i`` along the previous
-    z axis and then its frame origin (``a_i`` along x_i), with the joint step of
-    :func:`dh_fk`.
-    """
-    n = q.shape[0]
-    ct, st, twists, start = _chain(q, alpha, theta_offset, base)
-    frames: list[Frame] = []
-    frames.append(_walk(start, ct, st, d, a, twists, before=frames))  # J + 1 frames
-    pts = [start[3]]
-    for j in range(len(twists)):
-        p, z = frames[j][3], frames[j][2]
-        pts.append([p[k] + float(d[j]) * z[k] for k in range(3)])
-        pts.append(frames[j + 1][3])
-    out = np.empty((n, len(pts), 3))
-    for i, pt in enumerate(pts):
-        for k in range(3):
-            out[:, i, k] = pt[k]
-    return out
-
-
 def _broadcast(frame: Frame, n: int) -> Frame:
     """Frame components as arrays of length n (a joint-free chain keeps floats)."""
     return tuple([np.broadcast_to(v, (n,)) for v in vec] for vec in frame)  # type: ignore[return-value]
 
 
-def dh_jacobian(
-    q: FloatArray,
-    d: FloatArray,
-    a: FloatArray,
-    alpha: FloatArray,
-    theta_offset: FloatArray,
-    base: FloatArray | None = None,
-    tool: FloatArray | None = None,
-) -> FloatArray:
-    """Geometric Jacobian at the flange/TCP, expressed in the world (base) frame.
+@dataclass(frozen=True, eq=False)
+class DHChain:
+    """A standard-DH serial chain placed in the world: its table, base and tool.
 
-    Returns ``(n, 6, J)``: rows ``[v; omega]`` (linear velocity of the TCP point
-    [m/s], then angular velocity [rad/s], both in the frame of the FK output,
-    i.e. UR's speedl order ``[xd, yd, zd, wx, wy, wz]``), column ``i`` =
-    ``[z_{i-1} x (p_tcp - p_{i-1}); z_{i-1}]`` for revolute joint ``i``.
+    Attributes
+    ----------
+    table : the DH parameters ``(d, a, alpha, theta_offset)``, (J,) each [m, m, rad, rad].
+    base : optional 4x4 pose of the robot base in the world frame (None: the identity).
+    tool : optional 4x4 pose of the TCP in the flange frame (None: the flange).
     """
-    n, J = q.shape
-    out = np.empty((n, 6, J))
-    ct, st, twists, start = _chain(q, alpha, theta_offset, base)
-    for lo in range(0, n, _CHUNK):
-        hi = min(lo + _CHUNK, n)
-        before: list[Frame] = []
-        frame = _walk(_broadcast(start, hi - lo), ct, st, d, a, twists, slice(lo, hi), before)
-        axes = [(f[2], f[3]) for f in before]  # z_{j}, p_{j} of the frame before joint j+1
-        if tool is not None:
-            frame = _apply_tool(frame, tool)
-        pe = frame[3]
-        blk = out[lo:hi]
-        for j, (z, p) in enumerate(axes):
-            rx, ry, rz = pe[0] - p[0], pe[1] - p[1], pe[2] - p[2]
-            blk[:, 0, j] = z[1] * rz - z[2] * ry
-            blk[:, 1, j] = z[2] * rx - z[0] * rz
-            blk[:, 2, j] = z[0] * ry - z[1] * rx
-            blk[:, 3, j] = z[0]
-            blk[:, 4, j] = z[1]
-            blk[:, 5, j] = z[2]
-    return out
+
+    table: tuple[FloatArray, ...]
+    base: FloatArray | None = None
+    tool: FloatArray | None = None
+
+    def fk(self, q: FloatArray) -> FloatArray:
+        """TCP poses (n, 4, 4) ``base @ A_1(q_1) ... A_J(q_J) @ tool`` of joint positions
+        ``q`` (n, J) [rad] (already validated)."""
+        n = q.shape[0]
+        out = np.empty((n, 4, 4))
+        for rows, frame, _ in self._walks(q):
+            _write_pose(_broadcast(frame, rows.stop - rows.start), out[rows])
+        return out
+
+    def jacobian(self, q: FloatArray) -> FloatArray:
+        """Geometric Jacobian (n, 6, J) at the TCP of joint positions ``q`` (n, J) [rad].
+
+        Rows ``[v; omega]`` in the world frame: linear velocity of the TCP point [m/s], then
+        angular velocity [rad/s] (UR's speedl order ``[xd, yd, zd, wx, wy, wz]``); column
+        ``i`` = ``[z_{i-1} x (p_tcp - p_{i-1}); z_{i-1}]`` for revolute joint ``i``.
+        """
+        n, J = q.shape
+        out = np.empty((n, 6, J))
+        for rows, frame, before in self._walks(q, axes=True):
+            pe = frame[3]
+            blk = out[rows]
+            for j, f in enumerate(before):  # z_{j}, p_{j} of the frame before joint j+1
+                z, p = f[2], f[3]
+                rx, ry, rz = pe[0] - p[0], pe[1] - p[1], pe[2] - p[2]
+                blk[:, 0, j] = z[1] * rz - z[2] * ry
+                blk[:, 1, j] = z[2] * rx - z[0] * rz
+                blk[:, 2, j] = z[0] * ry - z[1] * rx
+                blk[:, 3, j] = z[0]
+                blk[:, 4, j] = z[1]
+                blk[:, 5, j] = z[2]
+        return out
+
+    def skeleton(self, q: FloatArray) -> FloatArray:
+        """The DH skeleton of configurations ``q`` (n, J): points (n, 2J + 1, 3) [m].
+
+        Point 0 is the base origin; joint ``i`` adds the point ``d_i`` along the previous
+        z axis and then its frame origin (``a_i`` along x_i), with the joint step of
+        :meth:`fk`.  The tool plays no part.
+        """
+        n = q.shape[0]
+        d, a, alpha, theta_offset = self.table
+        ct, st, twists, start = _chain(q, alpha, theta_offset, self.base)
+        frames: list[Frame] = []
+        frames.append(_walk(start, ct, st, d, a, twists, before=frames))  # J + 1 frames
+        pts = [start[3]]
+        for j in range(len(twists)):
+            p, z = frames[j][3], frames[j][2]
+            pts.append([p[k] + float(d[j]) * z[k] for k in range(3)])
+            pts.append(frames[j + 1][3])
+        out = np.empty((n, len(pts), 3))
+        for i, pt in enumerate(pts):
+            for k in range(3):
+                out[:, i, k] = pt[k]
+        return out
+
+    def _walks(
+        self, q: FloatArray, axes: bool = False
+    ) -> Iterator[tuple[slice, Frame, list[Frame]]]:
+        """Per chunk of poses: its rows, the TCP frame and (with ``axes``) the frame before
+        each joint (else an empty list)."""
+        n = q.shape[0]
+        d, a, alpha, theta_offset = self.table
+        ct, st, twists, start = _chain(q, alpha, theta_offset, self.base)
+        for lo in range(0, n, _CHUNK):
+            hi = min(lo + _CHUNK, n)
+            rows = slice(lo, hi)
+            before: list[Frame] = []
+            first = _broadcast(start, hi - lo) if axes else start
+            frame = _walk(first, ct, st, d, a, twists, rows, before if axes else None)
+            if self.tool is not None:
+                frame = _apply_tool(frame, self.tool)
+            yield rows, frame, before

@@ -43,7 +43,7 @@ from .._checks import (
 from ..ik import analytic as _ik
 from .calibration import Calibration
 from .inverse import InverseKinematics
-from .kinematics import dh_fk, dh_jacobian, dh_skeleton
+from .kinematics import DHChain
 from .ur_tables import nominal_dh
 
 #: Default joint acceleration limit [rad/s^2].  UR publishes none; this is the
@@ -383,6 +383,14 @@ class RobotModel(InverseKinematics):
     def _joints(self, q: ArrayLike, name: str = "q") -> FloatArray:
         return as_array(q, name, (self.n_joints,))
 
+    def _chain(self, table: tuple[FloatArray, ...] | None = None) -> DHChain:
+        """The arm's chain with its base and tool; ``table`` (d, a, alpha, offset) in
+        place of its own (the nominal one of a calibrated arm)."""
+        own = (self.d, self.a, self.alpha, self.theta_offset)
+        base = None if self._base_inv is None else self.base
+        tool = None if self._tool_inv is None else self.tool
+        return DHChain(own if table is None else table, base, tool)
+
     def fk(self, q: ArrayLike) -> FloatArray:
         """TCP poses in the world frame: joints (..., J) [rad] -> (..., 4, 4).
 
@@ -390,12 +398,8 @@ class RobotModel(InverseKinematics):
         Vectorised closed form: a loop over the joints, none over poses.
         """
         q = self._joints(q)
-        shape = q.shape[:-1]
-        flat = q.reshape(-1, self.n_joints)
-        base = None if self._base_inv is None else self.base
-        tool = None if self._tool_inv is None else self.tool
-        T = dh_fk(flat, self.d, self.a, self.alpha, self.theta_offset, base, tool)
-        return T.reshape(*shape, 4, 4)
+        T = self._chain().fk(q.reshape(-1, self.n_joints))
+        return T.reshape(*q.shape[:-1], 4, 4)
 
     def jacobian(self, q: ArrayLike) -> FloatArray:
         """Geometric Jacobian (..., 6, J) at the TCP, in the world frame.
@@ -404,12 +408,8 @@ class RobotModel(InverseKinematics):
         [rad/s] (UR speedl order), ``[v; omega] = J(q) @ qdot``.
         """
         q = self._joints(q)
-        shape = q.shape[:-1]
-        flat = q.reshape(-1, self.n_joints)
-        base = None if self._base_inv is None else self.base
-        tool = None if self._tool_inv is None else self.tool
-        Jm = dh_jacobian(flat, self.d, self.a, self.alpha, self.theta_offset, base, tool)
-        return Jm.reshape(*shape, 6, self.n_joints)
+        Jm = self._chain().jacobian(q.reshape(-1, self.n_joints))
+        return Jm.reshape(*q.shape[:-1], 6, self.n_joints)
 
     def link_points(self, q: ArrayLike) -> FloatArray:
         """The DH skeleton of configurations (..., J) in the world frame: (..., 2J + 1, 3).
@@ -423,16 +423,14 @@ class RobotModel(InverseKinematics):
         lies within millimetres of the real arm.
         """
         q = self._joints(q)
-        shape = q.shape[:-1]
-        base = None if self._base_inv is None else self.base
-        d, a, alpha, offset = self._seed_dh
-        pts = dh_skeleton(q.reshape(-1, self.n_joints), d, a, alpha, offset, base)
-        return pts.reshape(*shape, 2 * self.n_joints + 1, 3)
+        pts = self._chain(self._seed_dh).skeleton(q.reshape(-1, self.n_joints))
+        return pts.reshape(*q.shape[:-1], 2 * self.n_joints + 1, 3)
 
     def within_limits(self, q: ArrayLike, tol: float = 0.0) -> np.ndarray:
         """(...) bool: every joint of ``q`` (..., J) inside ``[lower - tol, upper + tol]``."""
         q = self._joints(q)
         return np.all((q >= self.lower - tol) & (q <= self.upper + tol), axis=-1)
+
 
 def _check_calibration(model: RobotModel) -> tuple[tuple[FloatArray, ...], bool]:
     """The nominal table (d, a, alpha, offset) of a calibrated model and whether its IK
