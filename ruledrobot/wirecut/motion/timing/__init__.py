@@ -56,11 +56,12 @@ Method of :func:`time_path` (details and measurements in ``docs/timing.md``):
 ``safety`` scales the joint limits only. The feed bound is not scaled: a constant
 feed equal to ``feed_speed`` is the goal of the cut.
 
-Modules, one job each (the way toppra splits itself): ``limits`` (tolerances),
-``result`` (:class:`TimedPath`), ``checks`` (input checks), ``report`` (the
-finite-difference verification), ``problem`` (grid and constraint rows),
-``solvers`` (toppra and the reachability fallback), ``sampling``, ``path``
-(:func:`time_path`), ``moves`` (:func:`joint_move`, :func:`concatenate`).
+Modules, one job each (the way toppra splits itself): ``tolerances`` (tolerances
+and limits), ``result`` (:class:`TimedPath`), ``inputs`` (the argument checks every
+timing function shares), ``report`` (the finite-difference verification),
+``problem`` (grid and constraint rows), ``solvers`` (toppra and the reachability
+fallback), ``sampling``, ``time_law`` (:func:`time_path`), ``moves``
+(:func:`joint_move`, :func:`concatenate`).
 """
 
 from __future__ import annotations
