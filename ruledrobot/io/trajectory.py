@@ -305,12 +305,20 @@ def meta_from_dict(doc: Any, where: str = "trajectory metadata") -> TrajectoryMe
         raise ValueError(f"{where}: {exc}") from None
 
 
+#: rows formatted by one ``%`` operation (a fifth faster than a row at a time)
+_CSV_BLOCK = 256
+
+
 def csv_text(traj: Trajectory) -> str:
     """The CSV of ``traj``: the header line, then one row per sample (``%.10g`` each,
-    the text ``numpy.savetxt`` writes, formatted a whole row at a time)."""
+    the text ``numpy.savetxt`` writes, formatted ``_CSV_BLOCK`` rows at a time)."""
     data = np.concatenate([traj.t[:, None], traj.q, traj.tcp], axis=1)
     row = ",".join(["%.10g"] * data.shape[1]) + "\n"
-    return ",".join(HEADER) + "\n" + "".join(map(row.__mod__, map(tuple, data.tolist())))
+    full = len(data) - len(data) % _CSV_BLOCK
+    blocks = data[:full].reshape(-1, _CSV_BLOCK * data.shape[1]).tolist()
+    text = [(row * _CSV_BLOCK) % tuple(b) for b in blocks]
+    text.append((row * (len(data) - full)) % tuple(data[full:].ravel().tolist()))
+    return ",".join(HEADER) + "\n" + "".join(text)
 
 
 def write_trajectory(path: str | os.PathLike[str], traj: Trajectory) -> Path:

@@ -78,6 +78,26 @@ def slit_direction(frames: FloatArray, i: int, stock: Box) -> FloatArray:
     return d / np.linalg.norm(d)
 
 
+def _clear_distance(grown: Box, o: FloatArray, z: FloatArray, direction: FloatArray,
+                    batch: int = 64) -> float:  # fmt: skip
+    """The first of 0, ``SLIT_STEP``, 2 ``SLIT_STEP``, ... (summed step by step) [m] at
+    which the line through ``o - dist * direction`` along ``z`` misses ``grown``; the
+    distances are tried ``batch`` at a time (one box test each batch).  Raises past
+    10 m."""
+    start = 0.0
+    while True:
+        steps = np.full(batch, SLIT_STEP)
+        steps[0] = start
+        dist = np.cumsum(steps)  # start, start + step, ...: the sums one at a time gives
+        dist = dist[dist <= 10.0]
+        if len(dist) == 0:
+            raise ValueError("slit: the ruling does not leave the stock along the normal")
+        hit = grown.clip_lines(o - dist[:, None] * direction, np.broadcast_to(z, (len(dist), 3)))[2]
+        if not hit.all():
+            return float(dist[int(np.argmin(hit))])
+        start = float(dist[-1]) + SLIT_STEP
+
+
 def _slit(frame: FloatArray, direction: FloatArray, stock: Box, lead: float,
           turn: FloatArray | None = None) -> FloatArray:  # fmt: skip
     """Frames (K, 4, 4) from outside the stock (clear by ``lead``) to ``frame``, the
@@ -90,11 +110,7 @@ def _slit(frame: FloatArray, direction: FloatArray, stock: Box, lead: float,
     feed with them)."""
     grown = Box(stock.centre, stock.size + 2.0 * lead, stock.rotation)
     o, z = frame[:3, 3], frame[:3, 2]
-    dist = 0.0
-    while grown.clip_lines((o - dist * direction)[None], z[None])[2][0]:
-        dist += SLIT_STEP
-        if dist > 10.0:
-            raise ValueError("slit: the ruling does not leave the stock along the normal")
+    dist = _clear_distance(grown, o, z, direction)
     n = max(2, int(np.ceil(dist / SLIT_STEP)) + 1)
     out = np.repeat(frame[None], n, axis=0)
     back = np.linspace(dist, 0.0, n)  # metres before the loop
