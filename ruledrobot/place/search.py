@@ -20,6 +20,7 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -29,6 +30,9 @@ from ..wirecut.cut.passes import cut_paths
 from ..wirecut.job.spec import Job
 from ..wirecut.reach.evaluate import Evaluator
 from .regions import AS_CLAMPED, Placement, Region, Turn, transforms
+
+if TYPE_CHECKING:
+    from ..robot.arm.model import RobotModel
 
 __all__ = ["Candidate", "PlaceResult", "job_passes", "search", "verify_best"]
 
@@ -92,8 +96,8 @@ class PlaceResult:
         return 60.0 * len(self.margins) / max(self.seconds, 1e-9)
 
 
-def job_passes(job: Job, model=None, progress: Callable[[str], None] | None = None
-               ) -> list[CutPath]:  # fmt: skip
+def job_passes(job: Job, model: RobotModel | None = None,
+               progress: Callable[[str], None] | None = None) -> list[CutPath]:  # fmt: skip
     """The planner's passes of every cut of ``job`` at its placement (their frames move
     with the block; the redundancy search's choice is not used)."""
     say = progress or (lambda msg: None)

@@ -27,6 +27,7 @@ from __future__ import annotations
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -36,6 +37,9 @@ from .cad_common import MatchOptions, pair_to_rulings
 from .extras import require
 from .options import Options
 from .rulings import Rulings, rulings_from_ends
+
+if TYPE_CHECKING:
+    import rhino3dm
 
 __all__ = ["RhinoOptions", "model_units", "read_rhino"]
 
@@ -62,7 +66,9 @@ class RhinoOptions:
         return opts
 
 
-def model_units(model, rhino, where: str, given: str | None) -> tuple[str, list[str]]:
+def model_units(
+    model: rhino3dm.File3dm, rhino, where: str, given: str | None
+) -> tuple[str, list[str]]:
     """The model's length unit name and notes (see the module doc)."""
     us = model.Settings.ModelUnitSystem
     name = getattr(us, "name", str(us))

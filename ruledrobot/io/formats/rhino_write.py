@@ -14,6 +14,7 @@ from __future__ import annotations
 import os
 import tempfile
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -24,6 +25,9 @@ from ..units import unit_scale
 from .cad_common import CadWriteOptions, segments
 from .extras import require
 from .rulings import Rulings
+
+if TYPE_CHECKING:
+    import rhino3dm
 
 __all__ = ["write_mesh_3dm", "write_rhino"]
 
@@ -36,13 +40,13 @@ def _model(rhino, units: str):
     return model
 
 
-def _layer(rhino, model, name: str, color: tuple[int, int, int]):
+def _layer(rhino, model: rhino3dm.File3dm, name: str, color: tuple[int, int, int]):
     attrs = rhino.ObjectAttributes()
     attrs.LayerIndex = model.Layers.AddLayer(name, (*color, 255))
     return attrs
 
 
-def _save(model, path: str | os.PathLike[str]) -> Path:
+def _save(model: rhino3dm.File3dm, path: str | os.PathLike[str]) -> Path:
     with tempfile.TemporaryDirectory() as tmp:
         scratch = Path(tmp) / "model.3dm"
         if not model.Write(str(scratch), 7):

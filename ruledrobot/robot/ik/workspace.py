@@ -20,11 +20,16 @@ Calibrated arms use their nominal table (their reach differs by millimetres).
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 from numpy.typing import ArrayLike
 
 from .._checks import FloatArray
 from .analytic import WRIST_EPS, URGeometry
+
+if TYPE_CHECKING:
+    from ..arm.model import RobotModel
 
 __all__ = ["REACH_DIRECTIONS", "elbow_distance", "reach_excess", "reach_margin"]
 
@@ -37,7 +42,7 @@ def _annulus(g: URGeometry) -> tuple[float, float]:
     return abs(abs(g.a2) - abs(g.a3)), abs(g.a2) + abs(g.a3)
 
 
-def elbow_distance(model, q: ArrayLike) -> FloatArray:
+def elbow_distance(model: RobotModel, q: ArrayLike) -> FloatArray:
     """Distance (m) from the shoulder to the origin of DH frame 3 in the arm plane,
     ``sqrt(a2^2 + a3^2 + 2 a2 a3 cos q3)``, of joint positions ``q`` (..., 6)."""
     g = model.nominal.ur_geometry
@@ -46,7 +51,7 @@ def elbow_distance(model, q: ArrayLike) -> FloatArray:
     return np.sqrt(np.maximum(d2, 0.0))
 
 
-def reach_margin(model, q: ArrayLike) -> FloatArray:
+def reach_margin(model: RobotModel, q: ArrayLike) -> FloatArray:
     """How far (m) the elbow target of joint positions ``q`` (..., 6) lies inside the
     elbow's annulus: ``min(|a2| + |a3| - D, D - ||a2| - |a3||)`` (0 stretched or folded)."""
     lo, hi = _annulus(model.nominal.ur_geometry)
@@ -54,7 +59,9 @@ def reach_margin(model, q: ArrayLike) -> FloatArray:
     return np.minimum(hi - D, D - lo)
 
 
-def reach_excess(model, T: ArrayLike, check: bool = True) -> tuple[FloatArray, np.ndarray]:
+def reach_excess(
+    model: RobotModel, T: ArrayLike, check: bool = True
+) -> tuple[FloatArray, np.ndarray]:
     """Per IK branch, how far (m) TCP poses ``T`` (..., 4, 4, world frame) miss the arm's
     reach: ``(excess, kind)``, both (..., 8) in the branch order of ``model.ik``.
 

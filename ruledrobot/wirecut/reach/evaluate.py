@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -47,6 +48,9 @@ from .margins import (
     kinematic_margins,
     limit_levers,
 )
+
+if TYPE_CHECKING:
+    from ...robot.arm.model import RobotModel
 
 __all__ = ["TIE", "ColumnDetail", "Evaluator", "PassSample", "Scores", "constant_rolls",
            "constant_words", "details"]
@@ -118,7 +122,8 @@ class Evaluator:
     verification plans on the calibration.
     """
 
-    def __init__(self, job: Job, passes: list[CutPath], model=None, rulings: int = RULINGS,
+    def __init__(self, job: Job, passes: list[CutPath], model: RobotModel | None = None,
+                 rulings: int = RULINGS,
                  rolls: int = ROLLS, rules: Rules = DEFAULT_RULES, per_round: int = 8,
                  max_rounds: int | None = None) -> None:  # fmt: skip
         self.job = job
@@ -405,8 +410,8 @@ def details(ev: Evaluator, T: FloatArray) -> list[ColumnDetail]:
     return out
 
 
-def constant_rolls(job: Job, passes: list[CutPath], model=None, rules: Rules = DEFAULT_RULES
-                   ) -> list[ColumnDetail]:  # fmt: skip
+def constant_rolls(job: Job, passes: list[CutPath], model: RobotModel | None = None,
+                   rules: Rules = DEFAULT_RULES) -> list[ColumnDetail]:  # fmt: skip
     """The best constant roll of every pass of ``job`` where the job places its block:
     the one model's fact (docs/place.md, "One model") that a failed plan's explanation,
     ``ruledrobot reach`` and ``ruledrobot place`` all report — :class:`Evaluator` on its
@@ -420,7 +425,7 @@ def constant_rolls(job: Job, passes: list[CutPath], model=None, rules: Rules = D
 JUMP = 0.5
 
 
-def constant_words(job: Job, model, cp: CutPath, col: ColumnDetail) -> str:
+def constant_words(job: Job, model: RobotModel, cp: CutPath, col: ColumnDetail) -> str:
     """The best constant roll ``col`` of a pass in words; of a pass the planner could not
     solve (:mod:`.reach_explain`) never "serves all" without what fails between the samples (the
     planner's own check of every ruling at that roll), so that it never stands beside the

@@ -7,6 +7,8 @@ when ``[robot] base`` is the identity, the usual case).
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from ...geometry.box import Box
@@ -15,6 +17,9 @@ from ..cut.clearance import Cell
 from ..cut.wire_geometry import chords, flange_poses, slide_bounds, wire_poses
 from ..job.spec import Job, ToolSpec
 from .margins import Rules
+
+if TYPE_CHECKING:
+    from ...robot.arm.model import RobotModel
 
 __all__ = [
     "DIRECTIONS",
@@ -40,7 +45,7 @@ ROLLS = 36
 RULINGS = 48
 
 
-def job_cell(job: Job, model, rules: Rules) -> Cell:
+def job_cell(job: Job, model: RobotModel, rules: Rules) -> Cell:
     """The planner's cell of ``job`` (table top at z = 0, the planner's thresholds)."""
     return Cell.of(model, job.tool, job.stock, 0.0, rules.margin, rules.singular_min, None)
 

@@ -15,6 +15,7 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -35,6 +36,9 @@ from .grid import (
     sample_rulings,
 )
 from .margins import DEFAULT_RULES, Reason, Rules, clearance_margins, kinematic_margins
+
+if TYPE_CHECKING:
+    from ...robot.arm.model import RobotModel
 
 __all__ = ["PassMap", "ReachMap", "classify", "job_cell", "map_pass", "reach_map"]
 
@@ -207,7 +211,7 @@ def _slide_options(F: FloatArray, slide: FloatArray, stock, tool: ToolSpec, n: i
 
 def reach_map(
     job: Job,
-    model=None,
+    model: RobotModel | None = None,
     rulings: int = 240,
     rolls: int = 72,
     rules: Rules = DEFAULT_RULES,

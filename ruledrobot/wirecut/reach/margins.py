@@ -40,6 +40,7 @@ from __future__ import annotations
 import dataclasses
 from dataclasses import dataclass
 from enum import IntEnum
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -47,6 +48,9 @@ from ...geometry.angles import wrap_angle
 from ...geometry.checks import FloatArray
 from ...robot.ik.workspace import reach_excess, reach_margin
 from ..cut.clearance import Cell, clearance
+
+if TYPE_CHECKING:
+    from ...robot.arm.model import RobotModel
 
 __all__ = [
     "DEFAULT_RULES",
@@ -128,7 +132,7 @@ class Rules:
 DEFAULT_RULES = Rules()
 
 
-def limit_levers(model) -> FloatArray:
+def limit_levers(model: RobotModel) -> FloatArray:
     """Metres per radian (6,) that turn each joint's distance to its limit into a length:
     ``|a2| + |a3|`` for joints 1-2, ``|a3|`` for the elbow, ``d5 + d6`` for the wrists."""
     g = model.nominal.ur_geometry
@@ -136,7 +140,9 @@ def limit_levers(model) -> FloatArray:
     return np.array([arm, arm, fore, wrist, wrist, wrist])
 
 
-def joint_limit_margin(model, q: FloatArray, levers: FloatArray | None = None) -> FloatArray:
+def joint_limit_margin(
+    model: RobotModel, q: FloatArray, levers: FloatArray | None = None
+) -> FloatArray:
     """Distance (...) of joint positions ``q`` (..., 6) from the nearest joint limit, for
     the best whole-turn representative of each joint (negative: no representative fits):
     radians, or metres with ``levers`` (6,) m/rad (:func:`limit_levers`).
@@ -156,7 +162,7 @@ def joint_limit_margin(model, q: FloatArray, levers: FloatArray | None = None) -
 
 
 def kinematic_margins(
-    model, q: FloatArray, P: FloatArray, rules: Rules
+    model: RobotModel, q: FloatArray, P: FloatArray, rules: Rules
 ) -> tuple[FloatArray, np.ndarray]:
     """Margins (m) and reasons of every IK branch before the clearance rules.
 
