@@ -20,7 +20,17 @@ from ...robot.arm.shape import arm_capsules
 from ...robot.tool import BowTool
 from ..job.spec import ToolSpec
 
-__all__ = ["Cell", "clearance"]
+__all__ = ["ARM_STOCK", "ARM_TABLE", "BOW_ARM", "BOW_STOCK", "BOW_TABLE", "RULES", "Cell",
+           "clearance"]
+
+#: the clearance rules by name: the keys of :func:`clearance`'s answer, in its order
+#: (the reach map's reasons and the placement search read these names)
+BOW_STOCK = "bow hits the stock"
+ARM_STOCK = "arm hits the stock"
+BOW_ARM = "bow or wire hits the arm"
+BOW_TABLE = "bow below the table"
+ARM_TABLE = "arm below the table"
+RULES = (BOW_STOCK, ARM_STOCK, BOW_ARM, BOW_TABLE, ARM_TABLE)
 
 
 #: link bodies checked against the bow and the wire: the upper arm, the forearm and
@@ -102,11 +112,11 @@ def clearance(cell: Cell, q: FloatArray, P: FloatArray) -> dict[str, np.ndarray]
     hits = stock.segment_hits(np.concatenate(seg_a, axis=1), np.concatenate(seg_b, axis=1),
                               np.concatenate(grow)[:, None])  # (n, segments)  # fmt: skip
     out = {
-        "bow hits the stock": hits[:, : hits.shape[1] - S].any(axis=1),
-        "arm hits the stock": hits[:, hits.shape[1] - S :].any(axis=1),
-        "bow or wire hits the arm": np.zeros(n, bool),
-        "bow below the table": np.zeros(n, bool),
-        "arm below the table": np.zeros(n, bool),
+        BOW_STOCK: hits[:, : hits.shape[1] - S].any(axis=1),
+        ARM_STOCK: hits[:, hits.shape[1] - S :].any(axis=1),
+        BOW_ARM: np.zeros(n, bool),
+        BOW_TABLE: np.zeros(n, bool),
+        ARM_TABLE: np.zeros(n, bool),
     }
     near = np.isin(body, _BODIES_NEAR_BOW)
     if near.any():  # the capsules of the links near the bow against its rods and wire
@@ -114,12 +124,12 @@ def clearance(cell: Cell, q: FloatArray, P: FloatArray) -> dict[str, np.ndarray]
         a, b = e[:, :, None, 0], e[:, :, None, 1]  # (n, K, 1, 3)
         dist = segment_distance(a, b, w[:, None, :, 0], w[:, None, :, 1])  # (n, K, 4)
         reach = radius[near] + BowTool.arm_radius + margin
-        out["bow or wire hits the arm"] = (dist < reach[None, :, None]).any(axis=(1, 2))
+        out[BOW_ARM] = (dist < reach[None, :, None]).any(axis=(1, 2))
     if cell.table_z is not None:
-        out["bow below the table"] = (w[:, :3, :, 2] < cell.table_z + margin).any(axis=(1, 2))
+        out[BOW_TABLE] = (w[:, :3, :, 2] < cell.table_z + margin).any(axis=(1, 2))
         # every link from the shoulder on (the column stands on the base, on the table);
         # a capsule is lowest at an end point
         up = body >= 1
         low = ends[:, up][..., 2].min(axis=2) - radius[up]  # (n, S_up)
-        out["arm below the table"] = (low < cell.table_z + margin).any(axis=1)
+        out[ARM_TABLE] = (low < cell.table_z + margin).any(axis=1)
     return {key: v.reshape(shape) for key, v in out.items()}

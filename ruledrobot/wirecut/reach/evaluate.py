@@ -1,7 +1,7 @@
 """Scoring many placements of a job's block at once: the worst margin over every pass.
 
 A placement moves the block (and every cut surface with it) by a rigid motion T of
-the base frame (:mod:`.placement`); the wire's poses move with it, ``P_c = T_c P``.
+the base frame (:mod:`ruledrobot.place.regions`); the wire's poses move with it, ``P_c = T_c P``.
 For each candidate and pass, every **column** — a wire direction, a roll about the
 wire and an IK branch, held along the whole pass (the planner's constant offset;
 a feasible path never changes analytic branch, since every branch change crosses a
@@ -12,7 +12,7 @@ Vectorised over candidates x directions x rolls x rulings x branches for the IK 
 the kinematic margins; the clearance rules run for the most promising columns only,
 best bound first, until no remaining column can beat the best one found
 (:func:`~.branch_bound.best_of`), with every candidate's stock in one call
-(:class:`~.reach_grid.RowBoxes`).  Ties between columns and candidates whose margins
+(:class:`~.grid.RowBoxes`).  Ties between columns and candidates whose margins
 are equal (the clearance is quantised) are broken by the kinematic margin
 (reach, limits, singularity): the score is ``margin + TIE * kinematic``.
 """
@@ -26,7 +26,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ...geometry.checks import FloatArray
-from ..cut.clearance import clearance
+from ..cut.clearance import BOW_STOCK, clearance
 from ..cut.cutpath import CutPath
 from ..job.spec import Job
 from .branch_bound import best_of
@@ -144,7 +144,7 @@ class Evaluator:
             for slide in slides:
                 P0 = pass_poses(self.cell.W, F[idx], slide[idx], self.rolls, self.directions)
                 bow = clearance(self.cell, np.zeros((*P0.shape[:-2], 6)), P0)
-                opts.append((P0, ~bow["bow hits the stock"]))
+                opts.append((P0, ~bow[BOW_STOCK]))
             self.samples.append(PassSample(names.index(cp.name), cp.name, idx, *opts[0],
                                            float(np.max(too_long)), len(F),
                                            tuple(opts[1:])))  # fmt: skip
@@ -415,7 +415,7 @@ def constant_rolls(job: Job, passes: list[CutPath], model: RobotModel | None = N
     """The best constant roll of every pass of ``job`` where the job places its block:
     the one model's fact (docs/place.md, "One model") that a failed plan's explanation,
     ``ruledrobot reach`` and ``ruledrobot place`` all report — :class:`Evaluator` on its
-    default grid (:data:`~.reach_grid.RULINGS` rulings x :data:`~.reach_grid.ROLLS`
+    default grid (:data:`~.grid.RULINGS` rulings x :data:`~.grid.ROLLS`
     rolls), at the identity placement."""
     ev = Evaluator(job, list(passes), model, rules=rules)
     return details(ev, np.eye(4))
@@ -427,7 +427,7 @@ JUMP = 0.5
 
 def constant_words(job: Job, model: RobotModel, cp: CutPath, col: ColumnDetail) -> str:
     """The best constant roll ``col`` of a pass in words; of a pass the planner could not
-    solve (:mod:`.reach_explain`) never "serves all" without what fails between the samples (the
+    solve (:mod:`.explain`) never "serves all" without what fails between the samples (the
     planner's own check of every ruling at that roll), so that it never stands beside the
     planner's "no constant roll works" as a contradiction."""
     if cp.feasible or (col.worst < 0.0 and not col.served.all()):

@@ -47,7 +47,7 @@ import numpy as np
 from ...geometry.angles import wrap_angle
 from ...geometry.checks import FloatArray
 from ...robot.ik.workspace import reach_excess, reach_margin
-from ..cut.clearance import Cell, clearance
+from ..cut.clearance import ARM_STOCK, ARM_TABLE, BOW_ARM, BOW_STOCK, BOW_TABLE, Cell, clearance
 
 if TYPE_CHECKING:
     from ...robot.arm.model import RobotModel
@@ -86,25 +86,20 @@ REASON_TEXT = {
     Reason.OUT_OF_REACH: "out of reach",
     Reason.JOINT_LIMIT: "joint limit",
     Reason.SINGULARITY: "near a singularity",
-    Reason.BOW_STOCK: "bow hits the stock",
-    Reason.ARM_STOCK: "arm hits the stock",
-    Reason.BOW_ARM: "bow or wire hits the arm",
-    Reason.BOW_TABLE: "bow below the table",
-    Reason.ARM_TABLE: "arm below the table",
+    Reason.BOW_STOCK: BOW_STOCK,
+    Reason.ARM_STOCK: ARM_STOCK,
+    Reason.BOW_ARM: BOW_ARM,
+    Reason.BOW_TABLE: BOW_TABLE,
+    Reason.ARM_TABLE: ARM_TABLE,
     Reason.CHORD: "chord longer than the wire",
     Reason.CLEARANCE: "clearance",
 }
 
 #: the keys of :func:`~.clearance.clearance` and their reasons (checked in this order)
-_RULES = {
-    "bow hits the stock": Reason.BOW_STOCK,
-    "arm hits the stock": Reason.ARM_STOCK,
-    "bow or wire hits the arm": Reason.BOW_ARM,
-    "bow below the table": Reason.BOW_TABLE,
-    "arm below the table": Reason.ARM_TABLE,
-}
+_RULES = {REASON_TEXT[r]: r for r in (Reason.BOW_STOCK, Reason.ARM_STOCK, Reason.BOW_ARM,
+                                       Reason.BOW_TABLE, Reason.ARM_TABLE)}  # fmt: skip
 #: rules of the tool against the stock and the wrist: pass or fail, not part of the value
-GATES = ("bow hits the stock", "bow or wire hits the arm")
+GATES = (BOW_STOCK, BOW_ARM)
 
 
 @dataclass(frozen=True)
