@@ -59,7 +59,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ._arrays import norm
-from .checks import FloatArray, as_float_array, as_point
+from .checks import FloatArray, as_float_array, as_number, as_point
 from .lines import Lines, plucker_from_point_direction
 
 __all__ = [
@@ -112,13 +112,8 @@ def _nonzero(value: Any, name: str) -> float:
 
 
 def _finite(value: Any, name: str) -> float:
-    try:
-        x = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name}: expected a number, got {value!r}") from None
-    if not np.isfinite(x):
-        raise ValueError(f"{name}: expected a finite number, got {value!r}")
-    return x
+    """A finite number of any sign (:func:`.checks.as_number`: booleans refused)."""
+    return as_number(value, name, positive=False)
 
 
 def _vector3(value: Any, name: str) -> FloatArray:
