@@ -120,7 +120,7 @@ def run_trajectory(
     Parameters
     ----------
     traj : the trajectory, or a trajectory CSV path (the recording goes beside it).
-    host : controller address (a robot, URSim, or :class:`~.emulator.Emulator`);
+    host : controller address (a robot, URSim, or :class:`~ruledrobot.ursim.process.Emulator`);
         None only with ``dry_run`` (the controller is not contacted).
     model : the robot model or its name; default, and it must agree with, the
         trajectory's metadata (:func:`ruledrobot.robot.model_for`).

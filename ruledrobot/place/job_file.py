@@ -2,7 +2,7 @@
 
 The user's file is edited in place, line by line, so its comments and layout stay:
 ``[stock] centre`` and ``rotvec``, each cut's surface ``pose`` and ``keep`` point and
-``[robot] base`` get the values of the placed job (:meth:`~.placement.Placement.job`);
+``[robot] base`` get the values of the placed job (:meth:`~.regions.Placement.job`);
 cuts not kept are removed with their tables; paths to other files (``file``, ``calibration``,
 ``root``, ``tip``, ``gcode`` ...) are rewritten relative to the new file's folder.
 The text written is read back with the job parser and compared with the moved job;

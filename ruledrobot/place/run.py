@@ -4,7 +4,7 @@ Output folder (written whole, swapped in at the end):
 
 * ``job.toml`` — the job with the best verified placement filled in, and ``plan/`` —
   its plan (trajectory and program when it passes);
-* ``margin.png`` — :mod:`.place_plot`; ``place.json`` — region, settings, the
+* ``margin.png`` — :mod:`.plot`; ``place.json`` — region, settings, the
   measured rate, the job's own placement, the ranked candidates, the verification,
   the setups;
 * when no single placement serves a job of several cuts and turns are allowed:
@@ -58,8 +58,9 @@ class PlaceOutcome:
 
 def limiting(ev: Evaluator, T: np.ndarray) -> str:
     """Where and why the placement T (4, 4) has its worst margin, in words: the best
-    constant roll of its worst pass (:meth:`~.place_eval.ColumnDetail.words`, the
-    sentence a failed plan and ``ruledrobot reach`` say of the same pass)."""
+    constant roll of its worst pass
+    (:meth:`~ruledrobot.wirecut.reach.evaluate.ColumnDetail.words`, the sentence a
+    failed plan and ``ruledrobot reach`` say of the same pass)."""
     cols = details(ev, T)
     if not cols:
         return ""
@@ -88,7 +89,7 @@ def run_place(
     program: Callable[[object, Path], Path] | None = None,
     scorer: Callable[[Evaluator], Evaluator] | None = None,
 ) -> PlaceOutcome:
-    """Search ``region`` for the block of ``job`` (:func:`~.place.search`), verify the
+    """Search ``region`` for the block of ``job`` (:func:`~.search.search`), verify the
     best with the planner and MuJoCo, and, when no single placement serves, split the
     cuts into setups over the allowed ``turns`` (:mod:`.setups`); write the files
     (module doc) into ``out``.  ``program(trajectory, folder)`` writes the robot program

@@ -1,17 +1,18 @@
 """Placement search: where to put the block so that the arm reaches every ruling of
 every cut with the largest worst margin.
 
-1. A grid over the region (``[x, y, yaw]``, :class:`~.placement.Region`), every
-   candidate scored at once by :class:`~.place_eval.Evaluator` (the worst margin of
-   :mod:`.margins` over every pass of every cut, the best constant roll, direction
-   and IK branch per pass).
+1. A grid over the region (``[x, y, yaw]``, :class:`~.regions.Region`), every
+   candidate scored at once by :class:`~ruledrobot.wirecut.reach.evaluate.Evaluator`
+   (the worst margin of :mod:`ruledrobot.wirecut.reach.margins` over every pass of
+   every cut, the best constant roll, direction and IK branch per pass).
 2. Refinement: around the best few candidates a local grid of half the step, twice.
 3. The ranked candidates; the best is written as a job file and verified by the
-   full planner and MuJoCo (:func:`~.planner.plan`) — the next ones in turn when
-   it fails (:func:`verify_best`).
+   full planner and MuJoCo (:func:`~ruledrobot.wirecut.planner.plan`) — the next ones
+   in turn when it fails (:func:`verify_best`).
 
-The margin of a candidate is in metres (:mod:`.margins`): >= 0 means every sampled
-ruling of every pass has a configuration the planner accepts, with that much room.
+The margin of a candidate is in metres (:mod:`ruledrobot.wirecut.reach.margins`):
+>= 0 means every sampled ruling of every pass has a configuration the planner
+accepts, with that much room.
 """
 
 from __future__ import annotations

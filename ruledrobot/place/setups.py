@@ -7,7 +7,7 @@ Rules (``docs/place.md``):
 * Each setup has its own placement: one of the turns the user allows (and the block
   as clamped), then a place in the region.  The cuts of a setup are made in the
   job's order; setups follow the order of their first cut; the resulting order must
-  pass the job's cut-order rules (:func:`~.order.check_cut_order`).
+  pass the job's cut-order rules (:func:`~ruledrobot.wirecut.cut.order.check_cut_order`).
 * The fewest setups whose worst margin is >= 0 win; among those, the largest worst
   margin.  Each group's placement is then searched again for its own cuts.
 

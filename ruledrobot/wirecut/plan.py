@@ -1,8 +1,8 @@
 """Planning a job, the pure step: rulings -> passes -> timed motion -> measured trajectory.
 
 :func:`make_plan` writes nothing and runs no simulation; :mod:`.verify` plays the
-result in MuJoCo, :mod:`.outcome` turns both into the report and the verdict,
-:mod:`.write` writes the files.  Every number measured here is measured on the
+result in MuJoCo, :mod:`.report.outcome` turns both into the report and the verdict,
+:mod:`.report.files` writes the files.  Every number measured here is measured on the
 *sampled* joints through forward kinematics (what the controller receives).
 """
 

@@ -2,7 +2,7 @@
 
 ``plan(job, out_dir)`` runs :func:`~.plan.make_plan` (rulings, passes, timed motion,
 measured on the samples), :func:`~.verify.verify_plan` (MuJoCo), and
-:func:`~.outcome.plan_outcome` (report and verdict), then :func:`~.write.write_plan`
+:func:`~.report.outcome.plan_outcome` (report and verdict), then :func:`~.report.files.write_plan`
 into ``out_dir``:
 
 * ``trajectory.csv`` / ``trajectory.json`` — one row per controller period:
@@ -71,7 +71,7 @@ def plan(
     the report, when no OpenGL backend works).
 
     The verdict (``report["verdict"]``, ``PlanResult.verdict``) is the conjunction of
-    every check (:mod:`.checks`).  The files are written into a staging folder and
+    every check (:mod:`.report.verdict`).  The files are written into a staging folder and
     replace ``out_dir`` as a whole: a plan whose verdict fails leaves ``report.json``
     and the plots, and no trajectory.  ``out_dir=None`` writes nothing.
     """

@@ -1,6 +1,6 @@
 """How far a pose lies inside or outside a UR arm's reach, in metres.
 
-The analytic IK (:mod:`.analytic_ik`) reduces the arm to a planar two-link problem:
+The analytic IK (:mod:`.analytic`) reduces the arm to a planar two-link problem:
 for each shoulder and wrist branch, the origin of DH frame 3 must lie at a distance
 ``D`` from the shoulder point with ``|a2| - |a3| <= D <= |a2| + |a3|`` (the elbow's
 annulus), and the wrist point ``p5`` must lie outside the cylinder ``r = d4`` about

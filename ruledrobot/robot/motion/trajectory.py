@@ -218,7 +218,7 @@ class TrajectoryMeta:
     #: they are not the catalogue's default (a job's ``[robot] acceleration``)
     max_acceleration: FloatArray | None = None
     #: what it cuts — the block, the wire, the passes' feeds — for measuring any motion
-    #: of it with the one model of the wire against the block (:mod:`.wire_cut`)
+    #: of it with the one model of the wire against the block (:mod:`..wire.cut`)
     cut: WireCut | None = None
 
     def __post_init__(self) -> None:
@@ -372,7 +372,7 @@ class Trajectory:
 
     def wire_in_stock(self) -> WireInStock | None:
         """The wire against the block along these samples (the one model,
-        :mod:`.wire_in_stock`); None when the metadata names no cut."""
+        :mod:`..wire.in_stock`); None when the metadata names no cut."""
         if self.meta.cut is None:
             return None
         return self.meta.cut.measure(self.t, self.tcp_poses())

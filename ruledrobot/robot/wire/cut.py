@@ -1,5 +1,5 @@
 """What a trajectory cuts: the block, the wire, the feed each pass must hold — and the
-feed and wire checks measured on any motion by the one model (:mod:`.wire_in_stock`).
+feed and wire checks measured on any motion by the one model (:mod:`.in_stock`).
 
 A trajectory's sidecar carries a :class:`WireCut` (``"cut"``), so that whoever holds
 the trajectory alone — an exported program's verification, the runner on its

@@ -3,8 +3,8 @@
 One :class:`Controller` owns the state a UR controller publishes over RTDE.
 :meth:`Controller.tick` advances it by one control period (2 ms e-Series,
 8 ms CB3): the running program (ur_rtde's control script, via
-:class:`~.handshake.ControlScript`, or a standalone program, via
-:class:`~.script_runner.ScriptRunner`) reads its inputs, the trajectory
+:class:`~..script.handshake.ControlScript`, or a standalone program, via
+:class:`~..script.runner.ScriptRunner`) reads its inputs, the trajectory
 generator produces a setpoint, the arm backend steps, and the published
 variables (``values``, keyed by RTDE name) are refreshed.
 
@@ -19,7 +19,7 @@ State machine (the parts clients see):
   arm brakes, power goes off; :meth:`release_emergency_stop`, then power on
   and brake release).
 * ``runtime_state``: STOPPED / PLAYING / PAUSED of the current program.
-* programs are compiled before they start (:mod:`.script_functions`): one line
+* programs are compiled before they start (:mod:`..script.functions`): one line
   the emulator cannot run refuses the whole program, nothing of it runs, the
   running program is stopped, the compile error is logged at error level and
   shown as the pendant's popup (:attr:`Controller.popup`, closed by the

@@ -11,7 +11,7 @@ controller checks when the line runs (digital output pins 0-7, tool pins 0-1,
 analog values 0-1, servoj lookahead 0.03-0.2 s and gain 100-2000, the payload
 mass) are checked here, before any motion.  :func:`bind` returns the call's
 parameters by name with defaults filled in, which is what
-:class:`~.script_runner.ScriptRunner` executes.
+:class:`~.runner.ScriptRunner` executes.
 
 Units: metres, radians, seconds, kilograms; analog outputs as a fraction
 0..1 of their range (URScript ``set_standard_analog_out``).

@@ -1,7 +1,7 @@
 """What a running program may use of the controller: the interface between the
 controller (:class:`~ruledrobot.ursim.controller.machine.Controller`) and the program runners
 (:class:`~.handshake.ControlScript` for ur_rtde's control script,
-:class:`~.script_runner.ScriptRunner` for standalone programs).
+:class:`~.runner.ScriptRunner` for standalone programs).
 
 The runners see the controller only through :class:`ProgramHost`, so neither
 imports the controller (no import circle) and neither reaches into its parts:

@@ -13,8 +13,8 @@ Two kinds of program matter:
 * any other program — e.g. the standalone programs
   :mod:`ruledrobot.export.urscript` writes — is parsed into its top-level
   statements, which :class:`~ruledrobot.ursim.controller.machine.Controller` runs with a small
-  interpreter (:mod:`.script_runner`; the functions and their argument checks
-  are in :mod:`.script_functions`).  A ``sec`` program is a secondary program:
+  interpreter (:mod:`.runner`; the functions and their argument checks
+  are in :mod:`.functions`).  A ``sec`` program is a secondary program:
   it runs beside the primary one (no motion, no waiting).
 
 The emulator has no variables and no control flow.  A line it cannot run
@@ -76,7 +76,7 @@ class Statement:
     """A top-level call ``name(args..., key=value...)``, its 1-based line number and text.
 
     ``params``: the checked arguments by name (filled by
-    :func:`~.script_functions.compile_program`).
+    :func:`~.functions.compile_program`).
     """
 
     name: str
@@ -296,7 +296,7 @@ def parse_program(text: str) -> Program:
     """Classify and parse one complete program (``def name(): ... end``, or lines).
 
     Raises :class:`CompileError` (line, text, reason) when a line cannot be
-    run; arguments are checked by :func:`~.script_functions.compile_program`.
+    run; arguments are checked by :func:`~.functions.compile_program`.
     """
     lines = text.splitlines()
     first_i = next((i for i, ln in enumerate(lines) if ln.strip()), None)

@@ -2,7 +2,7 @@
 
 It runs the programs :mod:`ruledrobot.export.urscript` writes and similar
 hand-written ones, one step per control period.  Programs arrive compiled
-(:func:`~.script_functions.compile_program`: every statement a known function
+(:func:`~.functions.compile_program`: every statement a known function
 with checked arguments in ``Statement.params``), so nothing is skipped:
 
 * ``movej``/``movel``/``movep`` (joint vector or ``p[...]`` pose; ``a``,

@@ -31,7 +31,7 @@ Which profiles: the kinds in :data:`PROFILE_KINDS`, open, whose two end rulings 
 within :data:`RETURN` of the profile's size of each other (a closed trailing edge, or
 an open one a fraction of the chord thick), at an end that cuts the block.  Other
 open surfaces keep their own ends (a surface that stops short of its block is
-refused: :mod:`.path`); G-code files carry their own entry and exit moves.
+refused: :mod:`.passes`); G-code files carry their own entry and exit moves.
 """
 
 from __future__ import annotations
@@ -117,7 +117,7 @@ def profile_entry(lines: Lines, kind: str | None, closed: bool, stock: Box, half
     """The entry and exit moves of a profile (see the module doc), or None when
     ``lines`` (N) of a file of ``kind`` are not a profile that returns to its start,
     or neither end cuts the block.  ``half`` [m]: half the wire; ``planes``: the file's
-    (:meth:`~.spec.SurfaceSpec.planes`), in the frame of ``lines`` and ``stock``."""
+    (:meth:`~..job.spec.SurfaceSpec.planes`), in the frame of ``lines`` and ``stock``."""
     n = len(lines)
     if closed or kind not in PROFILE_KINDS or n < 3:
         return None

@@ -22,7 +22,7 @@
    and where the block does, unless the cut says ``extend = true``: then it is cut
    on along the extrapolation and the pass notes how far and on how many rulings.
    Closed surfaces are cut as loops entered through a slit (:mod:`.closed`).
-4. The redundancy search (:mod:`.redundancy`) chooses roll, slide, wire
+4. The redundancy search (:mod:`.wire_pose`) chooses roll, slide, wire
    direction and IK branch.
 """
 
@@ -106,7 +106,7 @@ def _frames(
     their origins stray).  An open polyline of a file (:func:`_polyline_pieces`) is
     refined piece by piece between its corners, which stay corners; ``half`` [m]: half
     the wire.  ``straight``: rulings of a profile's entry and exit moves
-    (:mod:`.profile_entry`) ahead of and past the profile, each move refined as a piece
+    (:mod:`.entry`) ahead of and past the profile, each move refined as a piece
     of its own by ``projection`` and ``linear`` (the wire's ends stay on their straight
     lines, as a foam cutter's towers move).  The profile's end pieces are refined
     with the moves as context (an interpolatory scheme, then cut where the moves begin),
@@ -155,7 +155,7 @@ def _frames(
 
 def _polyline_pieces(lines, closed: bool, kind: str | None, stock: Box, half: float,
                      bounds: bool = False) -> list:
-    """The rulings split at their corners (:func:`.corners.polygon_corners`: the wire's
+    """The rulings split at their corners (:func:`..motion.corners.polygon_corners`: the wire's
     travel turns by more than ``CORNER_ANGLE``), each piece refined on its own: the one
     rule for the open rulings of every file — G-code, DXF, 3DM, airfoil, lines — whose
     rulings form a polyline with corners (a foam cutter's entry and exit moves, a
@@ -194,7 +194,7 @@ def refine_cut(
     except ValueError as exc:
         raise ValueError(f"{label} {s.label}: {exc}") from None
     straight = (0, 0)
-    if entry is not None:  # a profile's straight entry and exit moves (:mod:`.profile_entry`)
+    if entry is not None:  # a profile's straight entry and exit moves (:mod:`.entry`)
         lines, straight = entry.lines, (entry.before, entry.after)
     n = len(lines)
     if len(_polyline_pieces(lines, closed, s.kind, stock, half)) == 1 and s.kind != "gcode":
@@ -234,7 +234,7 @@ def _x_jumps(F: FloatArray, angle: float = CORNER_ANGLE) -> bool:
     """Whether the frames' x axes turn by more than ``angle`` [rad] between neighbours
     (the common normals of a polygon reverse at its corners); smooth DH frames are kept
     as the roll's reference, the others are world referenced
-    (:func:`.toolpath.world_referenced`)."""
+    (:func:`.wire_geometry.world_referenced`)."""
     x = F[:, :3, 0]
     return bool(((x[1:] * x[:-1]).sum(axis=1) < np.cos(angle)).any())
 

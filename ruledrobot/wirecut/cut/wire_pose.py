@@ -89,9 +89,10 @@ class SearchOptions:
 
 
 def bow_segments(tool: ToolSpec) -> FloatArray:
-    """The bow's rods (3, 2, 3) in the flange frame (:meth:`.BowTool.segments`):
-    an arm from each wire end back to the plane through the flange axis normal to the
-    bow's depth direction, and the crossbar between the arms' ends."""
+    """The bow's rods (3, 2, 3) in the flange frame
+    (:meth:`ruledrobot.robot.tool.BowTool.segments`): an arm from each wire end back to
+    the plane through the flange axis normal to the bow's depth direction, and the
+    crossbar between the arms' ends."""
     return BowTool.from_spec(tool).segments()
 
 

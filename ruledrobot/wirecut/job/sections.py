@@ -1,7 +1,7 @@
 """Parsing the tables of a job file: typed fields, errors naming file, section and field.
 
 Each ``parse_*`` function reads one table (a TOML dict) into a value type of
-:mod:`.job`.  Every error is a ``ValueError`` whose message starts with the file
+:mod:`.load`.  Every error is a ``ValueError`` whose message starts with the file
 and the section, then the field and what was expected, e.g.
 ``job.toml: [cut 'top'] feed_speed: expected a number > 0, got -1``.
 """

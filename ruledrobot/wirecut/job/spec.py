@@ -1,6 +1,6 @@
 """The value types of a cut job: surface, stock, robot, tool (with its heat), cuts.
 
-Built and validated by :mod:`.job` from a job file; every other module reads them.
+Built and validated by :mod:`.load` from a job file; every other module reads them.
 Units: metres, radians, seconds; poses in the robot base frame.
 """
 
@@ -157,7 +157,7 @@ class CutSpec:
     base frame, ``"inside"`` / ``"outside"`` for a closed surface, or None (the wire
     runs on the surface itself and the kerf is not compensated).  ``extend``: an open
     surface that stops short of the block is cut on through it along the extrapolated
-    frame motion (noted) instead of being refused (:func:`.path.cut_paths`).
+    frame motion (noted) instead of being refused (:func:`..cut.passes.cut_paths`).
     """
 
     name: str

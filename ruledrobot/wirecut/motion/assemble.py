@@ -1,7 +1,7 @@
 """The whole motion of a job: approach, every pass with its lead-in and lead-out, the
 transits between them, the retract — one timed joint trajectory with a label per sample.
 
-Each pass (:class:`~.path.CutPath`) is timed at its cut's feed speed
+Each pass (:class:`~..cut.cutpath.CutPath`) is timed at its cut's feed speed
 (:func:`~.timing.time_path`), in pieces from rest to rest between the corners of its
 path (:mod:`.corners`).  It is entered from a pose ``LIFT`` beyond its first
 ruling (away from the stock centre) and left to a pose ``LIFT`` beyond its last.
@@ -153,7 +153,7 @@ def feed_param(
 ) -> tuple[FloatArray, float]:
     """(M,) the path parameter the feed is held in, and ``near`` (m): the distance [m]
     travelled across the wire by the part of it nearest the block — the chord's ends
-    inside it — as the speed factor measures it (:func:`~.toolpath.speed_factor`, the
+    inside it — as the speed factor measures it (:func:`~..cut.wire_geometry.speed_factor`, the
     one model); ``near``: how far out of the block the time law bounds that part's
     speed: :data:`FEED_NEAR`, or farther so that the bound reaches three rulings beyond
     every entry and exit and the wire moves at the feed for :data:`SETTLE_S` before it.

@@ -58,7 +58,7 @@ def polygon_corners(
 ) -> np.ndarray:
     """:func:`corner_nodes` of a sequence of lines (N, 6) (Plücker ``[l, m]``), each
     taken at its point nearest ``centre`` (3,) [m]: the corners of a foam cutter's
-    polygon of moves, where refinement splits it (:func:`~.path.refine_cut`)."""
+    polygon of moves, where refinement splits it (:func:`~..cut.passes.refine_cut`)."""
     L = np.asarray(plucker, dtype=np.float64)
     L = L / np.linalg.norm(L[:, :3], axis=1, keepdims=True)
     z, p0 = L[:, :3], point_nearest_origin(L)

@@ -3,7 +3,7 @@ the stock and the table.
 
 The whole stock box counts as an obstacle during a transit (material an earlier cut
 separated may still lie where it was).  Routes are tried in order, each leg a
-straight joint move whose samples must keep every clearance rule (:mod:`.clearance`):
+straight joint move whose samples must keep every clearance rule (:mod:`..cut.clearance`):
 
 1. the direct move;
 2. over the top: up from the start until the bow and the wire are ``CLEAR`` above

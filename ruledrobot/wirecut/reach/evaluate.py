@@ -305,7 +305,7 @@ class ColumnDetail:
     worst: float = 0.0
     travel: float = np.inf
     rulings: int = 0
-    #: the slide option (:func:`~.reach_grid.planner_slides`, 0: the planner's first)
+    #: the slide option (:func:`~.grid.planner_slides`, 0: the planner's first)
     slide: int = 0
 
     @property

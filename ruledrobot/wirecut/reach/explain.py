@@ -4,16 +4,16 @@ and which rulings, which rule, and which way to move the block.
 Every figure is the one margin model's (docs/place.md, "One model"):
 
 * which rulings no roll serves, and by how much they miss the arm's reach: a coarse
-  reachability map (:func:`~.reach.map_pass`, 60 rulings x the planner's 36 rolls) of
+  reachability map (:func:`~.map.map_pass`, 60 rulings x the planner's 36 rolls) of
   every pass the redundancy search could not solve;
 * the best constant roll and the share of the sampled rulings it serves: the
-  placement search's column (:func:`~.place_eval.details`, the same function
+  placement search's column (:func:`~.evaluate.details`, the same function
   ``ruledrobot reach`` and ``ruledrobot place`` report); when it serves every sampled
   ruling although the planner found no constant roll, the planner's own check of every
   ruling at that roll says what fails between the samples;
 * the move: the block moved along eight horizontal directions (towards and away from
   the robot, to either side and between) by 2.5 to 50 cm, scored by the same
-  :class:`~.place_eval.Evaluator`; the shortest move after which a constant roll
+  :class:`~.evaluate.Evaluator`; the shortest move after which a constant roll
   serves every sampled ruling of every pass is suggested.
 """
 

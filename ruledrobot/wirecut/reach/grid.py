@@ -37,7 +37,7 @@ __all__ = [
 #: the two wire directions, in the order of every grid's first axis
 DIRECTIONS = (False, True)
 #: rolls over a turn of the constant-roll model (the planner's own grid: the default
-#: ``rolls`` of :func:`~.redundancy.solve_redundancy`, so every roll it scores is
+#: ``rolls`` of :func:`~..cut.wire_pose.solve_redundancy`, so every roll it scores is
 #: scored here): the placement search, the best constant roll of ``reach`` and of a
 #: failed plan's explanation, and the move it suggests (docs/place.md, "One model")
 ROLLS = 36

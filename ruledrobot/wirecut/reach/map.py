@@ -2,7 +2,7 @@
 about it and each wire direction, whether the arm can hold the wire there and, if
 not, why; the margin (:mod:`.margins`) where it can.
 
-The passes are the planner's own (:func:`~.path.cut_paths`: refined rulings, kerf,
+The passes are the planner's own (:func:`~..cut.passes.cut_paths`: refined rulings, kerf,
 lead-in/out), the slide is the planner's (the chosen motion's, else the one its
 search starts from), and the path the planner chose is kept to be drawn on the map
 and checked against it.  Vectorised over rulings x rolls x directions x IK branches;
@@ -111,11 +111,11 @@ class PassMap:
     path_reason: np.ndarray | None = field(repr=False)
     slides: FloatArray | None = field(default=None, repr=False)
     slide_index: np.ndarray | None = field(default=None, repr=False)
-    #: the best constant roll of the pass (:func:`~.place_eval.constant_rolls`: the one
+    #: the best constant roll of the pass (:func:`~.evaluate.constant_rolls`: the one
     #: model's, on its own grid, the same a failed plan and ``place`` report); None when
     #: not computed
     constant: object | None = field(default=None, repr=False)
-    #: it in words (:func:`~.place_eval.constant_words`)
+    #: it in words (:func:`~.evaluate.constant_words`)
     constant_words: str | None = field(default=None, repr=False)
 
     @property
@@ -153,7 +153,7 @@ def map_pass(
     interval in which the wire covers the ruling's chord (the common interval of the
     pass for rulings outside the stock); each cell keeps its best slide.  A pass the
     planner could not solve is mapped, with ``slides = 1``, at every slide the planner
-    tried (:func:`~.reach_grid.planner_slides`)."""
+    tried (:func:`~.grid.planner_slides`)."""
     F = cp.frames
     M = len(F)
     slide, too_long = planner_slide(F, cell.stock, tool)

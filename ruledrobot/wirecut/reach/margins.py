@@ -95,7 +95,7 @@ REASON_TEXT = {
     Reason.CLEARANCE: "clearance",
 }
 
-#: the keys of :func:`~.clearance.clearance` and their reasons (checked in this order)
+#: the keys of :func:`~..cut.clearance.clearance` and their reasons (checked in this order)
 _RULES = {REASON_TEXT[r]: r for r in (Reason.BOW_STOCK, Reason.ARM_STOCK, Reason.BOW_ARM,
                                        Reason.BOW_TABLE, Reason.ARM_TABLE)}  # fmt: skip
 #: rules of the tool against the stock and the wrist: pass or fail, not part of the value
@@ -211,7 +211,7 @@ def clearance_margins(
     the value of the level below; levels below the margin only with ``depth`` (else a
     failure is worth 20 mm below the lowest level).  A broken gate makes the value at
     most ``-margin``.
-    ``cell.stock`` may hold one box per configuration (:class:`~.reach_grid.RowBoxes`).
+    ``cell.stock`` may hold one box per configuration (:class:`~.grid.RowBoxes`).
     """
     n = len(q)
     first = clearance(dataclasses.replace(cell, margin=rules.margin), q, P)

@@ -245,7 +245,7 @@ def write_reach(
     progress: Callable[[str], None] | None = None,
     slides: int = 1,
 ) -> tuple[ReachMap, dict[str, Path]]:
-    """Map ``job`` (:func:`~.reach.reach_map`) and write ``reach.png`` and ``reach.json``
+    """Map ``job`` (:func:`~.map.reach_map`) and write ``reach.png`` and ``reach.json``
     into the folder ``out`` (written whole, swapped in at the end)."""
     from ...io.outdir import StagedFolder
     from ..plan import job_reference

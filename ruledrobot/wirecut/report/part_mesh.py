@@ -9,7 +9,7 @@ second order near the surface, and of the right sign elsewhere in the stock.  Th
 zero level is meshed by marching cubes (scikit-image, Lewiner) on a grid of
 ``resolution`` over the stock — a mesh to look at and send to CAD (``part.stl``);
 its faces lie within a fraction of the grid step of the surfaces.  How close the
-kept surface is to the target is measured on the wire's path (:mod:`.kerf`), not on
+kept surface is to the target is measured on the wire's path (:mod:`..cut.kerf`), not on
 this mesh.
 
 A ruling runs on past the strip of the surface it bounds where it crosses the waste (a
@@ -59,7 +59,7 @@ def _surface_samples(
     its ``passes``, and their normals (P, 3) pointing into the waste (a closed cut's
     slits, in the waste, are not its surface).
 
-    A loop cut in two passes (:mod:`.closed`) is two arcs, each cut out to the meeting
+    A loop cut in two passes (:mod:`..cut.closed`) is two arcs, each cut out to the meeting
     ruling and back along its own kerf: only the way out is sampled (sampled both ways,
     every point of the arc had two samples of opposite normals, and the nearest of them
     gave the distance its sign at random: hundreds of specks of part in the waste and of

@@ -42,7 +42,7 @@ def _phase_bands(ax, t: FloatArray, labels: np.ndarray) -> None:
 
 def plot_plan(path: str | Path, plan: Plan, part=None) -> Path:
     """Write the plan's picture (one PNG) to ``path`` atomically; ``part``: the kept part's
-    mesh (:func:`~.part.part_mesh`), drawn see-through in the stock."""
+    mesh (:func:`~.part_mesh.part_mesh`), drawn see-through in the stock."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
     from matplotlib.patches import Patch

@@ -13,10 +13,10 @@ Gating (the plan is feasible only when all hold; ``docs/verdict.md``):
 * ``feed_max`` / ``feed_min`` — the feed of the wire inside the stock within
   ``[cut] feed_tolerance`` of the set feed (above and below); the lowest feed leaves
   out the slow-down and speed-up where the wire stops at a corner of its path
-  (:mod:`.corners`: a turn of more than 30 degrees, which no machine passes at the
+  (:mod:`..motion.corners`: a turn of more than 30 degrees, which no machine passes at the
   feed), counted in ``corner_stops``;
 * ``kept_surface`` (kerf compensated cuts) — the kept part's surface within
-  ``[cut] wire_tolerance`` of the target, from the kerf offsets (:mod:`.kerf`)
+  ``[cut] wire_tolerance`` of the target, from the kerf offsets (:mod:`..cut.kerf`)
   (these four are per cut, named ``wire_deviation:NAME`` ... when a job has several);
 * ``joint_position`` / ``joint_speed`` / ``joint_acceleration`` — ratios to the
   robot's limits (finite differences of the samples) at most 1; ``joint_torque``
