@@ -101,7 +101,6 @@ class RunResult:
     stop_time: float = 0.0
     samples_sent: int = 0
     max_deviation: float = 0.0
-    approach_distance: float = 0.0
     actual: Trajectory | None = None
     actual_path: Path | None = None
     verdict: Verdict | None = None
@@ -143,6 +142,12 @@ class RunResult:
     def moved(self) -> bool:
         """Whether motion was started (not a dry run, refusal or cancellation)."""
         return self.status not in ("dry_run", "refused", "cancelled")
+
+    @property
+    def approach_distance(self) -> float:
+        """The leading joint's distance [rad] from the arm's pose to the first sample
+        streamed (the entry's, 0 before an entry is chosen)."""
+        return 0.0 if self.entry is None else self.entry.distance
 
     @property
     def checks(self) -> tuple[Check, ...]:

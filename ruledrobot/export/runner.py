@@ -191,15 +191,9 @@ def run_trajectory(
             True,
         )
     ]
-    result = RunResult(
-        "dry_run",
-        "",
-        n,
-        start_index,
-        start_index,
-        float(traj.t[start_index]),
-        requested_index=start_index,
-    )
+    result = RunResult(status="dry_run", message="", n_samples=n, start_index=start_index,
+                       stop_index=start_index, stop_time=float(traj.t[start_index]),
+                       requested_index=start_index)  # nothing moved yet: stopped where it starts
 
     def make_plan(entry: Entry | None) -> RunPlan:
         return RunPlan(Verdict(tuple(checks)), entry, host, mode, traj, approach_speed, speed_scale)
@@ -332,7 +326,6 @@ def _run(
         result.program_check = program.check
     plan = make_plan(entry)
     result.verdict, result.entry = plan.verdict, entry
-    result.approach_distance = entry.distance
     if not plan.verdict.ok:
         result.status = "refused"
         result.message = "; ".join(c.detail or c.label for c in plan.verdict.failed)

@@ -3,11 +3,14 @@
 from __future__ import annotations
 
 from collections import deque
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
-__all__ = ["ClockStats"]
+__all__ = ["RECENT", "ClockStats"]
+
+#: how many recent publishes the lateness and gap records keep
+RECENT = 20_000
 
 
 @dataclass
@@ -31,8 +34,8 @@ class ClockStats:
     tick_errors: int = 0
     publish_errors: int = 0
     gc_max: float = 0.0
-    lateness: deque | None = None
-    gaps: deque | None = None
+    lateness: deque[float] = field(default_factory=lambda: deque(maxlen=RECENT))
+    gaps: deque[float] = field(default_factory=lambda: deque(maxlen=RECENT))
 
     def summary(self) -> dict[str, float]:
         lat = np.asarray(self.lateness or [0.0])

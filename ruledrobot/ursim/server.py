@@ -20,7 +20,6 @@ import sys
 import tempfile
 import threading
 import time
-from collections import deque
 from collections.abc import Callable
 from pathlib import Path
 
@@ -180,7 +179,7 @@ class ThreadedEmulator:
         for srv in self._servers:
             srv.realtime = realtime
             srv.frozen = self.frozen
-        self.stats = ClockStats(lateness=deque(maxlen=20000), gaps=deque(maxlen=20000))
+        self.stats = ClockStats()
         self._stop = threading.Event()
         self._clock: threading.Thread | None = None
         self._started = False
@@ -459,8 +458,8 @@ class ThreadedEmulator:
 
     def reset_stats(self) -> None:
         """Forget the clock's timing so far (measure one phase of a test)."""
-        self.stats.lateness.clear()  # type: ignore[union-attr]
-        self.stats.gaps.clear()  # type: ignore[union-attr]
+        self.stats.lateness.clear()
+        self.stats.gaps.clear()
         self.stats.ticks = self.stats.missed = self.stats.resyncs = 0
         self.stats.gc_max = 0.0
 
