@@ -1,5 +1,11 @@
 """The IK solution of one pose nearest given joints (the planner's moves off and over the
-block: a pass's lifted pose, a transit over the stock)."""
+block: a pass's lifted pose, a transit over the stock).
+
+The emulator's controller chooses differently, as a UR controller does for ``movel`` and
+``movep`` (:meth:`ruledrobot.robot.motion.arm_kinematics.ArmKinematics.ik_nearest_pose`:
+the solutions within the joint limits first, then the nearest in the Euclidean norm,
+seeded by the last joint); the planner wants the smallest largest joint step and refuses
+a nearest solution beyond the limits rather than taking another branch."""
 
 from __future__ import annotations
 
