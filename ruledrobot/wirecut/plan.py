@@ -23,6 +23,7 @@ from ..robot.motion.rates import trajectory_limits_report
 from ..robot.motion.trajectory import Heat, Trajectory, phases_from_labels, runs
 from ..robot.tool import BowTool
 from ..robot.wire.cut import FeedWindow, WireCut
+from .cut.clearance import SINGULAR_MIN
 from .cut.order import check_cut_order
 from .cut.passes import CutPath, cut_paths, job_search
 from .cut.wire_geometry import distance_from_rulings
@@ -36,7 +37,8 @@ __all__ = [
     "wire_deviation",
 ]
 
-SINGULARITY_MARGIN = 0.02  # the redundancy search's own threshold (solve_redundancy)
+#: the verdict's singularity threshold: the wire-pose search's own (one home)
+SINGULARITY_MARGIN = SINGULAR_MIN
 
 
 @dataclass(frozen=True, eq=False)

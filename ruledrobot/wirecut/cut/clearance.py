@@ -20,8 +20,15 @@ from ...robot.arm.shape import arm_capsules
 from ...robot.tool import BowTool
 from ..job.spec import ToolSpec
 
-__all__ = ["ARM_STOCK", "ARM_TABLE", "BOW_ARM", "BOW_STOCK", "BOW_TABLE", "RULES", "Cell",
-           "clearance"]
+__all__ = ["ARM_STOCK", "ARM_TABLE", "BOW_ARM", "BOW_STOCK", "BOW_TABLE", "MARGIN", "RULES",
+           "SINGULAR_MIN", "Cell", "clearance"]
+
+#: the planner's thresholds, one home for the wire-pose search (:mod:`.wire_pose`), the
+#: transits, the reach map's rules (:class:`ruledrobot.wirecut.reach.margins.Rules`) and
+#: the verdict's singularity check: the clearance [m] of bow and arm from the stock, the
+#: table and each other, and the least singularity measure of a configuration
+MARGIN = 0.005
+SINGULAR_MIN = 0.02
 
 #: the clearance rules by name: the keys of :func:`clearance`'s answer, in its order
 #: (the reach map's reasons and the placement search read these names)

@@ -44,7 +44,7 @@ from ...io.words import index_ranges
 from ...robot import RobotModel, path_ik, wrap_angle
 from ...robot.tool import BowTool
 from ..job.spec import ToolSpec
-from .clearance import Cell, clearance
+from .clearance import MARGIN, SINGULAR_MIN, Cell, clearance
 from .wire_geometry import chords, flange_poses, slide_bounds, wire_poses
 
 __all__ = [
@@ -69,10 +69,10 @@ class SearchOptions:
 
     rolls: int = 36
     sample: int = 80
-    singular_min: float = 0.02
+    singular_min: float = SINGULAR_MIN
     jump_threshold: float = 0.5
     table_z: float | None = 0.0
-    margin: float = 0.005
+    margin: float = MARGIN
     strategy: str = "auto"
     q_start: FloatArray | None = field(default=None, repr=False)
 
@@ -154,10 +154,10 @@ def solve_redundancy(
     *,
     rolls: int = 36,
     sample: int = 80,
-    singular_min: float = 0.02,
+    singular_min: float = SINGULAR_MIN,
     jump_threshold: float = 0.5,
     table_z: float | None = 0.0,
-    margin: float = 0.005,
+    margin: float = MARGIN,
     strategy: str = "auto",
     q_start: FloatArray | None = None,
 ) -> RedundancyResult:

@@ -25,7 +25,7 @@ import numpy as np
 from ...geometry.checks import FloatArray
 from ...robot.arm.model import RobotModel
 from ...robot.arm.nearest import nearest_ik
-from ..cut.clearance import Cell, clearance
+from ..cut.clearance import MARGIN, Cell, clearance
 from ..job.spec import Job
 
 __all__ = ["CLEAR", "TransitPlanner"]
@@ -58,7 +58,7 @@ class TransitPlanner:
 
     @classmethod
     def of(
-        cls, job: Job, model: RobotModel, margin: float = 0.005, cell: Cell | None = None
+        cls, job: Job, model: RobotModel, margin: float = MARGIN, cell: Cell | None = None
     ) -> TransitPlanner:
         """The transits of ``job``: its whole stock an obstacle, the table at z = 0,
         ``margin`` [m] clearance, no singularity threshold; ``cell``: the plan's cell (its

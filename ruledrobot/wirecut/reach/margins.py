@@ -47,7 +47,17 @@ import numpy as np
 from ...geometry.angles import wrap_angle
 from ...geometry.checks import FloatArray
 from ...robot.ik.workspace import reach_excess, reach_margin
-from ..cut.clearance import ARM_STOCK, ARM_TABLE, BOW_ARM, BOW_STOCK, BOW_TABLE, Cell, clearance
+from ..cut.clearance import (
+    ARM_STOCK,
+    ARM_TABLE,
+    BOW_ARM,
+    BOW_STOCK,
+    BOW_TABLE,
+    MARGIN,
+    SINGULAR_MIN,
+    Cell,
+    clearance,
+)
 
 if TYPE_CHECKING:
     from ...robot.arm.model import RobotModel
@@ -106,15 +116,15 @@ GATES = (BOW_STOCK, BOW_ARM)
 class Rules:
     """Thresholds of the margins (m, rad).
 
-    ``singular_min`` and ``margin`` are the planner's (``solve_redundancy``);
-    ``levels`` the
-    clearance levels (m, absolute, ascending; ``margin`` among them) at which the
-    clearance rules are checked (from the top one on the clearance is ample).
+    ``singular_min`` and ``margin`` are the planner's (:data:`~..cut.clearance.SINGULAR_MIN`,
+    :data:`~..cut.clearance.MARGIN`); ``levels`` the clearance levels (m, absolute,
+    ascending; ``margin`` among them) at which the clearance rules are checked (from the
+    top one on the clearance is ample).
     """
 
-    singular_min: float = 0.02
-    margin: float = 0.005
-    levels: tuple[float, ...] = (-0.03, 0.0, 0.005, 0.015, 0.03, 0.05)
+    singular_min: float = SINGULAR_MIN
+    margin: float = MARGIN
+    levels: tuple[float, ...] = (-0.03, 0.0, MARGIN, 0.015, 0.03, 0.05)
     #: the scale of margins on pictures (m): the map's darkest green
     shown: float = 0.2
 
