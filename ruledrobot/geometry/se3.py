@@ -76,6 +76,7 @@ __all__ = [
     "quaternion_from_pose",
     "rotation_about_axis",
     "rotvec_from_matrix",
+    "transform_points",
     "ur_vector_from_pose",
     "uses_kernel",
     "validate_poses",
@@ -145,6 +146,23 @@ def validate_poses(T: ArrayLike, name: str = "poses", tol: float = 1e-6) -> Floa
 def compose(A: ArrayLike, B: ArrayLike) -> FloatArray:
     """Product ``A @ B`` of poses (..., 4, 4), broadcasting the batch axes."""
     return np.matmul(np.asarray(A, dtype=np.float64), np.asarray(B, dtype=np.float64))
+
+
+def transform_points(T: ArrayLike, points: ArrayLike) -> FloatArray:
+    """Points given in frames ``T``, in the frame ``T`` is given in: ``R p + t``.
+
+    Parameters
+    ----------
+    T : (..., 4, 4) poses [m].
+    points : (..., K, 3) points [m] in each pose's frame; the batch axes broadcast
+        against ``T``'s, so (K, 3) points are the same points in every frame.
+
+    Returns
+    -------
+    (..., K, 3) the points in the frame ``T`` is given in (the batch axes broadcast).
+    """
+    T = np.asarray(T, dtype=np.float64)
+    return np.einsum("...ij,...kj->...ki", T[..., :3, :3], points) + T[..., None, :3, 3]
 
 
 def inverse(T: ArrayLike) -> FloatArray:

@@ -31,6 +31,7 @@ import numpy as np
 from ..geometry._arrays import FloatArray
 from ..geometry.box import Box
 from ..geometry.interp import interp_linear
+from ..geometry.se3 import transform_points
 from ..robot.wire.in_stock import chord_fractions, wire_in_stock
 
 __all__ = ["CUTTING_PHASES", "CutAnnotator", "phase_labels"]
@@ -113,7 +114,7 @@ class CutAnnotator:
         # feed at every sample (forward kinematics of the samples), then at the frames
         flange = dataclasses.replace(scene.robot, tool=np.eye(4)).fk(q)
         w = np.stack([scene.tool.wire_start, scene.tool.wire_end])
-        all_ends = np.einsum("mij,kj->mki", flange[:, :3, :3], w) + flange[:, None, :3, 3]
+        all_ends = transform_points(flange, w)
         feed = wire_in_stock(t, all_ends, self.stock).feed
         k = np.clip(np.searchsorted(t, times - 1e-9), 0, t.size - 1)
         self.feed = feed[k]

@@ -14,6 +14,7 @@ import numpy as np
 
 from ..geometry.box import Box
 from ..geometry.checks import FloatArray
+from ..geometry.se3 import transform_points
 from ..robot.arm.model import RobotModel
 from .scene import BowTool
 
@@ -194,7 +195,7 @@ def _wire(
     """Wire ends (M, 2, 3) in the base frame and the wire length inside the stock (M,)."""
     flange = dataclasses.replace(robot, base=np.eye(4), tool=np.eye(4)).fk(q)
     ends = np.stack([tool.wire_start, tool.wire_end])  # (2, 3)
-    wire = np.einsum("nij,kj->nki", flange[:, :3, :3], ends) + flange[:, None, :3, 3]
+    wire = transform_points(flange, ends)
     if stock is None:
         return wire, None
     a, b = wire[:, 0], wire[:, 1]

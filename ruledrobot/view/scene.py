@@ -30,6 +30,7 @@ import numpy as np
 from ..geometry._arrays import FloatArray
 from ..geometry.box import Box
 from ..geometry.mesh import Mesh
+from ..geometry.se3 import transform_points
 from ..robot.arm.model import RobotModel
 from ..robot.motion.rates import finite_difference_rates
 from ..robot.motion.trajectory import KinematicsRef, model_for
@@ -246,7 +247,7 @@ def build_scene(
         tool = sim_scene.tool
         assert tool is not None
         ends = np.stack([tool.wire_start, tool.wire_end])
-        all_wire = np.einsum("mij,kj->mki", flange[:, :3, :3], ends) + flange[:, None, :3, 3]
+        all_wire = transform_points(flange, ends)
         feed = wire_in_stock(traj.t, all_wire, stock).feed[k]
         qd, _ = finite_difference_rates(traj.t, traj.q)
         vmax = np.asarray(robot.max_velocity, dtype=np.float64)

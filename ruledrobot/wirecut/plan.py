@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from ..geometry.checks import FloatArray
+from ..geometry.se3 import transform_points
 from ..robot.arm.model import RobotModel
 from ..robot.motion.rates import trajectory_limits_report
 from ..robot.motion.trajectory import Heat, Trajectory, phases_from_labels, runs
@@ -118,14 +119,9 @@ def _deviation_at(flange: FloatArray, passes: tuple[CutPath, ...], mo: Motion) -
         if not rows.size:
             continue
         _, target = target_frames(cp, mo.s[rows])
-        pts = wire_points(flange[rows], mo.ends[rows])
+        pts = transform_points(flange[rows], mo.ends[rows])
         out[rows] = distance_from_rulings(pts, target)
     return out
-
-
-def wire_points(flange: FloatArray, points_in_flange: FloatArray) -> FloatArray:
-    """World positions (M, K, 3) of flange-frame points (M, K, 3) under poses (M, 4, 4)."""
-    return np.einsum("mij,mkj->mki", flange[:, :3, :3], points_in_flange) + flange[:, None, :3, 3]
 
 
 def wire_cut(job: Job, motion: Motion, bow: BowTool | None = None) -> WireCut:
@@ -165,7 +161,7 @@ def _bow_outside_cuts(
 ) -> tuple[tuple[dict, ...], tuple[str, ...]]:
     """The planner's bow model (rods and wire) in the stock where no pass cuts."""
     segs = bow.segments()
-    world = wire_points(flange, np.broadcast_to(segs.reshape(1, 6, 3), (len(flange), 6, 3)))
+    world = transform_points(flange, segs.reshape(6, 3))
     world = world.reshape(-1, 3, 2, 3)
     cutting = motion.pass_of >= 0
     hits = job.stock.segment_hits(world[:, :, 0], world[:, :, 1]).any(axis=1) & ~cutting

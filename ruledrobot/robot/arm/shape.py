@@ -22,6 +22,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ...geometry.checks import FloatArray
+from ...geometry.se3 import transform_points
 from .model import RobotModel
 
 __all__ = [
@@ -176,6 +177,5 @@ def arm_capsules(
     local = np.array([[sg.a, sg.b] for ss in segs for sg in ss], dtype=np.float64)  # (S, 2, 3)
     radius = np.array([sg.radius for ss in segs for sg in ss], dtype=np.float64)
     Bb = B[:, body]  # (n, S, 4, 4)
-    R, t = Bb[..., :3, :3], Bb[..., :3, 3]
-    ends = np.einsum("nsij,sej->nsei", R, local) + t[:, :, None, :]
+    ends = transform_points(Bb, local)  # (n, S, 2, 3)
     return ends.reshape(*shape, len(body), 2, 3), radius, body

@@ -14,6 +14,7 @@ import numpy as np
 
 from ...geometry.box import Box
 from ...geometry.checks import FloatArray
+from ...geometry.se3 import transform_points
 from ...geometry.segments import segment_distance
 from ...robot.arm.model import RobotModel
 from ...robot.arm.shape import arm_capsules
@@ -100,7 +101,7 @@ def clearance(cell: Cell, q: FloatArray, P: FloatArray) -> dict[str, np.ndarray]
     qf = np.nan_to_num(q.reshape(-1, q.shape[-1]))
     Pf = P.reshape(-1, 4, 4)
     rods = np.concatenate([cell.rods, cell.wire[None]], axis=0)  # (4, 2, 3)
-    w = np.einsum("nij,kej->nkei", Pf[:, :3, :3], rods) + Pf[:, None, None, :3, 3]
+    w = transform_points(Pf[:, None], rods)  # (n, 4, 2, 3)
     ends, radius, body = arm_capsules(model, qf)  # (n, S, 2, 3), (S,), (S,)
     n, S = len(qf), len(radius)
     # one batch of segments against the stock, each with its own grown margin: the bow's
@@ -109,7 +110,7 @@ def clearance(cell: Cell, q: FloatArray, P: FloatArray) -> dict[str, np.ndarray]
     seg_a, seg_b = [w[:, :3, 0]], [w[:, :3, 1]]
     grow = [np.full(3, margin + BowTool.arm_radius)]
     if cell.hub is not None:
-        h = np.einsum("nij,ej->nei", Pf[:, :3, :3], cell.hub) + Pf[:, None, :3, 3]
+        h = transform_points(Pf, cell.hub)
         seg_a.append(h[:, None, 0])
         seg_b.append(h[:, None, 1])
         grow.append(np.array([margin + cell.hub_radius]))

@@ -515,4 +515,4 @@ def chord_ends_in_flange(path: CutPath) -> FloatArray:
     F, m = path.frames, path.motion
     ends_world = F[:, None, :3, 3] + m.chord[:, :, None] * F[:, None, :3, 2]
     P_inv = se3.inverse(m.flange)
-    return np.einsum("mij,mkj->mki", P_inv[:, :3, :3], ends_world) + P_inv[:, None, :3, 3]
+    return se3.transform_points(P_inv, ends_world)

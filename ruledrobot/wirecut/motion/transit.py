@@ -23,6 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...geometry.checks import FloatArray
+from ...geometry.se3 import transform_points
 from ...robot.arm.model import RobotModel
 from ...robot.arm.nearest import nearest_ik
 from ..cut.clearance import MARGIN, Cell, clearance
@@ -85,7 +86,7 @@ class TransitPlanner:
         return ~bad & self.cell.model.within_limits(q)
 
     def _wire_in_stock(self, P: FloatArray) -> np.ndarray:
-        w = np.einsum("nij,kj->nki", P[:, :3, :3], self.cell.wire) + P[:, None, :3, 3]
+        w = transform_points(P, self.cell.wire)
         return self.cell.stock.segment_hits(w[:, 0], w[:, 1], self.cell.margin)
 
     def clear(self, qa: FloatArray, qb: FloatArray) -> bool:
