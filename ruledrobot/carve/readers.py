@@ -21,6 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from ..geometry.checks import FloatArray
+from ..geometry.mesh import signed_volume
 from .cell import PartSpec
 
 __all__ = ["PartMesh", "edge_counts", "misoriented_edges", "read_part", "read_triangles"]
@@ -43,8 +44,7 @@ class PartMesh:
     @property
     def volume(self) -> float:
         """Enclosed volume [m^3] (divergence theorem)."""
-        a, b, c = (self.vertices[self.faces[:, k]] for k in range(3))
-        return float(np.einsum("ij,ij->i", a, np.cross(b, c)).sum() / 6.0)
+        return signed_volume(self.vertices, self.faces)
 
 
 def edge_counts(faces: np.ndarray) -> tuple[int, int]:

@@ -35,6 +35,7 @@ __all__ = [
     "Mesh",
     "box_clipped_mesh",
     "mesh_normals",
+    "signed_volume",
     "strip_mesh",
     "validate_mesh",
 ]
@@ -238,3 +239,10 @@ def mesh_normals(vertices: ArrayLike, faces: ArrayLike) -> FloatArray:
     nrm = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
     size = norm(nrm)
     return np.where(size[:, None] > 0.0, nrm / np.where(size > 0.0, size, 1.0)[:, None], 0.0)
+
+
+def signed_volume(vertices: FloatArray, faces: np.ndarray) -> float:
+    """Volume [m^3] enclosed by a closed triangle mesh, positive when its faces turn
+    counter-clockwise seen from outside (the divergence theorem over the faces)."""
+    a, b, c = vertices[faces[:, 0]], vertices[faces[:, 1]], vertices[faces[:, 2]]
+    return float(np.einsum("ij,ij->i", a, np.cross(b, c)).sum() / 6.0)

@@ -35,7 +35,7 @@ import numpy as np
 
 from ...geometry.box import Box
 from ...geometry.checks import FloatArray
-from ...geometry.mesh import Mesh
+from ...geometry.mesh import Mesh, signed_volume
 from ..cut.cutpath import CutPath
 from ..cut.kerf import ruling_normals, waste_sign
 from ..cut.wire_geometry import chords
@@ -299,10 +299,3 @@ def _off_grid_points(f: FloatArray, h: float) -> FloatArray:
     the float32 rounding of STL too."""
     eps = SNAP * h
     return np.where(np.abs(f) < eps, np.where(f < 0.0, -eps, eps), f)
-
-
-def signed_volume(vertices: FloatArray, faces: np.ndarray) -> float:
-    """Volume [m^3] enclosed by a closed triangle mesh, positive when its faces turn
-    counter-clockwise seen from outside (the divergence theorem over the faces)."""
-    a, b, c = vertices[faces[:, 0]], vertices[faces[:, 1]], vertices[faces[:, 2]]
-    return float(np.einsum("ij,ij->i", a, np.cross(b, c)).sum() / 6.0)
