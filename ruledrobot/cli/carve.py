@@ -41,6 +41,8 @@ def print_carve(report: dict[str, Any]) -> None:
     from rich.table import Table
     from rich.text import Text
 
+    from ..io.words import counted
+
     table = Table(title="cuts (mm)", title_justify="left", show_edge=False, pad_edge=False)
     for col in ("cut", "kind", "rulings", "setup", "face within", "closest", "loosest",
                 "gouge", "what"):  # fmt: skip
@@ -59,7 +61,7 @@ def print_carve(report: dict[str, Any]) -> None:
     for col in ("", "volume L", "excess %", "largest distance to the part mm"):
         whole.add_column(col, justify="right" if col else "left")
     whole.add_row("part", f"{w['part_volume_l']:.4f}", "", "")
-    whole.add_row(f"carved ({w['cuts']} cuts, {w['setups']} setups)",
+    whole.add_row(f"carved ({counted(w['cuts'], 'cut')}, {counted(w['setups'], 'setup')})",
                   f"{w['carved_volume_l']:.4f}", f"{100 * w['excess']:.2f}",
                   f"{w['largest_distance_mm']:.2f}")  # fmt: skip
     if b:

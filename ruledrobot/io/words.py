@@ -1,7 +1,8 @@
 """How messages write numbers: one home for every consumer (issue 23).
 
 * :func:`index_ranges` — indices as compact ranges, ``"3-17, 40"``;
-* :func:`mm` — metres as whole millimetres, ``"212"`` (never ``"-0"``).
+* :func:`mm` — metres as whole millimetres, ``"212"`` (never ``"-0"``);
+* :func:`counted` — a count and its noun, ``"1 setup"``, ``"2 setups"``.
 """
 
 from __future__ import annotations
@@ -9,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike
 
-__all__ = ["index_ranges", "mm"]
+__all__ = ["counted", "index_ranges", "mm"]
 
 
 def index_ranges(mask: ArrayLike, labels: ArrayLike | None = None) -> str:
@@ -29,3 +30,8 @@ def index_ranges(mask: ArrayLike, labels: ArrayLike | None = None) -> str:
 def mm(v: float) -> str:
     """Metres as whole millimetres, for messages (never "-0")."""
     return str(round(float(v) * 1e3) + 0)
+
+
+def counted(n: int, noun: str) -> str:
+    """``n`` and ``noun``, the noun in the plural (an ``s`` added) unless ``n`` is 1."""
+    return f"{n} {noun}{'' if n == 1 else 's'}"

@@ -41,6 +41,7 @@ from ...geometry.checks import FloatArray
 from ...geometry.lines import coincident_neighbours
 from ...geometry.ruled import RuledSurface
 from ...io.lines import LinesDocument
+from ...io.words import counted
 from ...robot.arm.model import RobotModel
 from ...subdivision import check_length, check_size, get_scheme, refined_count
 from ..job.spec import CutSpec, Job
@@ -372,7 +373,7 @@ def _rulings(r: _Overrun) -> str:
     if r.rulings == 0:
         return ("along the surface's extrapolation (screw motion), between that ruling and "
                 "the first extrapolated one")
-    n = f"{'more than ' if r.more else ''}{r.rulings} ruling{'s' if r.rulings > 1 else ''}"
+    n = f"{'more than ' if r.more else ''}{counted(r.rulings, 'ruling')}"
     return f"on {n} extrapolated from the surface (screw motion)"
 
 
