@@ -130,6 +130,8 @@ def stream(
     finally:
         gc.enable()
         gc.unfreeze()
+    if hot is not None and s.hot:  # a heat window that ends with the plan ends here, on
+        s.set_heat(False)  # the schedule, not after the final hold (0.7 s and more later)
     # hold the final target until the filter has converged
     last = rows[-1]
     deadline = time.monotonic() + 10.0 * lookahead + 0.5
