@@ -155,6 +155,7 @@ class StagedFolder:
             self.abort()
 
     def abort(self) -> None:
+        """Remove the staging folder and what it holds; ``target`` is left untouched."""
         shutil.rmtree(self.path, ignore_errors=True)
 
     def commit(self, info: dict[str, Any] | None = None) -> Path:

@@ -26,6 +26,9 @@ class MatchOptions:
 
     @classmethod
     def parse(cls, o: Options) -> MatchOptions:
+        """The options ``match``, ``points`` (3 to 100 000) and ``spacing`` read from ``o``;
+        does not call :meth:`.options.Options.done`, the caller's reader does.
+        """
         return cls(o.choice("match", MATCH_RULES, None),
                    o.integer("points", lo=3, hi=100_000),
                    o.choice("spacing", SPACINGS, "uniform"))  # fmt: skip
@@ -44,6 +47,10 @@ class CadWriteOptions:
 
     @classmethod
     def parse(cls, o: Options, surface: bool = False) -> CadWriteOptions:
+        """The options ``units``, ``length`` [m] (non-zero), ``frame`` (a UR pose vector,
+        shape (6,): position [m], rotation vector [rad]) and, when ``surface`` is true, the
+        option ``surface`` read from ``o``; unknown options are refused.
+        """
         frame = o.vector("frame", 6)
         opts = cls(
             units=o.unit("units", "mm"),

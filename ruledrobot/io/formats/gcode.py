@@ -47,6 +47,15 @@ class GcodeReadOptions:
 
     @classmethod
     def parse(cls, o: Options) -> GcodeReadOptions:
+        """The read options from ``o``; unknown options are refused.
+
+        ``tower_distance`` [m] is required (non-zero); ``units`` must be ``mm`` or ``in``.
+
+        Raises
+        ------
+        ValueError
+            When an option is missing, out of range or unknown, naming it.
+        """
         d = o.number("tower_distance", nonzero=True, required="the distance between the "
                      "towers (m) is a machine setting, not in the file; e.g. 0.8")  # fmt: skip
         axes = o.string("axes", "XYUV")

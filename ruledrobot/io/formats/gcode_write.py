@@ -65,6 +65,18 @@ class GcodeWriteOptions:
 
     @classmethod
     def parse(cls, o: Options) -> GcodeWriteOptions:
+        """The write options from ``o``; unknown options are refused.
+
+        ``frame`` is a UR pose vector, shape (6,) (position [m], rotation vector [rad]),
+        turned into a pose (4, 4); ``feed`` [m/s] is in (0, 1], ``dwell`` [s] >= 0.
+
+        Raises
+        ------
+        ValueError
+            When ``units`` is not ``mm`` or ``in``, the two ``faces`` are equal, both
+            ``frame`` and ``block_offset`` are given, or an option is out of range or
+            unknown, naming it.
+        """
         frame = o.vector("frame", 6)
         axes = o.string("axes", "XYUV")
         axes = check_axes(axes, o.label("axes"))

@@ -42,6 +42,7 @@ class Options(FieldReader):
         self.used: set[str] = set()
 
     def name(self, key: str) -> str:
+        """The user's name of field ``key``: the key itself, or ``--prefix-key`` when ``cli``."""
         return "--" + (self.prefix + key).replace("_", "-") if self.cli else key
 
     def label(self, key: str) -> str:
@@ -51,12 +52,15 @@ class Options(FieldReader):
         return f"{self.where}{sep}{self.name(key)}"
 
     def fail(self, key: str, msg: str) -> ValueError:
+        """The ValueError for field ``key``, ``msg`` prefixed by :meth:`label`."""
         return ValueError(f"{self.label(key)}: {msg}")
 
     def has(self, key: str) -> bool:
+        """Whether ``key`` is given with a value (not absent, not None); does not mark it used."""
         return self.raw.get(key) is not None
 
     def get(self, key: str, default: Any = None) -> Any:
+        """The raw value of ``key`` (``default`` when absent or None), marked as used."""
         self.used.add(key)
         value = self.raw.get(key)
         return default if value is None else value
@@ -84,6 +88,9 @@ class Options(FieldReader):
 
     def integer(self, key: str, default: int | None = None, *, lo: int | None = None,
                 hi: int | None = None) -> int | None:  # fmt: skip
+        """An integer, ``lo <= v <= hi`` when those are given (``None`` when absent
+        and ``default`` is None); booleans and floats are refused.
+        """
         v = self.get(key, default)
         if v is None:
             return None
@@ -96,6 +103,9 @@ class Options(FieldReader):
         return int(v)
 
     def choice(self, key: str, options: tuple[str, ...], default: str | None) -> str | None:
+        """One of ``options``, lower-cased (the value is matched case-insensitively;
+        ``None`` when absent and ``default`` is None).
+        """
         v = self.get(key, default)
         if v is None:
             return None
@@ -104,6 +114,7 @@ class Options(FieldReader):
         return v.lower()
 
     def string(self, key: str, default: str | None = None) -> str | None:
+        """A string (``None`` when absent and ``default`` is None)."""
         v = self.get(key, default)
         if v is not None and not isinstance(v, str):
             raise self.fail(key, f"expected a string, got {v!r}")
@@ -124,10 +135,14 @@ class Options(FieldReader):
         return tuple(v)
 
     def vector(self, key: str, n: int) -> np.ndarray | None:
+        """A list of ``n`` finite numbers as an ndarray, shape (n,) (``None`` when absent)."""
         v = self.get(key)
         return None if v is None else self.numbers(key, v, n)
 
     def unit(self, key: str, default: str | None = None) -> str | None:
+        """A length unit's canonical name (``m``, ``cm``, ``mm``, ``in``; see
+        :func:`ruledrobot.io.units.unit_name`), ``None`` when absent and ``default`` is None.
+        """
         v = self.get(key, default)
         if v is None:
             return None
@@ -151,6 +166,14 @@ class Options(FieldReader):
         return p
 
     def done(self) -> None:
+        """Refuse the keys no reader asked for.
+
+        Raises
+        ------
+        ValueError
+            When ``raw`` holds a key not read by :meth:`get`; the message lists the
+            known ones.
+        """
         extra = sorted(set(self.raw) - self.used)
         if extra:
             raise ValueError(

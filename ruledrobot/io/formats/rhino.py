@@ -58,6 +58,9 @@ class RhinoOptions:
 
     @classmethod
     def parse(cls, o: Options) -> RhinoOptions:
+        """The options ``use``, ``layer``, ``units``, ``direction`` and those of
+        :meth:`.cad_common.MatchOptions.parse` read from ``o``; unknown options are refused.
+        """
         opts = cls(use=o.choice("use", ("auto", "lines", "curves", "surface"), "auto"),
                    layer=o.string("layer"), units=o.unit("units"),
                    direction=o.choice("direction", ("u", "v"), None),

@@ -57,6 +57,18 @@ class WingOptions:
 
     @classmethod
     def parse(cls, o: Options) -> WingOptions:
+        """The wing panel's options from ``o``; unknown options are refused.
+
+        ``root`` (an airfoil file) and ``span`` [m] are required; ``twist`` [rad] or
+        ``washout`` [rad] (``twist = -washout``, not both) lies in [-pi/2, pi/2],
+        ``sweep`` and ``dihedral`` [rad] in [-1.4, 1.4], ``twist_axis`` (a fraction of the
+        chord, dimensionless) in [0, 1].
+
+        Raises
+        ------
+        ValueError
+            When an option is missing, out of range, given twice or unknown, naming it.
+        """
         root = o.path("root", kind="airfoil")
         tip = o.path("tip", required=False, kind="airfoil")
         if o.has("twist") and o.has("washout"):
