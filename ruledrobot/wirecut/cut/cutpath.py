@@ -55,10 +55,13 @@ class CutPath:
 
     @property
     def feasible(self) -> bool:
+        """Whether the chosen motion reaches every ruling (the motion's ``feasible``)."""
         return self.motion.feasible
 
     @property
     def target_frames(self) -> FloatArray:
+        """(M, 4, 4) the target surface's rulings: ``surface_frames``, or ``frames`` when
+        the pass is not kerf-compensated (None given)."""
         return self.frames if self.surface_frames is None else self.surface_frames
 
 

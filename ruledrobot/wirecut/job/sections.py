@@ -56,9 +56,11 @@ class Section(FieldReader):
         return cls({"_": raw}, "_", where, title=title)
 
     def fail(self, key: str, msg: str) -> ValueError:
+        """The error (returned, not raised) for field ``key``: file, section, field, ``msg``."""
         return ValueError(f"{self.where}: [{self.title}] {key}: {msg}")
 
     def get(self, key: str, default: Any = None) -> Any:
+        """The raw value of ``key`` (``default`` when absent), marking the field as read."""
         self.used.add(key)
         return self.raw.get(key, default)
 
@@ -70,6 +72,30 @@ class Section(FieldReader):
         hi: float | None = None,
         strict_lo: bool = False,
     ) -> float:
+        """Field ``key`` as a finite number within the given bounds.
+
+        Parameters
+        ----------
+        key : str
+            The field's name.
+        default : float or None
+            The value when the field is absent; None: the field is required.
+        lo, hi : float or None
+            Lower and upper bounds, inclusive (None: unbounded); the field's unit.
+        strict_lo : bool
+            Whether ``lo`` itself is refused (the value must be ``> lo``).
+
+        Returns
+        -------
+        value : float
+            The field's value.
+
+        Raises
+        ------
+        ValueError
+            When the field is missing without a default, is not a finite number, or
+            is out of bounds (the message names file, section and field).
+        """
         v = self.get(key, default)
         if v is None:
             raise self.fail(key, "missing; expected a number")
@@ -82,12 +108,27 @@ class Section(FieldReader):
         return float(v)
 
     def vector(self, key: str, n: int, default: Any = None) -> np.ndarray:
+        """Field ``key``, a list of ``n`` finite numbers, as an ndarray of shape (n,).
+
+        Raises
+        ------
+        ValueError
+            When the field is missing without a default, or is not a list of ``n``
+            finite numbers.
+        """
         v = self.get(key, default)
         if v is None:
             raise self.fail(key, f"missing; expected a list of {n} numbers")
         return self.numbers(key, v, n, (list,))
 
     def choice(self, key: str, options: tuple[str, ...], default: str) -> str:
+        """Field ``key``, one of ``options`` (``default`` when absent).
+
+        Raises
+        ------
+        ValueError
+            When the value is not one of ``options``.
+        """
         v = self.get(key, default)
         if v not in options:
             raise self.fail(key, f"expected one of {', '.join(options)}, got {v!r}")
@@ -96,6 +137,14 @@ class Section(FieldReader):
     flag = FieldReader.boolean  # ``key`` as true or false (``default`` when absent)
 
     def done(self) -> None:
+        """Check that every field of the table was read.
+
+        Raises
+        ------
+        ValueError
+            When the table has fields no accessor asked for (a misspelt or unknown
+            field), naming them and the fields expected.
+        """
         extra = sorted(set(self.raw) - self.used)
         if extra:
             raise ValueError(

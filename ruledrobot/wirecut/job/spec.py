@@ -105,6 +105,28 @@ class SurfaceSpec:
 
 @dataclass(frozen=True)
 class RobotSpec:
+    """The job's robot: its model, place in the cell, speed and acceleration limits.
+
+    Attributes
+    ----------
+    model : str
+        The catalogue model's canonical name (``"ur5e"``, ...).
+    base : ndarray, shape (4, 4)
+        Pose of the robot base in the world frame (the simulation's cell); plans,
+        all given in the base frame, ignore it.
+    speed_scale : float
+        Fraction in (0, 1] of the catalogue joint speed limits the motion uses
+        (dimensionless).
+    acceleration : ndarray, shape (6,), or None
+        Joint acceleration limits [rad/s^2] replacing the catalogue's (None: the
+        catalogue's).
+    home : ndarray, shape (6,), or None
+        Joint positions [rad] the motion starts and ends at (None: no home).
+    calibration : Calibration or None
+        The robot's own kinematics, read from the job's calibration file (None: the
+        catalogue's nominal kinematics).
+    """
+
     model: str = "ur5e"
     base: np.ndarray = field(default_factory=lambda: np.eye(4), repr=False)
     speed_scale: float = 1.0
@@ -130,6 +152,7 @@ class HeatSpec:
 
     @property
     def output(self) -> str:
+        """The output as ``"KIND:INDEX"`` (``"standard:0"``), as the job file writes it."""
         return f"{self.kind}:{self.index}"
 
 
@@ -146,6 +169,7 @@ class ToolSpec:
 
     @property
     def wire_length(self) -> float:
+        """Length of the wire between its end points [m]."""
         return float(np.linalg.norm(self.wire_end - self.wire_start))
 
 
