@@ -26,13 +26,19 @@ class BowSpec(Protocol):
     [m] and the bow's mass [kg] (None: the default)."""
 
     @property
-    def wire_start(self) -> ArrayLike: ...
+    def wire_start(self) -> ArrayLike:
+        """(3,) start of the wire in the flange frame [m]."""
+        ...
 
     @property
-    def wire_end(self) -> ArrayLike: ...
+    def wire_end(self) -> ArrayLike:
+        """(3,) end of the wire in the flange frame [m]."""
+        ...
 
     @property
-    def mass(self) -> float | None: ...
+    def mass(self) -> float | None:
+        """Total mass of the bow [kg]; None for :class:`BowTool`'s default."""
+        ...
 
 
 @dataclass(frozen=True)

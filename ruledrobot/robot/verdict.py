@@ -73,15 +73,18 @@ class Check:
 
     @property
     def value_text(self) -> str:
+        """The value with its unit for a table (``"0.012 m"``, ``"yes"``; ``"-"`` if missing)."""
         return _fmt(self.value, self.unit)
 
     @property
     def limit_text(self) -> str:
+        """The relation and limit with its unit (``"<= 0.0005 m"``), or ``"information"``."""
         if not self.gating:
             return "information"
         return f"{self.relation} {_fmt(self.limit, self.unit)}".strip()
 
     def as_dict(self) -> dict[str, Any]:
+        """The check's fields as a dict for a report (a non-finite float ``value`` as None)."""
         d = asdict(self)
         if isinstance(d["value"], float) and not math.isfinite(d["value"]):
             d["value"] = None
@@ -96,10 +99,12 @@ class Verdict:
 
     @property
     def ok(self) -> bool:
+        """Whether every gating check holds."""
         return all(c.ok for c in self.checks if c.gating)
 
     @property
     def failed(self) -> tuple[Check, ...]:
+        """The gating checks that fail, in order."""
         return tuple(c for c in self.checks if c.gating and not c.ok)
 
     def __getitem__(self, name: str) -> Check:
@@ -125,6 +130,8 @@ class Verdict:
                          for c in doc["checks"]))  # fmt: skip
 
     def as_dict(self) -> dict[str, Any]:
+        """The verdict as a dict for a report: ``ok``, ``summary``, the ``failed`` checks'
+        names and every check's :meth:`Check.as_dict`; :meth:`from_dict` reads it back."""
         return {
             "ok": self.ok,
             "summary": self.summary(),

@@ -53,11 +53,23 @@ class PathArm(Protocol):
     upper: FloatArray
 
     @property
-    def ur_geometry(self) -> _ik.URGeometry | None: ...
+    def ur_geometry(self) -> _ik.URGeometry | None:
+        """The UR link lengths the analytic IK solves with [m] (``RobotModel.ur_geometry``)."""
+        ...
 
-    def ik(self, T: ArrayLike, **kwargs): ...
+    def ik(self, T: ArrayLike, **kwargs):
+        """All 8 analytic IK solutions of TCP poses ``T`` (..., 4, 4) in the world frame [m].
 
-    def flange_poses(self, T: ArrayLike, *, check: bool = True) -> FloatArray: ...
+        Path IK calls it as ``RobotModel.ik`` takes it, with ``return_info=True``,
+        ``check=False`` and a ``q6_seed`` [rad]: an :class:`~.analytic.IKSolutions` of
+        (..., 8, 6) joint positions [rad].
+        """
+        ...
+
+    def flange_poses(self, T: ArrayLike, *, check: bool = True) -> FloatArray:
+        """Poses of the flange in the robot base frame (..., 4, 4) [m] for TCP poses ``T``
+        (..., 4, 4) in the world frame: what the closed-form IK solves for."""
+        ...
 
 
 _LIMIT_EPS = 1e-9  # rad of slack on the joint limits when placing 2 pi representatives

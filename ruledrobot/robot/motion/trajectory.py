@@ -189,6 +189,7 @@ class Heat:
 
     @property
     def output(self) -> str:
+        """The switched output as ``"kind:index"`` (``"standard:3"``), for messages and reports."""
         return f"{self.kind}:{self.index}"
 
     def on(self, n: int) -> np.ndarray:
@@ -260,6 +261,7 @@ class TrajectoryMeta:
         return cls(**kw)  # type: ignore[arg-type]
 
     def replace(self, **changes: object) -> TrajectoryMeta:
+        """A copy with the fields named in ``changes`` replaced (validated again)."""
         return dataclasses.replace(self, **changes)  # type: ignore[arg-type]
 
 
@@ -344,6 +346,7 @@ class Trajectory:
 
     @property
     def n(self) -> int:
+        """The number of samples M."""
         return int(self.t.size)
 
     @property
@@ -353,6 +356,7 @@ class Trajectory:
 
     @property
     def duration(self) -> float:
+        """Time from the first sample to the last [s] (0 for a single sample)."""
         return float(self.t[-1] - self.t[0])
 
     def tcp_poses(self) -> FloatArray:

@@ -294,6 +294,7 @@ class PathMotion:
 
     @property
     def finished(self) -> bool:
+        """Whether the path time has reached the end of the last segment."""
         return self.t >= self.duration
 
     @property
@@ -303,6 +304,7 @@ class PathMotion:
 
     @property
     def q_end(self) -> np.ndarray:
+        """(6,) joint positions [rad] at the end of the last segment."""
         return self.segments[-1].q_end
 
     def position(self, t: float) -> np.ndarray:
@@ -358,9 +360,16 @@ class StopMotion:
 
     @property
     def finished(self) -> bool:
+        """Whether every joint has come to rest."""
         return self.t >= self.duration
 
     def next(self, dt: float, time_scale: float = 1.0) -> Setpoint | None:
+        """Advance by ``dt`` [s] and return the setpoint ``(q, qd, qdd)``, each (6,) [rad],
+        [rad/s], [rad/s^2]; None once at rest.
+
+        ``time_scale`` is taken for the motions' common interface and ignored: a stop
+        runs in real time.
+        """
         if self.t >= self.duration:
             return None
         self.t = min(self.t + dt, self.duration)

@@ -70,11 +70,13 @@ class FeedWindow:
                              f"{self.wire_tolerance}")  # fmt: skip
 
     def mask(self, n: int) -> np.ndarray:
+        """(n,) bool: sample k is in the window ``[start, stop)``."""
         m = np.zeros(n, dtype=bool)
         m[self.start : self.stop] = True
         return m
 
     def held_mask(self, n: int) -> np.ndarray:
+        """(n,) bool: sample k is in one of the ``held`` ranges."""
         m = np.zeros(n, dtype=bool)
         for a, b in self.held:
             m[a:b] = True
@@ -137,10 +139,12 @@ class FeedMeasure:
 
     @property
     def max_ok(self) -> bool:
+        """Whether the highest feed is at most ``speed · (1 + tolerance)`` (True if NaN)."""
         return not self.highest > self.speed * (1.0 + self.tolerance)
 
     @property
     def min_ok(self) -> bool:
+        """Whether the lowest feed is at least ``speed · (1 - tolerance)`` (True if NaN)."""
         return not self.lowest < self.speed * (1.0 - self.tolerance)
 
 

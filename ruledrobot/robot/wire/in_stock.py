@@ -173,6 +173,7 @@ class WireInStock:
 
     @property
     def n(self) -> int:
+        """The number of samples M."""
         return int(self.t.size)
 
     @property
