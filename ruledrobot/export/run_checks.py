@@ -50,6 +50,7 @@ class ControllerInfo:
 
     @property
     def generation(self) -> str | None:
+        """``"CB3"`` (major version below 4) or ``"e-Series"``, None when the version is unknown."""
         if self.version is None:
             return None
         return "CB3" if self.version[0] < 4 else "e-Series"
@@ -74,6 +75,7 @@ class ControllerInfo:
 
     @property
     def version_text(self) -> str:
+        """The version as ``"5.11.1"``, or ``"unknown"``."""
         return "unknown" if self.version is None else ".".join(map(str, self.version))
 
 

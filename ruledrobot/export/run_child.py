@@ -141,6 +141,12 @@ def _run(s: Session, m: dict) -> None:
 
 
 def main(fd: int) -> None:  # pragma: no cover - runs in the child
+    """Run the child's side of the protocol (module doc) on the socket ``fd``; never returns.
+
+    Ignores SIGINT, dies with its parent, raises its priority, then receives the
+    session config, connects, sends ``state`` (or ``error``) and on ``go`` runs the
+    motion; leaves with ``os._exit(0)`` whatever happened.
+    """
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     _die_with_parent()
     conn = Connection(fd)

@@ -86,6 +86,7 @@ class Entry:
 
     @property
     def ok(self) -> bool:
+        """Whether the entry's check holds (the entry is not refused)."""
         return self.check.ok
 
 
@@ -255,6 +256,7 @@ class StopPlace:
     in_stock: bool
 
     def describe(self) -> str:
+        """The place in words: sample, time [s], phase and whether the wire is in the stock."""
         where = "inside the stock" if self.in_stock else "outside the stock"
         return f"sample {self.sample} (t = {self.time:.3f} s), phase {self.phase}, wire {where}"
 

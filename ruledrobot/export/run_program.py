@@ -89,6 +89,7 @@ class PathRun:
 
     @property
     def ok(self) -> bool:
+        """Whether the program's motion holds the plan's tolerances (``check.ok``)."""
         return self.check.ok
 
     def counts(self) -> str:

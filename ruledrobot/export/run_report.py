@@ -24,6 +24,9 @@ class RunProgress:
         self._inside = inside_mask(traj)
 
     def update(self, k: int, n: int) -> None:
+        """Show sample ``k`` of ``n`` (clipped to ``n``), its phase and trajectory time [s];
+        the first call starts the bar.
+        """
         from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
         traj = self.traj
@@ -44,6 +47,7 @@ class RunProgress:
         self.progress.update(self.task, completed=k, description=phase, t=float(traj.t[kk]))
 
     def stop(self) -> None:
+        """Stop the bar, if started (a later :meth:`update` starts a new one)."""
         if self.progress is not None:
             self.progress.stop()
             self.progress = None

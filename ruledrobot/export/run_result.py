@@ -129,6 +129,7 @@ class RunResult:
 
     @property
     def completed(self) -> bool:
+        """Whether the run went to its end (``completed``) or was a dry run."""
         return self.status in ("completed", "dry_run")
 
     @property
@@ -151,6 +152,7 @@ class RunResult:
 
     @property
     def checks(self) -> tuple[Check, ...]:
+        """The checks before motion (empty before the verdict)."""
         return () if self.verdict is None else self.verdict.checks
 
     @property

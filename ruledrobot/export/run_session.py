@@ -59,12 +59,18 @@ class Link:
         self.stop: Stop | None = None
 
     def send(self, *msg: Any) -> None:
+        """Send the tuple ``msg``; when the pipe is gone, remember a ``supervisor_lost``
+        :class:`Stop` (raised by the next :meth:`check`) instead of raising.
+        """
         try:
             self.conn.send(msg)
         except (OSError, EOFError):
             self.stop = self.stop or Stop("supervisor_lost", "the runner's supervisor went away")
 
     def stage(self, name: str, timeout: float) -> None:
+        """Announce step ``name``: the supervisor kills the child when no message
+        follows within ``timeout`` [s].
+        """
         self.send("stage", name, float(timeout))
 
     def check(self) -> None:
@@ -120,6 +126,13 @@ class Session:
     # ------------------------------------------------------------ connection
 
     def connect_receive(self) -> None:
+        """Connect the receive interface at ``frequency`` [Hz].
+
+        Raises
+        ------
+        SessionError
+            When the controller is not reachable.
+        """
         import rtde_receive
 
         try:
@@ -128,6 +141,10 @@ class Session:
             raise SessionError(f"controller at {self.host} not reachable: {exc}") from None
 
     def state(self) -> dict:
+        """The controller's state before motion: ``robot_mode``, ``safety_mode``,
+        ``runtime_state`` (ints), ``protective``, ``emergency`` (bools) and ``q``, the
+        actual joint angles [rad] (6 floats).
+        """
         r = self.r
         return {
             "robot_mode": int(r.getRobotMode()),
@@ -139,6 +156,13 @@ class Session:
         }
 
     def connect_control(self) -> None:
+        """Connect the control interface (it uploads the control script).
+
+        Raises
+        ------
+        SessionError
+            When the controller refuses it.
+        """
         import rtde_control
 
         try:
@@ -172,17 +196,32 @@ class Session:
             self.c.setWatchdog(self.watchdog)
 
     def kick(self) -> None:
+        """Kick the control script's watchdog (no-op when ``watchdog`` is 0)."""
         if self.watchdog > 0:
             self.c.kickWatchdog()
 
     # ------------------------------------------------------------ recording
 
     def start_recording(self) -> None:
+        """Record from the next data package on; its controller time becomes t = 0."""
         self.recording = True
         self._ts0 = None
         self._last_ts = -math.inf
 
     def record(self, ts: float, q: list[float], tcp: list[float]) -> None:
+        """Append one data package while recording (packages not newer than the
+        last are skipped).
+
+        Parameters
+        ----------
+        ts : float
+            Controller time [s].
+        q : list of float, 6 values
+            Actual joint angles [rad].
+        tcp : list of float, 6 values
+            Actual TCP pose in the base frame as a UR pose vector: position [m],
+            rotation vector [rad].
+        """
         if self.recording and ts > self._last_ts:
             if self._ts0 is None:
                 self._ts0 = ts
@@ -203,6 +242,11 @@ class Session:
         return ts, q, tcp
 
     def info(self) -> dict:
+        """The progress so far: ``k_match`` (matched grid sample), ``sent``,
+        ``max_dev`` (largest joint deviation [rad]), ``recording_t0`` (controller time [s]
+        of the recording's first sample, None before), ``skipped``, ``skipped_ranges``
+        (half-open grid sample ranges) and ``max_slip`` [s].
+        """
         return {"k_match": self.k_match, "sent": self.sent, "max_dev": self.max_dev,
                 "recording_t0": self._ts0, "skipped": self.skipped,
                 "skipped_ranges": list(self.skipped_ranges),
@@ -255,11 +299,15 @@ class Session:
     # ------------------------------------------------------------ monitoring
 
     def start_clock(self) -> None:
+        """Start the latency watch: the wall clock and the controller clock from now."""
         self._wall0 = time.monotonic()
         self._clock_ts0 = self.r.getTimestamp()
         self._lag_min = math.inf
 
     def connected(self) -> bool:
+        """Whether the receive interface (and the control one, when made) is connected;
+        False when asking fails.
+        """
         try:
             return bool(self.r.isConnected() and (self.c is None or self.c.isConnected()))
         except Exception:

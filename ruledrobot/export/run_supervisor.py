@@ -97,6 +97,7 @@ class Child:
     # ------------------------------------------------------------ messages
 
     def send(self, *msg: Any) -> bool:
+        """Send the tuple ``msg`` to the child; whether it went (False when the pipe is gone)."""
         try:
             self.conn.send(msg)
             return True
@@ -132,11 +133,15 @@ class Child:
     # ------------------------------------------------------------ lifecycle
 
     def exit_text(self) -> str:
+        """How the child ended, in words (``"exit code 0"``, ``"killed by SIGSEGV"``,
+        ``"still running"``), after waiting up to 0.5 s for it.
+        """
         with contextlib.suppress(subprocess.TimeoutExpired):
             self.proc.wait(0.5)
         return _describe_exit(self.proc.poll())
 
     def kill(self) -> None:
+        """Kill the child if it still runs and wait up to 2 s for it."""
         if self.proc.poll() is None:
             with contextlib.suppress(OSError):
                 self.proc.kill()
@@ -154,6 +159,9 @@ class Child:
             self.conn.close()
 
     def log_tail(self, lines: int = 12) -> str:
+        """The last ``lines`` lines of the child's output (of its last 4 KiB; empty when
+        unreadable).
+        """
         try:
             self._log.seek(0, os.SEEK_END)
             size = self._log.tell()

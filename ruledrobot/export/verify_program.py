@@ -117,10 +117,14 @@ class ProgramCheck:
 
     @property
     def deviation_ok(self) -> bool:
+        """Whether the largest wire deviation [m] is not above ``wire_tolerance``."""
         return not self.wire_deviation > self.wire_tolerance
 
     @property
     def ok(self) -> bool:
+        """Whether the program passes: the wire deviation and every cut's feed within
+        tolerance.
+        """
         return self.deviation_ok and all(f.max_ok and f.min_ok for f in self.feeds)
 
     def failures(self) -> list[str]:
