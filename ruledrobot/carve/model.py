@@ -44,6 +44,15 @@ class CutMeasure:
     ok: bool
 
     def as_dict(self) -> dict[str, float | bool]:
+        """The measures for ``carve.json``, in millimetres.
+
+        Returns
+        -------
+        dict
+            ``gouge_mm``, ``closest_mm``, ``farthest_mm``, ``deviation_mm`` [mm], rounded
+            to 4 decimals (None where the measure is not finite, e.g. a measure that does
+            not apply to the cut's kind), and ``ok`` (bool).
+        """
         mm = {k: round(float(getattr(self, k)) * 1e3, 4) if np.isfinite(getattr(self, k))
               else None for k in ("gouge", "closest", "farthest", "deviation")}  # fmt: skip
         return {"gouge_mm": mm["gouge"], "closest_mm": mm["closest"],

@@ -71,9 +71,12 @@ class Loop:
 
     @property
     def parallel(self) -> bool:
+        """Whether the loop is a great circle (``amplitude`` 0): its rulings parallel ``axis``."""
         return self.amplitude == 0.0
 
     def describe(self) -> str:
+        """The loop in words: ``"silhouette along (+0.00, +0.00, +1.00)"`` for a great circle,
+        ``"seam about (...), amplitude 0.3, 2 waves"`` for a seam."""
         a = ", ".join(f"{x:+.2f}" for x in self.axis)
         if self.parallel:
             return f"silhouette along ({a})"

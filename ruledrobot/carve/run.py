@@ -46,6 +46,7 @@ class CarveResult:
 
     @property
     def ok(self) -> bool:
+        """Whether every check holds (the report's ``ok``)."""
         return bool(self.report["ok"])
 
 

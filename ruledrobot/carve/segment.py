@@ -36,6 +36,7 @@ class Region:
 
     @property
     def centroid(self) -> FloatArray:
+        """Mean (3,) of the region's vertices ``points`` [m, base frame] (not area-weighted)."""
         return self.points.mean(axis=0)
 
 

@@ -34,6 +34,7 @@ def quat(R: ArrayLike) -> str:
 
 
 def is_identity_rotation(R: ArrayLike) -> bool:
+    """Whether the rotation matrix ``R`` (3, 3) is exactly the identity (no tolerance)."""
     return bool(np.array_equal(np.asarray(R), np.eye(3)))
 
 

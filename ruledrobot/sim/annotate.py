@@ -222,6 +222,10 @@ class CutAnnotator:
         return _write_text(img, self.caption(i), self.close is not None and self.cutting[i])
 
     def close_all(self) -> None:
+        """Close the close-up's renderer (made by the annotator), if any; idempotent.
+
+        The main renderer, the caller's, stays open.
+        """
         if self.close is not None:
             self.close.close()
             self.close = None

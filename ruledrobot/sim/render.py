@@ -165,6 +165,7 @@ class Renderer:
         return r.render()
 
     def close(self) -> None:
+        """Free the GL context (errors while closing are ignored); idempotent."""
         r, self._r = getattr(self, "_r", None), None
         if r is not None:
             with contextlib.suppress(Exception):

@@ -53,15 +53,24 @@ class CutJob(Protocol):
     ``stock`` the block (robot base frame) and ``robot_model()`` the arm."""
 
     @property
-    def robot(self) -> _Placed: ...
+    def robot(self) -> _Placed:
+        """The job's ``[robot]``: its ``base`` (4, 4), the pose of the robot base in the world."""
+        ...
 
     @property
-    def tool(self) -> BowSpec: ...
+    def tool(self) -> BowSpec:
+        """The bow's spec (flange frame)."""
+        ...
 
     @property
-    def stock(self) -> Box: ...
+    def stock(self) -> Box:
+        """The block of stock (robot base frame, [m])."""
+        ...
 
-    def robot_model(self) -> RobotModel: ...
+    def robot_model(self) -> RobotModel:
+        """The arm's model (with the job's calibration) in its own base frame (``base`` the
+        identity); :meth:`Scene.from_job` places it at ``robot.base``."""
+        ...
 
 
 #: Geom names of the scene's static objects and of the wire.
