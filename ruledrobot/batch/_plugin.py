@@ -24,5 +24,6 @@ class IgnoreSigint(WorkerPlugin):
     name = "ruledrobot-ignore-sigint"
 
     def setup(self, worker) -> None:
+        """Ignore SIGINT in ``worker``'s process (only when called from its main thread)."""
         if threading.current_thread() is threading.main_thread():
             signal.signal(signal.SIGINT, signal.SIG_IGN)

@@ -50,9 +50,12 @@ class CodeIdentity:
 
     @property
     def id(self) -> str:
+        """``version+sources``: the version and the first 16 hex digits of ``sources``."""
         return f"{self.version}+{self.sources[:16]}"
 
     def as_dict(self) -> dict[str, str | None]:
+        """The identity as a JSON-ready dict: ``id``, ``version``, ``sources_sha256``,
+        ``commit``."""
         return {"id": self.id, "version": self.version, "sources_sha256": self.sources,
                 "commit": self.commit}  # fmt: skip
 

@@ -106,6 +106,8 @@ class JobRecord:
         return self.status in ("infeasible", "bad_input", "crashed")
 
     def as_dict(self) -> dict[str, Any]:
+        """The record as a JSON-ready dict: its fields (tuples as lists) plus ``worst_check``
+        and ``worst_margin``."""
         d = asdict(self)
         d["failed_checks"] = list(self.failed_checks)
         d["files"] = list(self.files)
@@ -114,6 +116,8 @@ class JobRecord:
 
     @classmethod
     def from_dict(cls, d: dict[str, Any]) -> JobRecord:
+        """The record of a dict written by :meth:`as_dict`; keys that are not fields (the
+        derived ``worst_check`` / ``worst_margin``, or unknown ones) are ignored."""
         known = {f.name for f in fields(cls)}
         kw = {k: v for k, v in d.items() if k in known}
         kw["failed_checks"] = tuple(kw.get("failed_checks") or ())

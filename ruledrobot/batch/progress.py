@@ -66,6 +66,7 @@ class BatchBar:
         self.progress.update(self.task, completed=p.done, text=text)
 
     def stop(self) -> None:
+        """Stop the progress display, if one was started (safe to call twice)."""
         if self.progress is not None:
             self.progress.stop()
             self.progress = None

@@ -93,6 +93,7 @@ class BatchResult:
 
     @property
     def manifest(self) -> Path:
+        """The batch manifest ``batch.json`` in the output folder ``out``."""
         return self.out / "batch.json"
 
     @property

@@ -19,12 +19,14 @@ def say_program_size(path: Path) -> None:
 
 
 class ScriptMode(str, Enum):
+    """URScript motion command of ``export --format urscript`` (``--mode``)."""
     servoj = "servoj"
     movep = "movep"
     movel = "movel"
 
 
 class ExportFormat(str, Enum):
+    """File format of ``export`` (``--format``)."""
     csv = "csv"
     json = "json"
     npz = "npz"
@@ -97,6 +99,7 @@ def export(
 
 
 class RunModeName(str, Enum):
+    """How ``run`` drives the robot (``--mode``): ``servoj`` or ``path``."""
     servoj = "servoj"
     path = "path"
 

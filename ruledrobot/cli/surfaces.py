@@ -11,12 +11,14 @@ from ._common import app, console, fail
 
 
 class AlgorithmName(str, Enum):
+    """Refinement algorithm of ``refine`` (``--algorithm``)."""
     projection = "projection"
     combined = "combined"
     dh = "dh"
 
 
 class SchemeName(str, Enum):
+    """Subdivision scheme of ``refine`` (``--scheme``)."""
     linear = "linear"
     chaikin = "chaikin"
     bspline3 = "bspline3"

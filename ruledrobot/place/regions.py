@@ -79,6 +79,7 @@ class Turn:
 
     @property
     def label(self) -> str:
+        """The turn as the CLI writes it: ``"as clamped"`` or axis and degrees, e.g. ``"x90"``."""
         return "as clamped" if self.degrees == 0 else f"{self.axis}{self.degrees}"
 
     def matrix(self, stock: Box) -> FloatArray:
@@ -211,6 +212,10 @@ class Placement:
         return dataclasses.replace(moved, robot=robot)
 
     def describe(self) -> str:
+        """The placement in words, lengths in mm and the yaw in degrees (for reports).
+
+        Says where the block's centre goes (``move = "stock"``) or how far the robot's base
+        moves and turns (``move = "robot"``), and the :attr:`.regions.Turn.label` when turned."""
         turn = "" if self.turn.degrees == 0 else f", after turning it {self.turn.label}"
         if self.move == "stock":
             return (f"block centre at x = {mm(self.x)} mm, y = {mm(self.y)} mm, "

@@ -52,10 +52,23 @@ class Candidate:
 
     @property
     def xyz(self) -> FloatArray:
+        """The placement's ``[x, y, yaw]`` (3,): [m], [m], [rad]."""
         p = self.placement
         return np.array([p.x, p.y, p.yaw])
 
     def as_dict(self, cut_names: list[str]) -> dict:
+        """The candidate as a JSON-ready dict, lengths in mm and the yaw in degrees.
+
+        Parameters
+        ----------
+        cut_names : list of str
+            Names of the scored cuts, in the order of ``cut_margins``.
+
+        Returns
+        -------
+        dict
+            ``x_m``, ``y_m`` [m], ``yaw_deg`` [deg], ``turn`` (:attr:`.regions.Turn.label`),
+            ``margin_mm`` and ``cut_margins_mm`` (cut name -> margin) [mm]."""
         p = self.placement
         return {"x_m": p.x, "y_m": p.y, "yaw_deg": float(np.degrees(p.yaw)),
                 "turn": p.turn.label, "margin_mm": self.margin * 1e3,
@@ -86,14 +99,17 @@ class PlaceResult:
 
     @property
     def best(self) -> Candidate:
+        """The best-ranked candidate (``ranked[0]``)."""
         return self.ranked[0]
 
     @property
     def feasible(self) -> bool:
+        """Whether the best candidate's worst margin is >= 0 (every ruling reachable)."""
         return self.best.margin >= 0.0
 
     @property
     def rate(self) -> float:
+        """Candidates evaluated per minute [1/min] (``len(margins)`` over ``seconds``)."""
         return 60.0 * len(self.margins) / max(self.seconds, 1e-9)
 
 

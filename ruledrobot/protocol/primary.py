@@ -160,6 +160,7 @@ class Version:
 
     @property
     def text(self) -> str:
+        """The version as ``"major.minor.bugfix.build"``."""
         return f"{self.major}.{self.minor}.{self.bugfix}.{self.build}"
 
 

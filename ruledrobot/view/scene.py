@@ -82,6 +82,7 @@ class Timeline:
 
     @property
     def duration(self) -> float:
+        """Time from the first to the last display frame [s]."""
         return float(self.t[-1] - self.t[0])
 
     def frame_at(self, time: float) -> int:
