@@ -9,6 +9,7 @@ import pytest
 from typer.testing import CliRunner
 
 from ruledrobot.cli import app
+from ruledrobot.io.demo_cell import DEMO_CELL
 
 CELL = """\
 [part]
@@ -18,18 +19,7 @@ pose = {pose}
 tolerance = 0.0005
 rough_cuts = {rough}
 
-[stock]
-centre = [0.5, 0.0, 0.3]
-size = [0.2, 0.2, 0.15]
-
-[robot]
-model = "ur5e"
-
-[tool]
-wire_start = [-0.2, 0.0, 0.25]
-wire_end = [0.2, 0.0, 0.25]
-clearance = 0.02
-
+{cell}
 [cut]
 feed_speed = 0.012
 approach_speed = 0.6
@@ -42,7 +32,7 @@ AXIS_Y = [0.5, 0.0, 0.3, float(np.pi / 2), 0.0, 0.0]
 
 def write_cell(folder, file, pose, units="mm", rough=4, name="cell.toml"):
     path = folder / name
-    path.write_text(CELL.format(file=file, units=units, pose=pose, rough=rough))
+    path.write_text(CELL.format(file=file, units=units, pose=pose, rough=rough, cell=DEMO_CELL))
     return path
 
 

@@ -18,6 +18,7 @@ import pytest
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
+from ruledrobot.io.demo_cell import DEMO_CELL
 from ruledrobot.io.mesh import write_stl
 from ruledrobot.wirecut.cut.passes import cut_paths
 from ruledrobot.wirecut.job.demo import PART_JOB
@@ -25,18 +26,7 @@ from ruledrobot.wirecut.job.load import load_job
 from ruledrobot.wirecut.report.part_mesh import part_mesh
 
 #: a part of our own: a block with a saddle top and a column cut all the way round it
-COLUMN_JOB = """\
-[stock]
-centre = [0.5, 0.0, 0.3]
-size = [0.2, 0.2, 0.15]
-
-[robot]
-model = "ur5e"
-
-[tool]
-wire_start = [-0.2, 0.0, 0.25]
-wire_end = [0.2, 0.0, 0.25]
-clearance = 0.02
+COLUMN_JOB = DEMO_CELL + """\
 mass = 1.0
 
 [[cut]]
