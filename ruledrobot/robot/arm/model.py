@@ -28,7 +28,6 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass, field
-from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -289,17 +288,7 @@ class RobotModel(InverseKinematics):
         """
         if calibration is None:
             return self.nominal
-        if not isinstance(calibration, Calibration):
-            raise ValueError(
-                f"calibration: expected a Calibration or None (read files with "
-                f"ruledrobot.io.load_calibration), got "
-                f"{type(calibration).__name__}"
-            )
-        if calibration.model != self.name:
-            raise ValueError(
-                f"calibration: it belongs to a {calibration.model} (source "
-                f"{calibration.source!r}), this model is a {self.name}"
-            )
+        calibration = _calibration_of(self.name, calibration)
         return dataclasses.replace(
             self,
             calibration=calibration,
@@ -432,17 +421,27 @@ class RobotModel(InverseKinematics):
         return np.all((q >= self.lower - tol) & (q <= self.upper + tol), axis=-1)
 
 
+def _calibration_of(name: str, cal: object) -> Calibration:
+    """``cal`` when it is a :class:`Calibration` of the model called ``name``; ValueError
+    naming both models otherwise (the one check of :meth:`RobotModel.with_calibration`
+    and of a model built with a calibration)."""
+    if not isinstance(cal, Calibration):
+        raise ValueError(
+            f"calibration: expected a Calibration or None (read files with "
+            f"ruledrobot.io.load_calibration), got {type(cal).__name__}"
+        )
+    if cal.model != name:
+        raise ValueError(
+            f"calibration: it belongs to a {cal.model} (source {cal.source!r}), this model is "
+            f"a {name}"
+        )
+    return cal
+
+
 def _check_calibration(model: RobotModel) -> tuple[tuple[FloatArray, ...], bool]:
     """The nominal table (d, a, alpha, offset) of a calibrated model and whether its IK
     needs the Newton finish; ValueError when the calibration does not fit the model."""
-    cal: Any = model.calibration
-    if not isinstance(cal, Calibration):
-        raise ValueError(f"calibration: expected a Calibration or None, got {type(cal).__name__}")
-    if cal.model != model.name:
-        raise ValueError(
-            f"calibration: it belongs to a {cal.model} (source {cal.source!r}), this model is "
-            f"a {model.name}"
-        )
+    cal = _calibration_of(model.name, model.calibration)
     for f in ("theta_offset", "a", "d", "alpha"):
         mine, theirs = getattr(model, f), getattr(cal, f)
         if not np.array_equal(mine, theirs):

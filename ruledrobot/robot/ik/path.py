@@ -72,6 +72,9 @@ class PathArm(Protocol):
         ...
 
 
+#: rad: a step whose largest joint change exceeds this is a jump (:func:`path_ik`'s
+#: default, and the planner's between rulings: ``wirecut.cut.wire_pose``, ``reach``)
+JUMP_THRESHOLD = 0.5
 _LIMIT_EPS = 1e-9  # rad of slack on the joint limits when placing 2 pi representatives
 _STEP_CHUNK = 2048  # path steps per chunk when building the (8 x 8) step costs
 
@@ -271,7 +274,7 @@ def path_ik(
     poses: ArrayLike,
     *,
     q_start: ArrayLike | None = None,
-    jump_threshold: float = 0.5,
+    jump_threshold: float = JUMP_THRESHOLD,
     singular_tol: float = 0.05,
     weights: ArrayLike | None = None,
     max_messages: int = 20,

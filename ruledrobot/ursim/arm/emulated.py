@@ -36,14 +36,12 @@ def emulated_model(
         cal, where = load_calibration(calibration), f"{os.fspath(calibration)}: "
     else:
         cal, where = calibration, ""
-    if not isinstance(cal, Calibration):
-        raise ValueError(f"calibration: expected a Calibration or a file, got {type(cal).__name__}")
-    if cal.model != arm.name:
+    if isinstance(cal, Calibration) and cal.model != arm.name:
         raise ValueError(
             f"{where}a calibration of a {cal.model} (source {cal.source!r}), but the emulator "
             f"is a {arm.name}: refused"
         )
-    return arm.with_calibration(cal)
+    return arm.with_calibration(cal)  # refuses what is not a Calibration
 
 
 def kinematics_info_of(model: RobotModel) -> KinematicsInfo:

@@ -34,7 +34,8 @@ Search (vectorised over rulings; a Python loop over the small candidate grid):
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
+from typing import Any
 
 import numpy as np
 
@@ -42,6 +43,7 @@ from ...geometry.box import Box
 from ...geometry.checks import FloatArray
 from ...io.words import index_ranges
 from ...robot import RobotModel, path_ik, wrap_angle
+from ...robot.ik.path import JUMP_THRESHOLD
 from ...robot.tool import BowTool
 from ..job.spec import ToolSpec
 from .clearance import MARGIN, SINGULAR_MIN, Cell, clearance
@@ -52,6 +54,9 @@ __all__ = [
 ]
 
 STRATEGIES = ("auto", "constant", "varying")
+#: constant rolls scored over a turn (:attr:`SearchOptions.rolls`; the reach map and the
+#: placement search sample the same grid, ``reach.grid.ROLLS``)
+ROLLS = 36
 
 
 @dataclass(frozen=True, eq=False)
@@ -67,10 +72,10 @@ class SearchOptions:
     starts near (the job's ``[robot] home`` when the plan has one).
     """
 
-    rolls: int = 36
+    rolls: int = ROLLS
     sample: int = 80
     singular_min: float = SINGULAR_MIN
-    jump_threshold: float = 0.5
+    jump_threshold: float = JUMP_THRESHOLD
     table_z: float | None = 0.0
     margin: float = MARGIN
     strategy: str = "auto"
@@ -147,34 +152,19 @@ def _evaluate(cell: Cell, frames, roll, slide, reverse, jump: float):
 
 
 def solve_redundancy(
-    frames: FloatArray,
-    stock: Box,
-    tool: ToolSpec,
-    model: RobotModel,
-    *,
-    rolls: int = 36,
-    sample: int = 80,
-    singular_min: float = SINGULAR_MIN,
-    jump_threshold: float = 0.5,
-    table_z: float | None = 0.0,
-    margin: float = MARGIN,
-    strategy: str = "auto",
-    q_start: FloatArray | None = None,
+    frames: FloatArray, stock: Box, tool: ToolSpec, model: RobotModel, **options: Any
 ) -> RedundancyResult:
     """Choose roll, slide, wire direction and IK branch for rulings with ``frames`` (M, 4, 4).
 
     ``model``: a :class:`~ruledrobot.robot.RobotModel` whose ``fk`` gives the flange
-    pose (no tool set).  ``table_z``: height of the table top in the base frame
-    (None: no table check).  ``margin`` (m): clearance of the bow and arm from
-    stock, table and each other.  ``strategy``: "auto" (constant offset first, then a
-    varying roll), "constant" or "varying".  ``q_start`` (6,): joints the motion
-    starts near (path IK picks the branch and 2 pi representatives nearest them).
+    pose (no tool set).  ``options``: fields of :class:`SearchOptions` that differ from
+    its defaults (``rolls``, ``sample``, ``singular_min``, ``jump_threshold``,
+    ``table_z``, ``margin``, ``strategy``, ``q_start``; TypeError for any other name).
     See the module doc for the search; :func:`search_wire_pose` is the same with the
     options as one value and the cell built once by the caller.
     """
-    options = SearchOptions(rolls, sample, singular_min, jump_threshold, table_z, margin,
-                            strategy, q_start)  # fmt: skip
-    return search_wire_pose(frames, tool, options.cell(model, tool, stock), options)
+    opts = replace(SearchOptions(), **options)
+    return search_wire_pose(frames, tool, opts.cell(model, tool, stock), opts)
 
 
 def search_wire_pose(

@@ -26,6 +26,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ...geometry.checks import FloatArray
+from ...robot.ik.path import JUMP_THRESHOLD
 from ..cut.clearance import BOW_STOCK, clearance
 from ..cut.cutpath import CutPath
 from ..job.spec import Job
@@ -421,8 +422,8 @@ def constant_rolls(job: Job, passes: list[CutPath], model: RobotModel | None = N
     return details(ev, np.eye(4))
 
 
-#: the planner's joint step threshold between rulings (rad; ``solve_redundancy``)
-JUMP = 0.5
+#: the planner's joint step threshold between rulings (rad; ``SearchOptions``)
+JUMP = JUMP_THRESHOLD
 
 
 def constant_words(job: Job, model: RobotModel, cp: CutPath, col: ColumnDetail) -> str:

@@ -15,6 +15,7 @@ from ...geometry.box import Box
 from ...geometry.checks import FloatArray
 from ..cut.clearance import Cell
 from ..cut.wire_geometry import chords, flange_poses, slide_bounds, wire_poses
+from ..cut.wire_pose import ROLLS as WIRE_POSE_ROLLS
 from ..job.spec import Job, ToolSpec
 from .margins import Rules
 
@@ -37,10 +38,10 @@ __all__ = [
 #: the two wire directions, in the order of every grid's first axis
 DIRECTIONS = (False, True)
 #: rolls over a turn of the constant-roll model (the planner's own grid: the default
-#: ``rolls`` of :func:`~..cut.wire_pose.solve_redundancy`, so every roll it scores is
+#: ``rolls`` of :class:`~..cut.wire_pose.SearchOptions`, so every roll it scores is
 #: scored here): the placement search, the best constant roll of ``reach`` and of a
 #: failed plan's explanation, and the move it suggests (docs/place.md, "One model")
-ROLLS = 36
+ROLLS = WIRE_POSE_ROLLS
 #: rulings sampled per pass by the constant-roll model (ends included)
 RULINGS = 48
 

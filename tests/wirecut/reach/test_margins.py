@@ -4,7 +4,6 @@ stock of many placements in one clearance call, the quantised clearance."""
 from __future__ import annotations
 
 import dataclasses
-import inspect
 
 import numpy as np
 import pytest
@@ -12,7 +11,7 @@ import pytest
 from ruledrobot.geometry.box import Box
 from ruledrobot.robot import load
 from ruledrobot.wirecut.cut.clearance import Cell, clearance
-from ruledrobot.wirecut.cut.wire_pose import solve_redundancy
+from ruledrobot.wirecut.cut.wire_pose import SearchOptions
 from ruledrobot.wirecut.job.spec import ToolSpec
 from ruledrobot.wirecut.reach.branch_bound import best_of
 from ruledrobot.wirecut.reach.grid import RowBoxes, directions_needed
@@ -29,10 +28,10 @@ TOOL = ToolSpec(np.array([-0.2, 0.0, 0.25]), np.array([0.2, 0.0, 0.25]))
 
 def test_the_rules_are_the_planners():
     """Acceptable (margin >= 0) must mean what the redundancy search accepts."""
-    defaults = {k: p.default for k, p in inspect.signature(solve_redundancy).parameters.items()}
-    assert DEFAULT_RULES.singular_min == defaults["singular_min"]
-    assert DEFAULT_RULES.margin == defaults["margin"]
-    assert defaults["table_z"] == 0.0  # the cell of the map and the search (reach.job_cell)
+    defaults = SearchOptions()  # the search's defaults (solve_redundancy's too)
+    assert DEFAULT_RULES.singular_min == defaults.singular_min
+    assert DEFAULT_RULES.margin == defaults.margin
+    assert defaults.table_z == 0.0  # the cell of the map and the search (reach.job_cell)
 
 
 def test_joint_limit_margin_takes_the_best_whole_turn():

@@ -29,7 +29,7 @@ from ruledrobot.cli import app
 from ruledrobot.place.regions import Region
 from ruledrobot.place.run import run_place
 from ruledrobot.place.search import job_passes
-from ruledrobot.wirecut.cut.wire_pose import solve_redundancy
+from ruledrobot.wirecut.cut.wire_pose import SearchOptions
 from ruledrobot.wirecut.job.load import load_job
 from ruledrobot.wirecut.plan import make_plan
 from ruledrobot.wirecut.reach.evaluate import Evaluator
@@ -108,11 +108,9 @@ def _ur3e(tmp_path: Path, x: float) -> Path:
 
 
 def test_the_constant_roll_grid_is_the_planners():
-    import inspect
-
     from ruledrobot.wirecut.reach.grid import ROLLS
 
-    assert inspect.signature(solve_redundancy).parameters["rolls"].default == ROLLS
+    assert SearchOptions().rolls == ROLLS
 
 
 def test_a_block_out_of_reach_is_told_the_move_that_plans(tmp_path):
