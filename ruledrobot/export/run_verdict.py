@@ -42,7 +42,21 @@ from ..robot.wire.in_stock import runs_of, wire_ends
 from .run_plan import inside_mask
 from .urscript import plan_wire_tolerance
 
-__all__ = ["RunMeasures", "align_recording", "measure_run", "recording_cut"]
+__all__ = [
+    "DEVIATION_LIMIT",
+    "MAX_LATENCY",
+    "RunMeasures",
+    "align_recording",
+    "measure_run",
+    "recording_cut",
+]
+
+#: rad: the largest joint deviation of the arm from the plan a run tolerates (the run
+#: stops beyond it; ``run_trajectory``'s and the verdict's default)
+DEVIATION_LIMIT = 0.05
+#: s: the longest the stream may fall behind its clock, or the controller go silent,
+#: before the run stops (``run_trajectory``'s and the verdict's default)
+MAX_LATENCY = 0.1
 
 
 def align_recording(plan_q: np.ndarray, rec_q: np.ndarray, tags: np.ndarray,
@@ -147,9 +161,9 @@ def measure_run(
     message: str,
     skipped_ranges: list[tuple[int, int]] | tuple[tuple[int, int], ...] = (),
     max_slip: float = 0.0,
-    max_latency: float = 0.1,
+    max_latency: float = MAX_LATENCY,
     max_deviation: float = 0.0,
-    deviation_limit: float = 0.05,
+    deviation_limit: float = DEVIATION_LIMIT,
     speed_scale: float = 1.0,
     wire_tolerance: float | None = None,
 ) -> RunMeasures:

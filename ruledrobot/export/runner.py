@@ -52,7 +52,13 @@ from .run_plan import Entry, plan_entry, recording_path_for, resample, stop_plac
 from .run_program import PathRun, plan_path_run
 from .run_result import ControllerError, RunMode, RunPlan, RunResult
 from .run_supervisor import Child, ChildGone
-from .run_verdict import RunMeasures, align_recording, measure_run
+from .run_verdict import (
+    DEVIATION_LIMIT,
+    MAX_LATENCY,
+    RunMeasures,
+    align_recording,
+    measure_run,
+)
 from .urscript import check_servo_options, plan_wire_tolerance
 
 __all__ = ["ControllerError", "RunMode", "RunPlan", "RunResult", "run_trajectory"]
@@ -93,7 +99,7 @@ def run_trajectory(
     lookahead: float = 0.1,
     gain: float = 300.0,
     speed_scale: float = 1.0,
-    deviation_limit: float = 0.05,
+    deviation_limit: float = DEVIATION_LIMIT,
     dry_run: bool = False,
     progress: ProgressFn | None = None,
     start_index: int = 0,
@@ -104,7 +110,7 @@ def run_trajectory(
     resume_tolerance: float = 0.005,
     resume_window: float = 1.0,
     stop_deceleration: float = 4.0,
-    max_latency: float = 0.1,
+    max_latency: float = MAX_LATENCY,
     path_tolerance: float | None = None,
     path_blend: float = 0.002,
     path_acceleration: float = 1.0,
