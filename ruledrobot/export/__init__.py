@@ -16,7 +16,7 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from ..io.trajectory import WouldReplace, check_export_targets, export_targets
+from ..io.export_targets import WouldReplace, check_export_targets, export_targets
 from ..robot.motion.trajectory import Trajectory
 from .limits import check_trajectory
 from .run_plan import recording_path_for
@@ -55,7 +55,7 @@ def export_trajectory(
     the CSV and its sidecar) exists and is not of the kind it writes there -- a user's
     file, a JSON export where the sidecar would go, a run's recording -- it raises
     :class:`WouldReplace` (a ValueError) naming the file, unless ``force``
-    (:func:`ruledrobot.io.trajectory.check_export_targets`, docs/trajectory.md)."""
+    (:func:`ruledrobot.io.export_targets.check_export_targets`, docs/trajectory.md)."""
     p = Path(path)
     kind = fmt or EXPORT_FORMATS.get(p.suffix.lower())
     if kind is not None and not force:

@@ -11,7 +11,8 @@ from typer.testing import CliRunner
 
 from ruledrobot.cli import app
 from ruledrobot.export import WouldReplace, export_trajectory
-from ruledrobot.io.trajectory import file_kind, write_trajectory
+from ruledrobot.io.export_targets import file_kind
+from ruledrobot.io.trajectory import write_trajectory
 from tests.support.emulators import smooth_trajectory
 
 runner = CliRunner()
