@@ -80,7 +80,7 @@ def plan(
     try:
         t0 = time.perf_counter()
         p = make_plan(job, progress=say)
-        ver = verify_plan(p, say) if simulate and p.motion is not None else None
+        ver = verify_plan(p, say) if simulate and p.reachable else None
         report, verdict = plan_outcome(p, ver)
         trajectory = p.trajectory if p.motion is not None else None
         result = PlanResult(verdict.ok, report, {}, trajectory, p.passes[0], verdict, p)
