@@ -16,6 +16,13 @@ from .checks import FloatArray, as_float_array
 
 __all__ = ["Box"]
 
+#: the unit cube's corners (8, 3), +-1/2, corner 4i + 2j + k at (i, j, k) of (low, high)
+_UNIT_CORNERS = np.array([[i, j, k] for i in (-0.5, 0.5) for j in (-0.5, 0.5)
+                          for k in (-0.5, 0.5)])  # fmt: skip
+#: corner index pairs (12, 2) that differ in one axis: the cube's edges
+_EDGES = np.array([(a, b) for a in range(8) for b in range(a + 1, 8)
+                   if bin(a ^ b).count("1") == 1])  # fmt: skip
+
 
 @dataclass(frozen=True)
 class Box:
@@ -53,6 +60,17 @@ class Box:
         T[:3, :3] = self.rotation
         T[:3, 3] = self.centre
         return T
+
+    @property
+    def corners(self) -> FloatArray:
+        """The 8 corners (8, 3) in world coordinates [m]; corner ``4i + 2j + k`` lies at
+        ``(i, j, k)`` of the box axes' (low, high) halves."""
+        return self.centre + (_UNIT_CORNERS * self.size) @ self.rotation.T
+
+    @property
+    def edges(self) -> FloatArray:
+        """The 12 edges (12, 2, 3) as pairs of corners in world coordinates [m]."""
+        return self.corners[_EDGES]
 
     def to_box(self, points: ArrayLike) -> FloatArray:
         """World points (..., 3) in box coordinates."""

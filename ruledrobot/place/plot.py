@@ -20,10 +20,7 @@ __all__ = ["plot_place"]
 def _outline(job, cand: Candidate | None) -> np.ndarray:
     """The block's footprint (5, 2) [m] (closed) after ``cand``'s placement (None: as is)."""
     j = job if cand is None else cand.placement.job(job)
-    st = j.stock
-    c = np.array([[-1, -1, -1], [1, -1, -1], [1, 1, -1], [-1, 1, -1], [-1, -1, -1]]) * 0.5
-    pts = st.centre + (c * st.size) @ st.rotation.T
-    return pts[:, :2]
+    return j.stock.corners[[0, 4, 6, 2, 0], :2]  # the bottom face, round (Box.corners)
 
 
 def plot_place(path: str | Path, res: PlaceResult, extra: list[Candidate] | None = None,

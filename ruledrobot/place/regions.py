@@ -93,8 +93,7 @@ class Turn:
             axis = stock.rotation[:, "xy".index(self.axis)]
         R = se3.rotation_about_axis(axis, angle)
         c = stock.centre
-        corners = np.array(np.meshgrid([-0.5, 0.5], [-0.5, 0.5], [-0.5, 0.5])).reshape(3, -1).T
-        pts = (corners * stock.size) @ stock.rotation.T
+        pts = stock.corners - stock.centre
         lift = (pts[:, 2].min() - (pts @ R.T)[:, 2].min())  # keep the bottom height
         T = np.eye(4)
         T[:3, :3] = R

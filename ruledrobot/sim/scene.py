@@ -94,8 +94,7 @@ def default_table(model: RobotModel, stock: Box | None = None, margin: float = 0
     reach = float(model.reach) if model.reach else float(np.sum(np.abs(model.a)) + 0.3)
     pts = [np.array([-0.2, -0.2]), np.array([0.2, 0.2])]
     if stock is not None:
-        corners = np.array(np.meshgrid([-0.5, 0.5], [-0.5, 0.5], [-0.5, 0.5])).reshape(3, -1).T
-        xyz = stock.centre + (corners * stock.size) @ stock.rotation.T
+        xyz = stock.corners
         pts += [xyz[:, :2].min(axis=0), xyz[:, :2].max(axis=0)]
     else:
         pts += [np.array([-0.3 * reach, -0.6 * reach]), np.array([0.8 * reach, 0.6 * reach])]

@@ -68,8 +68,7 @@ class TransitPlanner:
             cell = Cell.of(model, job.tool, job.stock, 0.0, margin, 0.0, None)
         else:
             cell = cell.with_rules(0.0, margin, 0.0, None)
-        corners = np.array([[i, j, k] for i in (-1, 1) for j in (-1, 1) for k in (-1, 1)]) * 0.5
-        pts = job.stock.centre + (corners * job.stock.size) @ job.stock.rotation.T
+        pts = job.stock.corners
         lo = np.maximum(model.lower, -2.0 * np.pi)
         hi = np.minimum(model.upper, 2.0 * np.pi)
         return cls(cell, float(pts[:, 2].max()), lo, hi)

@@ -15,22 +15,13 @@ from ...io.pictures import thinned_series
 from ...robot.tool import BowTool
 from ..plan import Plan
 
-__all__ = ["PHASE_COLOURS", "plot_plan", "stock_edges"]
+__all__ = ["PHASE_COLOURS", "plot_plan"]
 
 #: colours of the phases in every picture of a plan
 PHASE_COLOURS = {
     "approach": "0.75", "preheat": "tab:red", "lead_in": "tab:olive", "cut": "tab:green",
     "lead_out": "tab:cyan", "transit": "tab:purple", "retract": "0.55", "move": "0.9",
 }  # fmt: skip
-
-
-def stock_edges(job) -> FloatArray:
-    """The 12 edges (12, 2, 3) of the stock box in the base frame [m]."""
-    corners = np.array([[i, j, k] for i in (-1, 1) for j in (-1, 1) for k in (-1, 1)]) * 0.5
-    pts = job.stock.centre + (corners * job.stock.size) @ job.stock.rotation.T
-    pairs = [(i, j) for i in range(8) for j in range(i + 1, 8)
-             if np.sum(corners[i] != corners[j]) == 1]  # fmt: skip
-    return np.array([[pts[i], pts[j]] for i, j in pairs])
 
 
 def _phase_bands(ax, t: FloatArray, labels: np.ndarray) -> None:
@@ -76,7 +67,7 @@ def plot_plan(path: str | Path, plan: Plan, part=None) -> Path:
         ends = np.stack([G[:, :3, 3] - half * G[:, :3, 2], G[:, :3, 3] + half * G[:, :3, 2]], 1)
         ax.add_collection3d(Line3DCollection(ends[:: max(1, len(ends) // 10)],
                                              colors="tab:orange", linewidths=1.2))  # fmt: skip
-    ax.add_collection3d(Line3DCollection(stock_edges(job), colors="0.4", linewidths=0.8))
+    ax.add_collection3d(Line3DCollection(job.stock.edges, colors="0.4", linewidths=0.8))
     if part is not None:
         tri = part.vertices[part.faces]
         step = max(1, len(tri) // 15000)  # a few thousand facets draw in a second

@@ -1,0 +1,36 @@
+"""Box.corners and Box.edges: the one home of a block's corners (plots, transits,
+placement, scene)."""
+
+from __future__ import annotations
+
+import numpy as np
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from ruledrobot.geometry.box import Box
+from ruledrobot.geometry.se3 import pose_from_rotvec
+
+coords = st.floats(-1.0, 1.0, allow_nan=False)
+sizes = st.floats(0.01, 2.0, allow_nan=False)
+
+
+@settings(max_examples=50, deadline=None)
+@given(st.tuples(coords, coords, coords), st.tuples(sizes, sizes, sizes),
+       st.tuples(coords, coords, coords))
+def test_corners_are_on_the_box_and_edges_have_its_lengths(c, s, rv):
+    box = Box(np.array(c), np.array(s), pose_from_rotvec(np.array(rv))[:3, :3])
+    local = box.to_box(box.corners)
+    np.testing.assert_allclose(np.abs(local), np.broadcast_to(0.5 * box.size, (8, 3)),
+                               atol=1e-12)
+    assert len({tuple(np.sign(p)) for p in local}) == 8  # all eight, once each
+    np.testing.assert_allclose(box.corners.mean(axis=0), box.centre, atol=1e-12)
+    lengths = np.linalg.norm(box.edges[:, 1] - box.edges[:, 0], axis=1)
+    assert box.edges.shape == (12, 2, 3)
+    np.testing.assert_allclose(np.sort(lengths), np.sort(np.repeat(box.size, 4)), rtol=1e-12)
+
+
+def test_corner_order_is_low_high_per_axis():
+    box = Box(np.zeros(3), np.array([2.0, 4.0, 6.0]))
+    np.testing.assert_allclose(box.corners[0], [-1, -2, -3])
+    np.testing.assert_allclose(box.corners[7], [1, 2, 3])
+    np.testing.assert_allclose(box.corners[4 + 2], [1, 2, -3])
