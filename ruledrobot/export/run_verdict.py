@@ -236,19 +236,15 @@ def measure_run(
     of = len(feeds) > 1
     for f in feeds:
         key, name = (f":{f.name}", f" ({f.name})") if of else ("", "")
-        top, low = f.speed * (1 + f.tolerance), f.speed * (1 - f.tolerance)
         scaled = f" at speed scale {speed_scale:g}" if speed_scale != 1.0 else ""
         at_hi = int(idx[f.at_highest]) if f.at_highest >= 0 else -1
         at_lo = int(idx[f.at_lowest]) if f.at_lowest >= 0 else -1
-        checks.append(Check.at_most(
-            "feed_max" + key, f"highest feed of the actual wire in the block{name}{scaled}",
-            1e3 * f.highest if np.isfinite(f.highest) else None, 1e3 * top, "mm/s",
+        checks.extend(f.checks(key, (
+            f"highest feed of the actual wire in the block{name}{scaled}",
+            f"lowest feed of the actual wire in the block{name}{scaled}"), (
             f"{1e3 * f.highest:.2f} mm/s at plan sample {at_hi} against "
-            f"{1e3 * f.speed:.2f} mm/s +{100 * f.tolerance:g} %: the wire drags"))  # fmt: skip
-        checks.append(Check.at_least(
-            "feed_min" + key, f"lowest feed of the actual wire in the block{name}{scaled}",
-            1e3 * f.lowest if np.isfinite(f.lowest) else None, 1e3 * low, "mm/s",
+            f"{1e3 * f.speed:.2f} mm/s +{100 * f.tolerance:g} %: the wire drags",
             f"{1e3 * f.lowest:.2f} mm/s at plan sample {at_lo} against "
-            f"{1e3 * f.speed:.2f} mm/s -{100 * f.tolerance:g} %: a wider kerf there"))  # fmt: skip
+            f"{1e3 * f.speed:.2f} mm/s -{100 * f.tolerance:g} %: a wider kerf there")))  # fmt: skip
     return RunMeasures(Verdict(tuple(checks)), idx, rcut, wis.runs(), feeds, wdev, wat,
                        skipped, n_bad, tuple(bad_runs), max_slip)  # fmt: skip

@@ -10,7 +10,7 @@ from hypothesis import strategies as st
 
 from ruledrobot.geometry import se3
 from ruledrobot.geometry.box import Box
-from ruledrobot.robot.wire.cut import FeedWindow, WireCut, feed_measures
+from ruledrobot.robot.wire.cut import FeedWindow, WireCut, feed_checks, feed_measures
 from ruledrobot.robot.wire.in_stock import (
     TOUCH,
     feed_chord,
@@ -140,3 +140,24 @@ def test_feed_measures_of_windows():
     assert not fm.max_ok and 67 <= fm.at_highest <= 133
     sliced = cut.sliced(100, 201)
     assert sliced.feeds[0].start == 0 and sliced.feeds[0].held == ((0, 20),)
+
+
+def test_a_cut_the_wire_never_made_fails_every_feed_check():
+    """The one feed rule (feed_checks): a window or held range the wire never enters in
+    the stock fails (before, an exported program's check passed it while the run's and
+    the plan's verdicts failed it)."""
+    t = np.linspace(0.0, 2.0, 201)
+    x = -0.3 + 0.3 * t  # in the stock (|x| < 0.1) at samples 67-133
+    ends = np.stack([np.stack([x, -0.5 + 0 * t, 0 * t], 1), np.stack([x, 0.5 + 0 * t, 0 * t], 1)],
+                    axis=1)  # fmt: skip
+    w = wire_in_stock(t, ends, STOCK)
+    missed = WireCut(STOCK, 1.0, (FeedWindow("a", 0, 201, 0.3, 0.05, ((150, 190),)),))
+    (fm,) = feed_measures(w, missed)
+    assert np.isnan(fm.lowest) and not fm.min_ok and fm.max_ok
+    hi, lo = fm.checks(":a")
+    assert (hi.name, lo.name) == ("feed_max:a", "feed_min:a") and hi.ok and not lo.ok
+    (fm,) = feed_measures(w, WireCut(STOCK, 1.0, (FeedWindow("a", 0, 40, 0.3, 0.05),)))
+    assert np.isnan(fm.highest) and not fm.max_ok and not fm.min_ok
+    # the plan's verdict words the same rule in mm/s: at the limit passes, beyond fails
+    assert all(c.ok for c in feed_checks("", 10.5, 9.5, 10.0, 0.05))
+    assert [c.ok for c in feed_checks("", 10.51, 9.49, 10.0, 0.05)] == [False, False]

@@ -23,9 +23,10 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ...geometry.box import Box
+from ..verdict import Check
 from .in_stock import WireInStock, wire_ends, wire_in_stock
 
-__all__ = ["FeedMeasure", "FeedWindow", "WireCut", "feed_measures"]
+__all__ = ["FeedMeasure", "FeedWindow", "WireCut", "feed_checks", "feed_measures"]
 
 
 def _ranges(value: object, what: str) -> tuple[tuple[int, int], ...]:
@@ -139,13 +140,52 @@ class FeedMeasure:
 
     @property
     def max_ok(self) -> bool:
-        """Whether the highest feed is at most ``speed · (1 + tolerance)`` (True if NaN)."""
-        return not self.highest > self.speed * (1.0 + self.tolerance)
+        """Whether the highest feed is at most ``speed · (1 + tolerance)``; False when the
+        wire never entered the stock in the cut's window (:func:`feed_checks`)."""
+        return self.checks()[0].ok
 
     @property
     def min_ok(self) -> bool:
-        """Whether the lowest feed is at least ``speed · (1 - tolerance)`` (True if NaN)."""
-        return not self.lowest < self.speed * (1.0 - self.tolerance)
+        """Whether the lowest feed where it is held is at least ``speed · (1 - tolerance)``;
+        False when the wire was never in the stock there (:func:`feed_checks`)."""
+        return self.checks()[1].ok
+
+    def checks(
+        self,
+        key: str = "",
+        labels: tuple[str, str] = ("highest feed", "lowest feed"),
+        details: tuple[str, str] = ("", ""),
+    ) -> tuple[Check, Check]:
+        """This cut's ``feed_max`` and ``feed_min`` checks (:func:`feed_checks`)."""
+        return feed_checks(key, _mm(self.highest), _mm(self.lowest), self.speed * 1e3,
+                           self.tolerance, labels, details)  # fmt: skip
+
+
+def _mm(x: float) -> float | None:
+    """m (/s) -> mm (/s); None for NaN (not measured)."""
+    return None if np.isnan(x) else float(x) * 1e3
+
+
+def feed_checks(
+    key: str,
+    highest_mm_s: float | None,
+    lowest_mm_s: float | None,
+    speed_mm_s: float,
+    tolerance: float,
+    labels: tuple[str, str] = ("highest feed", "lowest feed"),
+    details: tuple[str, str] = ("", ""),
+) -> tuple[Check, Check]:
+    """The one feed rule of a cut, for the plan's verdict, an exported program's and a
+    run's: ``feed_max<key>``: the highest feed in the stock at most ``speed · (1 +
+    tolerance)``; ``feed_min<key>``: the lowest where it is held at least ``speed · (1 -
+    tolerance)``.  Values in mm/s; None (the wire never in the stock there: the cut was
+    not made) fails.  ``labels`` and ``details`` word the two checks for their report."""
+    return (
+        Check.at_most("feed_max" + key, labels[0], highest_mm_s, speed_mm_s * (1 + tolerance),
+                      "mm/s", details[0]),
+        Check.at_least("feed_min" + key, labels[1], lowest_mm_s, speed_mm_s * (1 - tolerance),
+                       "mm/s", details[1]),
+    )  # fmt: skip
 
 
 def feed_measures(wis: WireInStock, cut: WireCut) -> tuple[FeedMeasure, ...]:

@@ -31,6 +31,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from ...robot.verdict import Check, Verdict
+from ...robot.wire.cut import feed_checks
 
 __all__ = ["CutMeasurements", "Measurements", "collision_sentence", "plan_verdict"]
 
@@ -90,13 +91,11 @@ def _cut_checks(c: CutMeasurements, single: bool) -> list[Check]:
                       "planned wire deviation from the rulings" + of,
                       c.planned_wire_deviation_mm, c.wire_tolerance_mm, "mm",
                       "the planned wire leaves the target rulings"),
-        Check.at_most("feed_max" + key, "highest feed inside the stock" + of, c.feed_max_mm_s,
-                      F * (1 + tol), "mm/s",
-                      f"the wire moves faster than {F:g} mm/s + {100 * tol:g} %"),
-        Check.at_least("feed_min" + key, "lowest feed inside the stock" + of, c.feed_min_mm_s,
-                       F * (1 - tol), "mm/s",
-                       f"the wire slows below {F:g} mm/s - {100 * tol:g} % inside the stock "
-                       f"(a wider kerf there): {c.feed_min_limit or 'see the plots'}"),
+        *feed_checks(key, c.feed_max_mm_s, c.feed_min_mm_s, F, tol, (
+            "highest feed inside the stock" + of, "lowest feed inside the stock" + of), (
+            f"the wire moves faster than {F:g} mm/s + {100 * tol:g} %",
+            f"the wire slows below {F:g} mm/s - {100 * tol:g} % inside the stock "
+            f"(a wider kerf there): {c.feed_min_limit or 'see the plots'}")),
     ]  # fmt: skip
     if c.compensated:
         checks.append(Check.at_most(
