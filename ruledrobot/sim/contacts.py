@@ -16,6 +16,7 @@ from ..geometry.box import Box
 from ..geometry.checks import FloatArray
 from ..geometry.se3 import transform_points
 from ..robot.arm.model import RobotModel
+from ..robot.wire.in_stock import chord_fractions
 from .scene import BowTool
 
 __all__ = ["Collision", "ProgressCallback"]
@@ -194,15 +195,12 @@ def _events(
 def _wire(
     robot: RobotModel, tool: BowTool, stock: Box | None, q: FloatArray
 ) -> tuple[FloatArray, FloatArray | None]:
-    """Wire ends (M, 2, 3) in the base frame and the wire length inside the stock (M,)."""
+    """Wire ends (M, 2, 3) in the base frame and the wire length inside the stock (M,) [m]
+    (:func:`~ruledrobot.robot.wire.in_stock.chord_fractions`: 0 where it only touches)."""
     flange = dataclasses.replace(robot, base=np.eye(4), tool=np.eye(4)).fk(q)
     ends = np.stack([tool.wire_start, tool.wire_end])  # (2, 3)
     wire = transform_points(flange, ends)
     if stock is None:
         return wire, None
-    a, b = wire[:, 0], wire[:, 1]
-    t_in, t_out, hit = stock.clip_lines(a, b - a)
-    lo = np.where(hit, np.maximum(t_in, 0.0), 0.0)
-    hi = np.where(hit, np.minimum(t_out, 1.0), 0.0)
-    inside = np.maximum(hi - lo, 0.0) * tool.wire_length
-    return wire, inside
+    lo, hi = chord_fractions(wire, stock)  # the planner's model: a touch is not inside
+    return wire, np.nan_to_num(hi - lo) * tool.wire_length
