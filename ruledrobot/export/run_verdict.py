@@ -38,7 +38,7 @@ import numpy as np
 from ..robot.motion.trajectory import Trajectory, model_for
 from ..robot.verdict import Check, Verdict
 from ..robot.wire.cut import FeedMeasure, FeedWindow, WireCut, feed_measures
-from ..robot.wire.in_stock import runs_of, wire_ends
+from ..robot.wire.in_stock import largest_line_distance, runs_of, wire_ends
 from .run_plan import inside_mask
 from .urscript import plan_wire_tolerance
 
@@ -214,12 +214,8 @@ def measure_run(
     wis = rcut.measure(rec.t, robot.fk(rec.q))
     # the actual chord's ends from the planned wire (a line) at the matched plan sample
     plan_ends = wire_ends(traj.tcp_poses()[idx], cut.wire_length)
-    a = plan_ends[:, 0]
-    u = plan_ends[:, 1] - a
-    u /= np.linalg.norm(u, axis=1, keepdims=True)
-    p = wis.chord_points() - a[:, None, :]  # (R, 2, 3), NaN outside
-    perp = p - np.einsum("rki,ri->rk", p, u)[:, :, None] * u[:, None, :]
-    dev = np.where(wis.inside, np.nan_to_num(np.linalg.norm(perp, axis=2)).max(axis=1), 0.0)
+    a, b = plan_ends[:, 0], plan_ends[:, 1]
+    dev = largest_line_distance(wis.chord_points(), a, b - a)  # (R,), 0 outside
     if wis.inside.any():
         r = int(np.argmax(dev))
         wdev, wat = float(dev[r]), int(idx[r])

@@ -38,7 +38,7 @@ from ..robot.motion.arm_kinematics import ArmKinematics
 from ..robot.motion.trajectory import Trajectory, model_for, runs
 from ..robot.motion.ur_motion import PathMotion, Segment, joint_segment, linear_segment
 from ..robot.wire.cut import FeedMeasure, FeedWindow, WireCut, feed_measures
-from ..robot.wire.in_stock import wire_ends
+from ..robot.wire.in_stock import largest_line_distance, wire_ends
 
 __all__ = [
     "MATCH_WINDOW",
@@ -226,15 +226,6 @@ def _match(plan_t: np.ndarray, plan_x: np.ndarray, t: np.ndarray, x: np.ndarray,
     return out
 
 
-def _line_distance(points: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """(N, K) distances of points (N, K, 3) from the lines through a, b (N, 3)."""
-    u = b - a
-    u = u / np.maximum(np.linalg.norm(u, axis=-1, keepdims=True), 1e-300)
-    w = points - a[:, None, :]
-    w = w - (w * u[:, None, :]).sum(-1, keepdims=True) * u[:, None, :]
-    return np.linalg.norm(w, axis=-1)
-
-
 def _carried(cut: WireCut, match: np.ndarray) -> WireCut:
     """The plan's feed windows carried to the program's samples by ``match``."""
     feeds = []
@@ -283,7 +274,8 @@ def measure_motion(
         if inside.any():
             chord = wis.chord_points()[inside]
             m = match[inside]
-            dev[inside] = _line_distance(chord, plan_ends[m, 0], plan_ends[m, 1]).max(axis=1)
+            a, b = plan_ends[m, 0], plan_ends[m, 1]
+            dev[inside] = largest_line_distance(chord, a, b - a)
     k = int(np.argmax(dev))
     return ProgramCheck(feeds, float(dev[k]), float(t[k]), float(wire_tolerance),
                         float(t[-1] - t[0]), float(plan_t[-1]), int(t.size), t)  # fmt: skip

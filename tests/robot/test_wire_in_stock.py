@@ -14,6 +14,7 @@ from ruledrobot.robot.wire.cut import FeedWindow, WireCut, feed_checks, feed_mea
 from ruledrobot.robot.wire.in_stock import (
     TOUCH,
     feed_chord,
+    largest_line_distance,
     wire_ends,
     wire_in_stock,
 )
@@ -161,3 +162,20 @@ def test_a_cut_the_wire_never_made_fails_every_feed_check():
     # the plan's verdict words the same rule in mm/s: at the limit passes, beyond fails
     assert all(c.ok for c in feed_checks("", 10.5, 9.5, 10.0, 0.05))
     assert [c.ok for c in feed_checks("", 10.51, 9.49, 10.0, 0.05)] == [False, False]
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**31 - 1))
+def test_largest_line_distance_is_the_projection_residual(seed):
+    """The one deviation measure (plan, program, run) against the projection form."""
+    rng = np.random.default_rng(seed)
+    x = rng.normal(size=(5, 3, 3))
+    o = rng.normal(size=(5, 3))
+    u = rng.normal(size=(5, 3)) * rng.uniform(0.1, 10.0, size=(5, 1))  # any length
+    x[0, 1] = np.nan  # a point left out
+    x[1] = np.nan  # no point: 0
+    n = u / np.linalg.norm(u, axis=1, keepdims=True)
+    w = x - o[:, None]
+    r = np.linalg.norm(w - np.einsum("kpi,ki->kp", w, n)[..., None] * n[:, None], axis=2)
+    np.testing.assert_allclose(largest_line_distance(x, o, u), np.nanmax(
+        np.where(np.isnan(r), -np.inf, r), axis=1).clip(0.0), rtol=1e-12, atol=1e-12)

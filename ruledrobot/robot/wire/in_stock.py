@@ -46,6 +46,7 @@ __all__ = [
     "across_speeds",
     "chord_fractions",
     "feed_chord",
+    "largest_line_distance",
     "runs_of",
     "wire_ends",
     "wire_gap",
@@ -54,6 +55,22 @@ __all__ = [
 
 #: m: a chord shorter than this is not in the stock (the wire only touches the block).
 TOUCH = 1e-6
+
+
+def largest_line_distance(
+    points: ArrayLike, origins: ArrayLike, directions: ArrayLike
+) -> FloatArray:
+    """The largest distance (K,) [m] of points (K, P, 3) from the lines through
+    ``origins`` (K, 3) along ``directions`` (K, 3), normalised here:
+    ``max_p |(x_p - o) x u|``; NaN points are left out (0 when all are).  The wire's
+    deviation from a line — its target ruling (the plan), the planned wire (an exported
+    program, a run) — with the points the chord's ends."""
+    x = np.asarray(points, dtype=np.float64)
+    o = np.asarray(origins, dtype=np.float64)
+    u = np.asarray(directions, dtype=np.float64)
+    u = u / np.linalg.norm(u, axis=-1, keepdims=True)
+    d = np.linalg.norm(np.cross(x - o[:, None, :], u[:, None, :]), axis=-1)
+    return np.nan_to_num(d, nan=0.0).max(axis=1) if d.size else np.zeros(len(o))
 
 
 def wire_ends(tcp: ArrayLike, wire_length: float) -> FloatArray:

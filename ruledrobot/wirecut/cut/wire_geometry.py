@@ -29,7 +29,7 @@ from ...geometry import se3
 from ...geometry.box import Box
 from ...geometry.checks import FloatArray
 from ...robot.tool import BowTool
-from ...robot.wire.in_stock import across_speeds, feed_chord, wire_ends
+from ...robot.wire.in_stock import across_speeds, feed_chord, largest_line_distance, wire_ends
 from ..job.spec import ToolSpec
 
 __all__ = [
@@ -176,8 +176,5 @@ def distance_from_rulings(points: ArrayLike, frames: ArrayLike) -> FloatArray:
     (K, 4, 4) (origin, z axis): ``max_p |(x_p - o) x z|``; NaN points are left out
     (0 when all are NaN).  The wire's deviation from its target ruling, with the points
     its chord ends and the frames the target rulings at the same path parameter."""
-    x = np.asarray(points, dtype=np.float64)
     F = np.asarray(frames, dtype=np.float64)
-    off = x - F[:, None, :3, 3]
-    d = np.linalg.norm(np.cross(off, F[:, None, :3, 2]), axis=-1)
-    return np.nan_to_num(d, nan=0.0).max(axis=1) if d.size else np.zeros(len(F))
+    return largest_line_distance(points, F[:, :3, 3], F[:, :3, 2])
