@@ -15,6 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..robot import RobotModel
+from ..robot.ik.path import LIMIT_TOL
 from ..robot.motion.rates import finite_difference_rates
 from ..robot.motion.trajectory import Trajectory
 
@@ -58,7 +59,7 @@ def check_trajectory(
         raise ValueError(f"trajectory sample {k}: time t = {float(t[k])!r} does not increase")
     ts = (t - t[0]) / speed_scale
     lo, hi = np.asarray(model.lower), np.asarray(model.upper)
-    bad = (q < lo - 1e-9) | (q > hi + 1e-9)
+    bad = (q < lo - LIMIT_TOL) | (q > hi + LIMIT_TOL)
     if bad.any():
         k, j = np.argwhere(bad)[0]
         raise ValueError(

@@ -17,6 +17,7 @@ from ..geometry import se3
 from ..geometry.checks import FloatArray
 from ..io.atomic import atomic_open, atomic_write_text
 from ..robot.arm.model import RobotModel
+from ..robot.motion.rates import RATIO_MAX
 from ..robot.verdict import Check, Verdict
 from .contacts import Collision
 from .mjcf import ServoGains
@@ -109,9 +110,9 @@ class PlaybackResult:
                   "yes" if pos["within_limits"] else "no", "yes", relation="==",
                   ok=bool(pos["within_limits"]), detail="a joint leaves its position range"),
             Check.at_most("joint_speed", "simulated joint speed / limit",
-                          rep["joint_speed"]["max_ratio"], 1.0 + 1e-9),
+                          rep["joint_speed"]["max_ratio"], RATIO_MAX),
             Check.at_most("joint_torque", "simulated joint torque / limit",
-                          rep["joint_torque"]["max_ratio"], 1.0 + 1e-9,
+                          rep["joint_torque"]["max_ratio"], RATIO_MAX,
                           detail="a joint needs more torque than it has"),
             Check.info("tcp_error", "TCP position error (simulated vs reference)",
                        rep["tcp_position_error_mm"]["max"], "mm"),
@@ -166,8 +167,8 @@ class PlaybackResult:
         ok = (
             not collisions
             and within
-            and bool(np.all(tau_ratio <= 1.0 + 1e-9))
-            and bool(np.all(speed_ratio <= 1.0 + 1e-9))
+            and bool(np.all(tau_ratio <= RATIO_MAX))
+            and bool(np.all(speed_ratio <= RATIO_MAX))
         )
         return {
             "format": REPORT_FORMAT,

@@ -145,17 +145,6 @@ def wire_cut(job: Job, motion: Motion, bow: BowTool | None = None) -> WireCut:
     return WireCut(job.stock, bow.wire_length, tuple(feeds))
 
 
-def _position_ratio(model: RobotModel, q: FloatArray) -> float:
-    """Largest |q - centre| / half-range over joints with finite limits (1 = at a limit)."""
-    lo, hi = np.asarray(model.lower), np.asarray(model.upper)
-    fin = np.isfinite(lo) & np.isfinite(hi)
-    if not fin.any():
-        return 0.0
-    lo, hi = lo[fin], hi[fin]
-    mid, half = 0.5 * (lo + hi), 0.5 * (hi - lo)
-    return float((np.abs(q[:, fin] - mid) / half).max())
-
-
 def _bow_outside_cuts(
     job: Job, bow: BowTool, motion: Motion, flange: FloatArray
 ) -> tuple[tuple[dict, ...], tuple[str, ...]]:
@@ -237,7 +226,7 @@ def make_plan(
         flange=flange, feed=feed, deviation=dev,
         ratios=trajectory_limits_report(timed.t, timed.q, model.max_velocity,
                                         model.max_acceleration),
-        position_ratio=_position_ratio(model, timed.q),
+        position_ratio=model.position_ratio(timed.q),
         singularity_min=float(model.singularity_measure(timed.q[cutting]).min()),
         collisions=collisions, sentences=sentences,
     )  # fmt: skip

@@ -40,6 +40,7 @@ from .._checks import (
     readonly,
 )
 from ..ik import analytic as _ik
+from ..ik.path import LIMIT_TOL
 from .calibration import Calibration
 from .inverse import InverseKinematics
 from .kinematics import DHChain
@@ -415,10 +416,23 @@ class RobotModel(InverseKinematics):
         pts = self._chain(self._seed_dh).skeleton(q.reshape(-1, self.n_joints))
         return pts.reshape(*q.shape[:-1], 2 * self.n_joints + 1, 3)
 
-    def within_limits(self, q: ArrayLike, tol: float = 0.0) -> np.ndarray:
-        """(...) bool: every joint of ``q`` (..., J) inside ``[lower - tol, upper + tol]``."""
+    def within_limits(self, q: ArrayLike, tol: float = LIMIT_TOL) -> np.ndarray:
+        """(...) bool: every joint of ``q`` (..., J) inside ``[lower - tol, upper + tol]``
+        [rad] (default the one slack, :data:`~ruledrobot.robot.ik.path.LIMIT_TOL`)."""
         q = self._joints(q)
         return np.all((q >= self.lower - tol) & (q <= self.upper + tol), axis=-1)
+
+    def position_ratio(self, q: ArrayLike) -> float:
+        """The largest ``|q - centre| / (half range + LIMIT_TOL)`` over the samples of
+        ``q`` (..., J) and the joints with finite limits (0 when none): at most 1 exactly
+        when :meth:`within_limits` holds (1 = at a limit, within the one slack)."""
+        q = self._joints(q)
+        fin = np.isfinite(self.lower) & np.isfinite(self.upper)
+        if not fin.any() or q.size == 0:
+            return 0.0
+        lo, hi = self.lower[fin], self.upper[fin]
+        mid, half = 0.5 * (lo + hi), 0.5 * (hi - lo)
+        return float((np.abs(q[..., fin] - mid) / (half + LIMIT_TOL)).max())
 
 
 def _calibration_of(name: str, cal: object) -> Calibration:

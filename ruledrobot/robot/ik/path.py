@@ -75,7 +75,10 @@ class PathArm(Protocol):
 #: rad: a step whose largest joint change exceeds this is a jump (:func:`path_ik`'s
 #: default, and the planner's between rulings: ``wirecut.cut.wire_pose``, ``reach``)
 JUMP_THRESHOLD = 0.5
-_LIMIT_EPS = 1e-9  # rad of slack on the joint limits when placing 2 pi representatives
+#: rad: a joint position up to this far beyond a limit counts as within it — the one
+#: slack of the joint position limits (2 pi representatives placed here, ``RobotModel.
+#: within_limits`` and ``position_ratio``, the export's limit check)
+LIMIT_TOL = 1e-9
 _STEP_CHUNK = 2048  # path steps per chunk when building the (8 x 8) step costs
 
 
@@ -171,9 +174,9 @@ def _representable(x: FloatArray, lo: FloatArray, hi: FloatArray) -> np.ndarray:
     finite_lo = np.isfinite(lo)
     lo_f = np.where(finite_lo, lo, 0.0)
     # smallest representative >= lo, then compare with hi
-    k = np.ceil((lo_f - _LIMIT_EPS - x) / TWO_PI)
+    k = np.ceil((lo_f - LIMIT_TOL - x) / TWO_PI)
     rep = x + TWO_PI * k
-    return np.where(finite_lo, rep <= hi + _LIMIT_EPS, True)
+    return np.where(finite_lo, rep <= hi + LIMIT_TOL, True)
 
 
 def _step_costs(Q: FloatArray, feas: np.ndarray, w: FloatArray) -> FloatArray:
@@ -223,8 +226,8 @@ def _fit_joint(
             u = u + TWO_PI * np.round((pref - u[0]) / TWO_PI)
         return u, wraps
     umin, umax = float(u.min()), float(u.max())
-    kmin = np.ceil((lo - _LIMIT_EPS - umin) / TWO_PI) if np.isfinite(lo) else -np.inf
-    kmax = np.floor((hi + _LIMIT_EPS - umax) / TWO_PI) if np.isfinite(hi) else np.inf
+    kmin = np.ceil((lo - LIMIT_TOL - umin) / TWO_PI) if np.isfinite(lo) else -np.inf
+    kmax = np.floor((hi + LIMIT_TOL - umax) / TWO_PI) if np.isfinite(hi) else np.inf
     if kmin <= kmax:  # always so when one side is unlimited
         if pref is not None:
             k = np.round((pref - u[0]) / TWO_PI)
@@ -241,12 +244,12 @@ def _fit_joint(
     prev: float | None = pref
     while s < n:
         x = u[s]
-        k_lo = np.ceil((lo - _LIMIT_EPS - x) / TWO_PI)  # both limits are finite here
-        k_hi = np.floor((hi + _LIMIT_EPS - x) / TWO_PI)
+        k_lo = np.ceil((lo - LIMIT_TOL - x) / TWO_PI)  # both limits are finite here
+        k_hi = np.floor((hi + LIMIT_TOL - x) / TWO_PI)
         best_k, best_end, best_d = k_lo, s, np.inf
         for k in np.arange(k_lo, k_hi + 1):
             v = u[s:] + TWO_PI * k
-            bad = (v < lo - _LIMIT_EPS) | (v > hi + _LIMIT_EPS)
+            bad = (v < lo - LIMIT_TOL) | (v > hi + LIMIT_TOL)
             end = s + (int(np.argmax(bad)) if bad.any() else n - s)
             dist = 0.0 if prev is None else abs(v[0] - prev)
             if end > best_end or (end == best_end and dist < best_d):

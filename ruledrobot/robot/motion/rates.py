@@ -14,12 +14,15 @@ from numpy.typing import ArrayLike
 
 from ...geometry.checks import FloatArray, as_limits, as_shaped, check_increasing
 
-__all__ = ["RATIO_TOL", "finite_difference_rates", "trajectory_limits_report"]
+__all__ = ["RATIO_MAX", "RATIO_TOL", "finite_difference_rates", "trajectory_limits_report"]
 
 #: Ratios (sampled value / limit) up to ``1 + RATIO_TOL`` count as within the limit:
 #: finite differences of positions of size ~1 rad divided by dt² = 4e-6 s² carry a
 #: rounding error of ~1e-16/4e-6 ≈ 3e-11 rad/s²; 1e-9 covers it with margin.
 RATIO_TOL = 1e-9
+#: the largest ratio within a limit: every check of speeds, accelerations and torques
+#: against their limits (plan, simulation, export) compares with this
+RATIO_MAX = 1.0 + RATIO_TOL
 
 
 def finite_difference_rates(t: FloatArray, q: FloatArray) -> tuple[FloatArray, FloatArray]:
@@ -100,6 +103,6 @@ def trajectory_limits_report(
                 max_acc_ratio=float(r[k, j]), worst_acc=(int(k) + 1, int(j)),
             )  # fmt: skip
     out["ok"] = bool(
-        out["max_speed_ratio"] <= 1.0 + RATIO_TOL and out["max_acc_ratio"] <= 1.0 + RATIO_TOL
+        out["max_speed_ratio"] <= RATIO_MAX and out["max_acc_ratio"] <= RATIO_MAX
     )
     return out

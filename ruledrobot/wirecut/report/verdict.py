@@ -30,6 +30,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from ...robot.motion.rates import RATIO_MAX
 from ...robot.verdict import Check, Verdict
 from ...robot.wire.cut import feed_checks
 
@@ -139,11 +140,11 @@ def plan_verdict(m: Measurements, *, singularity_margin: float) -> Verdict:
         *cut_checks,
         Check.at_most("joint_position", "joint position / limit", m.position_ratio, 1.0,
                       detail="a joint leaves its position range"),
-        Check.at_most("joint_speed", "joint speed / limit", m.speed_ratio, 1.0,
+        Check.at_most("joint_speed", "joint speed / limit", m.speed_ratio, RATIO_MAX,
                       detail="a joint is faster than its limit"),
-        Check.at_most("joint_acceleration", "joint acceleration / limit", m.acc_ratio, 1.0,
+        Check.at_most("joint_acceleration", "joint acceleration / limit", m.acc_ratio, RATIO_MAX,
                       detail="a joint accelerates beyond its limit"),
-        Check.at_most("joint_torque", "simulated joint torque / limit", m.torque_ratio, 1.0,
+        Check.at_most("joint_torque", "simulated joint torque / limit", m.torque_ratio, RATIO_MAX,
                       detail="a joint needs more torque than it has (payload, speed)"),
         Check.at_least("singularity", "singularity measure during the cut", m.singularity_min,
                        singularity_margin, detail="the arm comes too close to a singularity"),

@@ -6,7 +6,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .tolerances import RATIO_TOL, BoolArray, FloatArray, IntArray
+from .tolerances import RATIO_MAX, BoolArray, FloatArray, IntArray
 
 # --------------------------------------------------------------------------- result
 
@@ -84,7 +84,7 @@ class TimedPath:
     @property
     def within_limits(self) -> bool:
         """Whether the sampled joint speeds and accelerations are within the limits."""
-        return self.max_speed_ratio <= 1.0 + RATIO_TOL and self.max_acc_ratio <= 1.0 + RATIO_TOL
+        return self.max_speed_ratio <= RATIO_MAX and self.max_acc_ratio <= RATIO_MAX
 
     @property
     def feed_limited_intervals(self) -> FloatArray:

@@ -11,7 +11,7 @@ from .problem import _Problem
 from .report import _feed_of_samples
 from .result import TimedPath
 from .solvers import _StalledError
-from .tolerances import FEED_HOLD_TOL, FEED_TOL, MAX_SAMPLES, RATIO_TOL, FloatArray
+from .tolerances import FEED_HOLD_TOL, FEED_TOL, MAX_SAMPLES, RATIO_MAX, FloatArray
 
 # --------------------------------------------------------------------------- sampling
 
@@ -94,14 +94,14 @@ def _timed_from_law(
     )  # fmt: skip
     lo: list[FloatArray] = []
     hi: list[FloatArray] = []
-    if tp.max_speed_ratio > 1.0 + RATIO_TOL or tp.max_feed_ratio > 1.0 + FEED_TOL:
+    if tp.max_speed_ratio > RATIO_MAX or tp.max_feed_ratio > 1.0 + FEED_TOL:
         v = np.abs(np.diff(q, axis=0)) / (dt * vlim)
-        k = np.flatnonzero((v > 1.0 + RATIO_TOL).any(axis=1) | (f_ratio > 1.0 + FEED_TOL))
+        k = np.flatnonzero((v > RATIO_MAX).any(axis=1) | (f_ratio > 1.0 + FEED_TOL))
         lo.append(sig[k])
         hi.append(sig[k + 1])
-    if tp.max_acc_ratio > 1.0 + RATIO_TOL:
+    if tp.max_acc_ratio > RATIO_MAX:
         a = np.abs(np.diff(q, 2, axis=0)) / (dt * dt * alim)
-        k = np.flatnonzero((a > 1.0 + RATIO_TOL).any(axis=1))
+        k = np.flatnonzero((a > RATIO_MAX).any(axis=1))
         lo.append(sig[k])
         hi.append(sig[k + 2])
     if not lo:

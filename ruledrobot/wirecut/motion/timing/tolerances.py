@@ -6,9 +6,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ....geometry.checks import FloatArray
-from ....robot.motion.rates import RATIO_TOL
+from ....robot.motion.rates import RATIO_MAX, RATIO_TOL
 
-__all__ = ["RATIO_TOL", "FloatArray"]
+__all__ = ["RATIO_MAX", "RATIO_TOL", "FloatArray"]
 
 BoolArray = NDArray[np.bool_]
 IntArray = NDArray[np.int64]
