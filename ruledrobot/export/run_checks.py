@@ -79,6 +79,11 @@ class ControllerInfo:
         return "unknown" if self.version is None else ".".join(map(str, self.version))
 
 
+#: m, rad: a controller's DH table read over the primary interface equals another table
+#: (the planned one, the catalogue's) when no entry differs by more than this
+DH_TOL = 1e-12
+
+
 def _read_line(sock: socket.socket, buf: bytearray, deadline: float) -> str:
     while b"\n" not in buf:
         left = deadline - time.monotonic()
@@ -188,14 +193,14 @@ def controller_checks(meta: TrajectoryMeta, info: ControllerInfo) -> list[Check]
 def kinematics_check(meta: TrajectoryMeta, host: str, *, timeout: float = 3.0,
                      force: bool = False) -> tuple[Check, KinematicsRef | None]:  # fmt: skip
     """The controller's kinematics (KinematicsInfo, primary interface) against the ones
-    the trajectory was planned with: the same DH table (to 1e-12) and, when the
+    the trajectory was planned with: the same DH table (to :data:`DH_TOL`) and, when the
     trajectory knows them, the same per-joint checksums.  ``force`` turns a mismatch
     into information (a conscious choice, shown as such).  Also returns the
     controller's kinematics (None when not read): a recording is in *its* frame."""
     check, info = _kinematics_check(meta, host, timeout, force)
     if info is None:
         return check, None
-    nominal = not np.any(np.abs(info.dh() - _nominal_dh(meta.robot)) > 1e-12)
+    nominal = _is_nominal(info.dh(), meta.robot)
     ref = KinematicsRef(info.dh(), "nominal" if nominal else f"controller {host}", "",
                         None if nominal else tuple(int(c) for c in info.checksum))  # fmt: skip
     return check, ref
@@ -217,7 +222,7 @@ def _kinematics_check(meta: TrajectoryMeta, host: str, timeout: float, force: bo
     planned = meta.kinematics.dh
     diff = info.dh() - planned
     names = ("theta_offset", "a", "d", "alpha")
-    off = np.argwhere(np.abs(diff) > 1e-12)[:4]
+    off = np.argwhere(np.abs(diff) > DH_TOL)[:4]
     problems = [f"joint {j + 1} {names[c]}: controller {info.dh()[j, c]:.9g}, planned "
                 f"{planned[j, c]:.9g}" for j, c in off]  # fmt: skip
     want = meta.kinematics.controller_checksum
@@ -225,8 +230,7 @@ def _kinematics_check(meta: TrajectoryMeta, host: str, timeout: float, force: bo
         bad = [j + 1 for j in range(6) if info.checksum[j] != want[j]]
         problems.append(f"checksums of joints {bad} differ (controller {list(info.checksum)}, "
                         f"planned {list(want)})")  # fmt: skip
-    source = "nominal" if not np.any(np.abs(
-        info.dh() - _nominal_dh(meta.robot)) > 1e-12) else "calibrated"  # fmt: skip
+    source = "nominal" if _is_nominal(info.dh(), meta.robot) else "calibrated"
     value = f"{source}, checksums {list(info.checksum)}"
     if not problems:
         return Check("kinematics", label, value, "the trajectory's", relation="==", ok=True), info
@@ -238,6 +242,12 @@ def _kinematics_check(meta: TrajectoryMeta, host: str, timeout: float, force: bo
                           detail=detail), info  # fmt: skip
     return Check("kinematics", label, value, "the trajectory's", relation="==", ok=False,
                  detail=detail), info  # fmt: skip
+
+
+def _is_nominal(dh: np.ndarray, robot: str) -> bool:
+    """Whether a controller's DH table (6, 4) is the catalogue's of ``robot`` (to
+    :data:`DH_TOL`)."""
+    return not np.any(np.abs(dh - _nominal_dh(robot)) > DH_TOL)
 
 
 def _nominal_dh(robot: str) -> np.ndarray:
