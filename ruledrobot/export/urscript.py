@@ -51,7 +51,7 @@ from ..geometry.se3 import ur_vector_from_pose
 from ..io.atomic import atomic_write_text
 from ..io.trajectory import write_trajectory, write_trajectory_json, write_trajectory_npz
 from ..robot import model_for
-from ..robot.motion.trajectory import Trajectory
+from ..robot.motion.trajectory import HEATED_PHASES, Trajectory
 from .decimate import path_steps
 from .heat import urscript_heat
 from .limits import check_trajectory
@@ -88,8 +88,6 @@ MAX_PROGRAM_BYTES = 2_000_000
 #: servoj/lookahead ranges the controller accepts (URScript manual).
 LOOKAHEAD_RANGE = (0.03, 0.2)
 GAIN_RANGE = (100.0, 2000.0)
-#: phases whose TCP speed a path program keeps within 2 % (the wire near or in the stock)
-CUTTING_PHASES = ("preheat", "lead_in", "cut", "lead_out")
 
 
 def check_servo_options(lookahead: float, gain: float) -> None:
@@ -142,7 +140,7 @@ def path_program(
     bounds += [x for r in meta.in_stock for x in r]
     strict = np.zeros(n, dtype=bool) if meta.phases else np.ones(n, dtype=bool)
     for p in meta.phases:
-        if p.name in CUTTING_PHASES:
+        if p.name in HEATED_PHASES:  # the wire near or in the stock: speed within 2 %
             strict[p.start : p.stop] = True
     strict |= traj.inside_stock() | (heat if heat is not None else False)
     tol = 0.25 * wire_tolerance if tolerance is None else tolerance

@@ -32,12 +32,11 @@ from ..geometry._arrays import FloatArray
 from ..geometry.box import Box
 from ..geometry.interp import interp_linear
 from ..geometry.se3 import transform_points
+from ..robot.motion.trajectory import CUTTING_PHASES
 from ..robot.wire.in_stock import chord_fractions, wire_in_stock
 
-__all__ = ["CUTTING_PHASES", "CutAnnotator", "phase_labels"]
+__all__ = ["CutAnnotator", "phase_labels"]
 
-#: Phases in which the wire cuts (the close-up is shown then).
-CUTTING_PHASES = ("lead_in", "cut", "lead_out")
 _MAX_DECOR = 1200  # decorative geoms per frame at most (older ones are thinned)
 _CUT_RGBA = np.array([0.95, 0.45, 0.10, 1.0], np.float32)
 _WIRE_RGBA = np.array([0.90, 0.05, 0.05, 1.0], np.float32)

@@ -25,7 +25,8 @@ from typing import Any
 
 import numpy as np
 
-from .scene import CUTTING_PHASES, PlanScene
+from ..robot.motion.trajectory import CUTTING_PHASES
+from .scene import PlanScene
 
 __all__ = ["PHASE_COLOURS", "Painter", "caption", "figures_markdown"]
 

@@ -50,8 +50,6 @@ NEAR_MISS = 0.02
 CLEARANCE_STEP = 0.01
 #: The browser's first view: the video's camera moved this fraction of the way to its target.
 CAMERA_ZOOM = 0.7
-#: Phases in which the wire cuts (the video's close-up camera, the viewer's colours).
-CUTTING_PHASES = ("lead_in", "cut", "lead_out")
 
 
 @dataclass(frozen=True, eq=False)

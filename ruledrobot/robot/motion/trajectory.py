@@ -42,6 +42,8 @@ from ..wire.in_stock import WireInStock, runs_of
 from .rates import finite_difference_rates
 
 __all__ = [
+    "CUTTING_PHASES",
+    "HEATED_PHASES",
     "PHASE_NAMES",
     "Heat",
     "KinematicsRef",
@@ -59,6 +61,12 @@ __all__ = [
 PHASE_NAMES = (
     "approach", "preheat", "lead_in", "cut", "lead_out", "retract", "transit", "move",
 )
+#: the phases in which the wire goes through the stock: it cuts (the simulation's and the
+#: viewer's "cutting"; a touch of the block outside them is a collision)
+CUTTING_PHASES = ("lead_in", "cut", "lead_out")
+#: the phases with the wire hot: the cutting phases and the preheat before them (the
+#: planner's heat windows; a path program keeps the TCP speed tight in them)
+HEATED_PHASES = ("preheat", *CUTTING_PHASES)
 
 
 def kinematics_checksum(dh: ArrayLike) -> str:

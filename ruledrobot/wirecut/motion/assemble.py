@@ -28,6 +28,7 @@ from ...geometry.angles import wrap_near
 from ...geometry.checks import FloatArray
 from ...robot.arm.model import RobotModel
 from ...robot.arm.nearest import nearest_ik
+from ...robot.motion.trajectory import HEATED_PHASES
 from ...robot.tool import BowTool
 from ...robot.wire.in_stock import WireInStock, wire_ends, wire_gap, wire_in_stock
 from ..cut.clearance import Cell
@@ -345,6 +346,6 @@ def _label(job: Job, model: RobotModel, bow: BowTool, whole: TimedPath, b: _Buil
     surface = in_stock & (labels == "cut")
     heat = np.zeros(M, dtype=bool)
     if job.tool.heat is not None:
-        heat = np.isin(labels.astype(str), ("preheat", "lead_in", "cut", "lead_out"))
+        heat = np.isin(labels.astype(str), HEATED_PHASES)
     return Motion(whole, labels, pass_of, s, in_stock, _chord_in_flange(bow, wire), heat,
                   tuple(notes), tuple(passes), surface, stop & surface, wire)
