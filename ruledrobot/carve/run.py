@@ -98,7 +98,9 @@ def carve(cell_path: str | os.PathLike[str], out: str | os.PathLike[str],
     with staged:
         t = time.perf_counter()
         query = MeshQuery(part)
-        lead = float(cell.tables.get("cut", {}).get("lead_in", 0.02))
+        from ..wirecut.job.spec import CutSpec
+
+        lead = float(cell.tables.get("cut", {}).get("lead_in", CutSpec.lead_in))
         plan = find_cuts(part, cell.stock, query, cell.part.tolerance, cell.part.rough_cuts,
                          lead, progress)  # fmt: skip
         times["cuts"] = time.perf_counter() - t

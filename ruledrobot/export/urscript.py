@@ -52,6 +52,7 @@ from ..io.atomic import atomic_write_text
 from ..io.trajectory import write_trajectory, write_trajectory_json, write_trajectory_npz
 from ..robot import model_for
 from ..robot.motion.trajectory import HEATED_PHASES, Trajectory
+from ..robot.wire.cut import WIRE_TOLERANCE
 from .decimate import path_steps
 from .heat import urscript_heat
 from .limits import check_trajectory
@@ -114,7 +115,7 @@ def plan_wire_tolerance(traj: Trajectory, wire_tolerance: float | None = None) -
     sidecar's ``cut``), or 0.5 mm for a trajectory that names no cut."""
     if wire_tolerance is not None:
         return float(wire_tolerance)
-    return traj.meta.cut.wire_tolerance if traj.meta.cut is not None else 0.0005
+    return traj.meta.cut.wire_tolerance if traj.meta.cut is not None else WIRE_TOLERANCE
 
 
 def path_program(

@@ -37,7 +37,7 @@ import numpy as np
 from ..robot.motion.arm_kinematics import ArmKinematics
 from ..robot.motion.trajectory import Trajectory, model_for, runs
 from ..robot.motion.ur_motion import PathMotion, Segment, joint_segment, linear_segment
-from ..robot.wire.cut import FeedMeasure, FeedWindow, WireCut, feed_measures
+from ..robot.wire.cut import WIRE_TOLERANCE, FeedMeasure, FeedWindow, WireCut, feed_measures
 from ..robot.wire.in_stock import largest_line_distance, wire_ends
 
 __all__ = [
@@ -247,7 +247,7 @@ def measure_motion(
     t: np.ndarray,
     q: np.ndarray,
     *,
-    wire_tolerance: float = 0.0005,
+    wire_tolerance: float = WIRE_TOLERANCE,
     window: float = MATCH_WINDOW,
 ) -> ProgramCheck:
     """Measure a joint motion ``(t, q)`` of ``traj``'s robot and TCP — a program's
@@ -285,7 +285,7 @@ def check_path_program(
     traj: Trajectory,
     ops: Sequence[Op],
     *,
-    wire_tolerance: float = 0.0005,
+    wire_tolerance: float = WIRE_TOLERANCE,
     window: float = MATCH_WINDOW,
 ) -> ProgramCheck:
     """Generate the motion of ``ops`` (:func:`simulate_path_program`) and measure it

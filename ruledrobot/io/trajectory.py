@@ -55,7 +55,7 @@ from ..robot.motion.trajectory import (
     Trajectory,
     TrajectoryMeta,
 )
-from ..robot.wire.cut import FeedWindow, WireCut
+from ..robot.wire.cut import WIRE_TOLERANCE, FeedWindow, WireCut
 from .atomic import atomic_write_bytes, atomic_write_text
 from .text import read_user_text
 
@@ -214,7 +214,7 @@ def _cut(d: _Doc) -> WireCut | None:
             feeds.append(FeedWindow(str(w["name"]), int(w["start"]), int(w["stop"]),
                                     float(w["speed_m_s"]), float(w["tolerance"]),
                                     tuple(tuple(r) for r in w.get("held", [])),
-                                    float(w.get("wire_tolerance_m", 0.0005))))  # fmt: skip
+                                    float(w.get("wire_tolerance_m", WIRE_TOLERANCE))))  # fmt: skip
         except (KeyError, TypeError, ValueError, AttributeError) as exc:
             raise d.fail(f"cut.feeds[{i}]", "expected {name, start, stop, speed_m_s, tolerance, "
                          f"held}}: {exc}") from None  # fmt: skip

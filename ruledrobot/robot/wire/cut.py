@@ -26,7 +26,12 @@ from ...geometry.box import Box
 from ..verdict import Check
 from .in_stock import WireInStock, wire_ends, wire_in_stock
 
-__all__ = ["FeedMeasure", "FeedWindow", "WireCut", "feed_checks", "feed_measures"]
+__all__ = ["WIRE_TOLERANCE", "FeedMeasure", "FeedWindow", "WireCut", "feed_checks",
+           "feed_measures"]
+
+#: m: how far the wire may stray from its target in the stock, by default (a job's
+#: ``wire_tolerance``; a trajectory whose sidecar names none)
+WIRE_TOLERANCE = 0.0005
 
 
 def _ranges(value: object, what: str) -> tuple[tuple[int, int], ...]:
@@ -52,7 +57,7 @@ class FeedWindow:
     speed: float
     tolerance: float
     held: tuple[tuple[int, int], ...] = ()
-    wire_tolerance: float = 0.0005
+    wire_tolerance: float = WIRE_TOLERANCE
 
     def __post_init__(self) -> None:
         if not 0 <= int(self.start) < int(self.stop):
@@ -112,7 +117,7 @@ class WireCut:
     @property
     def wire_tolerance(self) -> float:
         """m: the strictest of the passes' wire tolerances (0.5 mm without passes)."""
-        return min((w.wire_tolerance for w in self.feeds), default=0.0005)
+        return min((w.wire_tolerance for w in self.feeds), default=WIRE_TOLERANCE)
 
     def measure(self, t: ArrayLike, tcp: ArrayLike) -> WireInStock:
         """The wire against the block along TCP poses ``tcp`` (M, 4, 4) at times ``t`` (M,)."""

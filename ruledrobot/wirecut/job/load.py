@@ -113,8 +113,8 @@ def _tool(t: Section) -> ToolSpec:
     heat = None
     if t.get("heat") is not None:
         heat = parse_heat(Section(t.raw, "heat", t.where, title=f"{t.title}.heat"))
-    tool = ToolSpec(w0, w1, clearance=t.number("clearance", 0.02, lo=0.0),
-                    mass=t.number("mass", 1.0, lo=0.0), heat=heat)  # fmt: skip
+    tool = ToolSpec(w0, w1, clearance=t.number("clearance", ToolSpec.clearance, lo=0.0),
+                    mass=t.number("mass", ToolSpec.mass, lo=0.0), heat=heat)  # fmt: skip
     if 2 * tool.clearance >= length:
         raise t.fail(
             "clearance",
@@ -151,15 +151,19 @@ def _cut(c: Section, name: str, surface: SurfaceSpec, surface_title: str = "surf
     cut = CutSpec(
         name=name,
         surface=surface,
-        feed_speed=c.number("feed_speed", 0.01, lo=0.0, hi=1.0, strict_lo=True),
-        lead_in=c.number("lead_in", 0.02, lo=0.0),
-        lead_out=c.number("lead_out", 0.02, lo=0.0),
-        approach_speed=c.number("approach_speed", 0.3, lo=0.0, hi=1.0, strict_lo=True),
-        kerf=c.number("kerf", 0.0008, lo=0.0),
+        # the defaults are CutSpec's own (one home: a job built in memory plans the same)
+        feed_speed=c.number("feed_speed", CutSpec.feed_speed, lo=0.0, hi=1.0, strict_lo=True),
+        lead_in=c.number("lead_in", CutSpec.lead_in, lo=0.0),
+        lead_out=c.number("lead_out", CutSpec.lead_out, lo=0.0),
+        approach_speed=c.number("approach_speed", CutSpec.approach_speed, lo=0.0, hi=1.0,
+                                strict_lo=True),
+        kerf=c.number("kerf", CutSpec.kerf, lo=0.0),
         keep=_keep(c, closed),
-        wire_tolerance=c.number("wire_tolerance", 0.0005, lo=0.0, strict_lo=True),
-        feed_tolerance=c.number("feed_tolerance", 0.05, lo=0.0, hi=1.0, strict_lo=True),
-        extend=c.flag("extend", False),
+        wire_tolerance=c.number("wire_tolerance", CutSpec.wire_tolerance, lo=0.0,
+                                strict_lo=True),
+        feed_tolerance=c.number("feed_tolerance", CutSpec.feed_tolerance, lo=0.0, hi=1.0,
+                                strict_lo=True),
+        extend=c.flag("extend", CutSpec.extend),
     )
     if cut.extend and closed:
         raise c.fail("extend", "only for an open surface (a closed one is entered through a "

@@ -15,6 +15,7 @@ import numpy as np
 from ...geometry.box import Box
 from ...geometry.lines import Lines
 from ...robot.arm.calibration import Calibration
+from ...robot.wire.cut import WIRE_TOLERANCE
 
 __all__ = ["CutSpec", "HeatSpec", "Job", "RobotSpec", "SurfaceSpec", "ToolSpec"]
 
@@ -192,7 +193,7 @@ class CutSpec:
     approach_speed: float = 0.3
     kerf: float = 0.0008
     keep: str | np.ndarray | None = field(default=None, repr=False)
-    wire_tolerance: float = 0.0005
+    wire_tolerance: float = WIRE_TOLERANCE
     feed_tolerance: float = 0.05
     extend: bool = False
 
