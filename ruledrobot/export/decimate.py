@@ -17,6 +17,7 @@ from itertools import pairwise
 import numpy as np
 
 from ..geometry.se3 import pose_from_rotvec, rotvec_from_matrix
+from .settings import PATH_BLEND
 
 __all__ = ["PathStep", "decimate_points", "decimate_tcp_path", "path_steps"]
 
@@ -179,7 +180,7 @@ def path_steps(
     speed_change: float = 0.02,
     free_speed_change: float = 0.10,
     speed_floor: float = 1e-4,
-    blend: float = 0.002,
+    blend: float = PATH_BLEND,
     min_dwell: float = 0.05,
 ) -> tuple[PathStep, ...]:
     """The steps of a path program playing the plan's samples — TCP ``tcp`` (M, 6), joints

@@ -18,6 +18,7 @@ from __future__ import annotations
 import socket
 from typing import Any
 
+from ..protocol.primary import SECONDARY_PORT
 from ..robot.motion.trajectory import Heat
 
 __all__ = ["heat_off_program", "send_heat_off", "set_heat_rtde", "urscript_heat"]
@@ -48,10 +49,6 @@ def set_heat_rtde(io: Any, heat: Heat, on: bool) -> bool:
     if heat.kind == "tool":
         return bool(io.setToolDigitalOut(n, on))
     return bool(io.setAnalogOutputCurrent(n, heat.value if on else 0.0))
-
-
-#: the controller's secondary client interface (URScript in, robot state out)
-SECONDARY_PORT = 30002
 
 
 def send_heat_off(host: str, heat: Heat, timeout: float = 2.0) -> str:

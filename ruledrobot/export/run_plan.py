@@ -38,6 +38,7 @@ import numpy as np
 
 from ..robot.motion.trajectory import Trajectory
 from ..robot.verdict import Check
+from .settings import APPROACH_ACCELERATION, APPROACH_SPEED
 
 __all__ = [
     "Entry",
@@ -148,8 +149,8 @@ def plan_entry(
     *,
     tolerance: float = 0.005,
     window: float = 1.0,
-    approach_speed: float = 0.25,
-    approach_acceleration: float = 0.5,
+    approach_speed: float = APPROACH_SPEED,
+    approach_acceleration: float = APPROACH_ACCELERATION,
 ) -> Entry:
     """Decide how to enter ``traj`` at sample ``requested`` from the pose ``q_actual``."""
     q = np.asarray(traj.q, dtype=float)

@@ -29,6 +29,7 @@ import numpy as np
 from ..robot.motion.trajectory import Heat, Trajectory
 from ..robot.verdict import Check
 from ..robot.wire.cut import FeedWindow, WireCut
+from .settings import PATH_ACCELERATION, PATH_BLEND
 from .urscript import path_program
 from .verify_program import Move, Op, ProgramCheck, Sleep, Switch, check_path_program
 
@@ -146,8 +147,8 @@ def plan_path_run(
     *,
     speed_scale: float = 1.0,
     tolerance: float | None = None,
-    blend: float = 0.002,
-    acceleration: float = 1.0,
+    blend: float = PATH_BLEND,
+    acceleration: float = PATH_ACCELERATION,
     wire_tolerance: float,
 ) -> PathRun:
     """The path program of ``traj`` from sample ``start`` at ``speed_scale``

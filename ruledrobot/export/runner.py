@@ -59,6 +59,14 @@ from .run_verdict import (
     align_recording,
     measure_run,
 )
+from .settings import (
+    APPROACH_ACCELERATION,
+    APPROACH_SPEED,
+    PATH_ACCELERATION,
+    PATH_BLEND,
+    SERVO_GAIN,
+    SERVO_LOOKAHEAD,
+)
 from .urscript import check_servo_options, plan_wire_tolerance
 
 __all__ = ["ControllerError", "RunMode", "RunPlan", "RunResult", "run_trajectory"]
@@ -96,8 +104,8 @@ def run_trajectory(
     model: RobotModel | str | None = None,
     *,
     mode: str | RunMode = "servoj",
-    lookahead: float = 0.1,
-    gain: float = 300.0,
+    lookahead: float = SERVO_LOOKAHEAD,
+    gain: float = SERVO_GAIN,
     speed_scale: float = 1.0,
     deviation_limit: float = DEVIATION_LIMIT,
     dry_run: bool = False,
@@ -105,15 +113,15 @@ def run_trajectory(
     start_index: int = 0,
     confirm: Callable[[RunPlan], bool] | None = None,
     force_kinematics: bool = False,
-    approach_speed: float = 0.25,
-    approach_acceleration: float = 0.5,
+    approach_speed: float = APPROACH_SPEED,
+    approach_acceleration: float = APPROACH_ACCELERATION,
     resume_tolerance: float = 0.005,
     resume_window: float = 1.0,
     stop_deceleration: float = 4.0,
     max_latency: float = MAX_LATENCY,
     path_tolerance: float | None = None,
-    path_blend: float = 0.002,
-    path_acceleration: float = 1.0,
+    path_blend: float = PATH_BLEND,
+    path_acceleration: float = PATH_ACCELERATION,
     actual_path: str | os.PathLike[str] | None = None,
     watchdog: float = 2.0,
     heartbeat: float = 1.0,

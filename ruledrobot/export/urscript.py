@@ -56,6 +56,14 @@ from ..robot.wire.cut import WIRE_TOLERANCE
 from .decimate import path_steps
 from .heat import urscript_heat
 from .limits import check_trajectory
+from .settings import (
+    APPROACH_ACCELERATION,
+    APPROACH_SPEED,
+    PATH_ACCELERATION,
+    PATH_BLEND,
+    SERVO_GAIN,
+    SERVO_LOOKAHEAD,
+)
 from .verify_program import (
     Move,
     Op,
@@ -123,8 +131,8 @@ def path_program(
     *,
     tolerance: float | None = None,
     angle_tolerance: float | None = None,
-    blend: float = 0.002,
-    acceleration: float = 1.0,
+    blend: float = PATH_BLEND,
+    acceleration: float = PATH_ACCELERATION,
     wire_tolerance: float | None = None,
 ) -> list[Op]:
     """The statements of a movel/movep program of ``traj`` after its initial ``movej``:
@@ -185,14 +193,14 @@ def urscript_program(
     traj: Trajectory,
     *,
     mode: str = "servoj",
-    lookahead: float = 0.1,
-    gain: float = 300.0,
-    approach_speed: float = 0.25,
-    approach_acceleration: float = 0.5,
+    lookahead: float = SERVO_LOOKAHEAD,
+    gain: float = SERVO_GAIN,
+    approach_speed: float = APPROACH_SPEED,
+    approach_acceleration: float = APPROACH_ACCELERATION,
     tolerance: float | None = None,
     angle_tolerance: float | None = None,
-    blend: float = 0.002,
-    acceleration: float = 1.0,
+    blend: float = PATH_BLEND,
+    acceleration: float = PATH_ACCELERATION,
     wire_tolerance: float | None = None,
     verify: bool = True,
     name: str = "ruledrobot_cut",

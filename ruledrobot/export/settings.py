@@ -1,0 +1,27 @@
+"""The motion settings an exported program and a run share by default, in one place so
+that ``ruledrobot run`` streams or sends exactly the program ``ruledrobot export``
+writes for the same samples (``run_program``'s promise) — and the controller's ranges
+they are checked against live beside them in :mod:`.urscript`."""
+
+from __future__ import annotations
+
+__all__ = [
+    "APPROACH_ACCELERATION",
+    "APPROACH_SPEED",
+    "PATH_ACCELERATION",
+    "PATH_BLEND",
+    "SERVO_GAIN",
+    "SERVO_LOOKAHEAD",
+]
+
+#: s: servoj's lookahead time (URScript ``lookahead_time``)
+SERVO_LOOKAHEAD = 0.1
+#: servoj's proportional gain (URScript ``gain``)
+SERVO_GAIN = 300.0
+#: rad/s and rad/s²: the joint move (``movej``) to the first sample
+APPROACH_SPEED = 0.25
+APPROACH_ACCELERATION = 0.5
+#: m: the blend radius of a movel/movep path program's moves
+PATH_BLEND = 0.002
+#: m/s²: the tool acceleration of a movel/movep path program's moves
+PATH_ACCELERATION = 1.0
