@@ -96,10 +96,13 @@ def job_reference(job: Job | Plan) -> dict[str, str] | None:
     :class:`Plan`, the reference it hashed when it was made."""
     if isinstance(job, Plan):
         return job.job_ref if job.job_ref is not None else job_reference(job.job)
-    data = job_source_bytes(job)
-    if data is None:
-        return None
-    return {"path": str(job.source), "sha256": hashlib.sha256(data).hexdigest()}
+    return _reference(job, job_source_bytes(job))
+
+
+def _reference(job: Job, data: bytes | None) -> dict[str, str] | None:
+    """``{"path", "sha256"}`` of the job file's bytes ``data`` (None: none)."""
+    return None if data is None else {"path": str(job.source),
+                                      "sha256": hashlib.sha256(data).hexdigest()}  # fmt: skip
 
 
 def wire_deviation(plan: Plan, q: FloatArray) -> FloatArray:
@@ -190,8 +193,7 @@ def make_plan(
     timings: dict[str, float] = {}
     model = job.robot_model() if model is None else model
     data = job_source_bytes(job)
-    ref = None if data is None else {"path": str(job.source),
-                                     "sha256": hashlib.sha256(data).hexdigest()}  # fmt: skip
+    ref = _reference(job, data)
     bow = BowTool.from_spec(job.tool)
     options = job_search(job, search)
     cell = options.cell(model, bow, job.stock)

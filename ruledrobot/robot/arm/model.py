@@ -32,6 +32,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ...geometry import se3
 from .._checks import (
     FloatArray,
     as_array,
@@ -56,13 +57,6 @@ _UR_ALPHA = np.array([np.pi / 2, 0.0, 0.0, np.pi / 2, -np.pi / 2, 0.0])
 
 def _identity() -> FloatArray:
     return readonly(np.eye(4))
-
-
-def _inverse(T: FloatArray) -> FloatArray:
-    out = np.eye(4)
-    out[:3, :3] = T[:3, :3].T
-    out[:3, 3] = -T[:3, :3].T @ T[:3, 3]
-    return out
 
 
 @dataclass(frozen=True, eq=False, kw_only=True)
@@ -192,8 +186,8 @@ class RobotModel(InverseKinematics):
         put(self, "_seed_dh", seed_dh)
         put(self, "_refine", refine)
         eye = np.eye(4)
-        put(self, "_base_inv", None if np.array_equal(self.base, eye) else _inverse(self.base))
-        put(self, "_tool_inv", None if np.array_equal(self.tool, eye) else _inverse(self.tool))
+        put(self, "_base_inv", None if np.array_equal(self.base, eye) else se3.inverse(self.base))
+        put(self, "_tool_inv", None if np.array_equal(self.tool, eye) else se3.inverse(self.tool))
 
     # ------------------------------------------------------------------ construction
 
