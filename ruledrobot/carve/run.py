@@ -98,7 +98,7 @@ def carve(cell_path: str | os.PathLike[str], out: str | os.PathLike[str],
     with staged:
         t = time.perf_counter()
         query = MeshQuery(part)
-        from ..wirecut.job.spec import CutSpec
+        from ..wirecut import CutSpec  # its defaults: the lead the planner uses
 
         lead = float(cell.tables.get("cut", {}).get("lead_in", CutSpec.lead_in))
         plan = find_cuts(part, cell.stock, query, cell.part.tolerance, cell.part.rough_cuts,

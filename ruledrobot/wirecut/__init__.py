@@ -7,8 +7,9 @@ Usage::
 """
 
 from .job.load import Job, load_job, parse_job
+from .job.spec import CutSpec
 from .planner import PlanResult, plan
 from .report.part_mesh import part_mesh, part_sdf, signed_volume, stock_mesh
 
-__all__ = ["Job", "PlanResult", "load_job", "parse_job", "part_mesh", "part_sdf", "plan",
+__all__ = ["CutSpec", "Job", "PlanResult", "load_job", "parse_job", "part_mesh", "part_sdf", "plan",
            "signed_volume", "stock_mesh"]
