@@ -45,6 +45,7 @@ from ..io.trajectory import read_trajectory, sidecar_path, write_trajectory
 from ..robot import RobotModel, load, model_for
 from ..robot.motion.trajectory import Trajectory
 from ..robot.verdict import Check, Verdict
+from . import settings  # the defaults a run shares with the exported program
 from .heat import send_heat_off
 from .limits import check_trajectory
 from .run_checks import controller_checks, kinematics_check, query_dashboard, readiness_check
@@ -58,14 +59,6 @@ from .run_verdict import (
     RunMeasures,
     align_recording,
     measure_run,
-)
-from .settings import (
-    APPROACH_ACCELERATION,
-    APPROACH_SPEED,
-    PATH_ACCELERATION,
-    PATH_BLEND,
-    SERVO_GAIN,
-    SERVO_LOOKAHEAD,
 )
 from .urscript import check_servo_options, plan_wire_tolerance
 
@@ -104,8 +97,8 @@ def run_trajectory(
     model: RobotModel | str | None = None,
     *,
     mode: str | RunMode = "servoj",
-    lookahead: float = SERVO_LOOKAHEAD,
-    gain: float = SERVO_GAIN,
+    lookahead: float = settings.SERVO_LOOKAHEAD,
+    gain: float = settings.SERVO_GAIN,
     speed_scale: float = 1.0,
     deviation_limit: float = DEVIATION_LIMIT,
     dry_run: bool = False,
@@ -113,15 +106,15 @@ def run_trajectory(
     start_index: int = 0,
     confirm: Callable[[RunPlan], bool] | None = None,
     force_kinematics: bool = False,
-    approach_speed: float = APPROACH_SPEED,
-    approach_acceleration: float = APPROACH_ACCELERATION,
+    approach_speed: float = settings.APPROACH_SPEED,
+    approach_acceleration: float = settings.APPROACH_ACCELERATION,
     resume_tolerance: float = 0.005,
     resume_window: float = 1.0,
     stop_deceleration: float = 4.0,
     max_latency: float = MAX_LATENCY,
     path_tolerance: float | None = None,
-    path_blend: float = PATH_BLEND,
-    path_acceleration: float = PATH_ACCELERATION,
+    path_blend: float = settings.PATH_BLEND,
+    path_acceleration: float = settings.PATH_ACCELERATION,
     actual_path: str | os.PathLike[str] | None = None,
     watchdog: float = 2.0,
     heartbeat: float = 1.0,
