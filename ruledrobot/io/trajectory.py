@@ -287,13 +287,14 @@ def meta_from_dict(doc: Any, where: str = "trajectory metadata") -> TrajectoryMe
     job = d.get("job")
     if job is not None and not isinstance(job, dict):
         raise d.fail("job", f"expected an object or null, got {job!r}")
+    cut = _cut(d)  # its errors name the file and field already
     try:
         return TrajectoryMeta(
             robot=model.name, control_period=float(period), tcp_offset=tcp,
             payload=Payload(mass, cog), kinematics=kinematics, base=base,
             phases=tuple(phases), in_stock=tuple(stock), job=job,
             source=str(d.get("source", default="")), heat=heat, max_acceleration=max_acc,
-            cut=_cut(d),
+            cut=cut,
         )  # fmt: skip
     except ValueError as exc:
         raise ValueError(f"{where}: {exc}") from None

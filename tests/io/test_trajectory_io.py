@@ -166,3 +166,16 @@ def test_sliced_keeps_phases_in_range():
     assert part.t[0] == 0.0 and part.n == 15
     assert part.meta.phases == (Phase("approach", 0, 5), Phase("cut", 5, 15))
     assert part.meta.in_stock == ((7, 15),)
+
+
+def test_a_bad_feed_window_is_named_with_the_file_once(tmp_path):
+    p = write_trajectory(tmp_path / "traj.csv", _traj())
+    side = sidecar_path(p)
+    doc = json.loads(side.read_text())
+    doc["cut"] = {"stock": {"centre": [0.5, 0, 0.3], "size": [0.2, 0.2, 0.2],
+                           "rotvec": [0, 0, 0]},
+                  "wire_length_m": 0.4, "feeds": [{"name": "a", "start": "x"}]}  # fmt: skip
+    side.write_text(json.dumps(doc))
+    with pytest.raises(ValueError, match=r"field 'cut.feeds\[0\]': expected \{name") as info:
+        read_trajectory(p)
+    assert str(info.value).count(str(side)) == 1, str(info.value)
