@@ -30,12 +30,16 @@ from ruledrobot.wirecut.planner import plan
 from tests.support.emulators import smooth_trajectory, start_emulator
 from tests.support.rawclient import RawRTDEClient
 
+#: the demo job at 25 mm/s (its own 10 mm/s: the planner's tests and test_run_path)
+FAST_DEMO_JOB = DEMO_JOB.replace("feed_speed = 0.01 ", "feed_speed = 0.025 ")
+
 
 @pytest.fixture(scope="module")
 def demo(tmp_path_factory: pytest.TempPathFactory) -> Trajectory:
-    """The demo's planned trajectory with what it cuts (``meta.cut``)."""
+    """The demo's planned trajectory with what it cuts (``meta.cut``), at 25 mm/s (each
+    mode's program is played in real time: 10 s of cut instead of 24 s)."""
     path = tmp_path_factory.mktemp("demo") / "job.toml"
-    path.write_text(DEMO_JOB)
+    path.write_text(FAST_DEMO_JOB)
     job = load_job(path)
     res = plan(job, None, simulate=False)
     traj = res.trajectory
