@@ -30,7 +30,7 @@ from ruledrobot.wirecut.planner import plan
 from tests.support.emulators import smooth_trajectory, start_emulator
 from tests.support.rawclient import RawRTDEClient
 
-#: the demo job at 25 mm/s (its own 10 mm/s: the planner's tests and test_run_path)
+#: the demo job at 25 mm/s (its own 10 mm/s is planned and verified in tests/wirecut)
 FAST_DEMO_JOB = DEMO_JOB.replace("feed_speed = 0.01 ", "feed_speed = 0.025 ")
 
 
