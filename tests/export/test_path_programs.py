@@ -34,22 +34,27 @@ from tests.support.rawclient import RawRTDEClient
 FAST_DEMO_JOB = DEMO_JOB.replace("feed_speed = 0.01 ", "feed_speed = 0.025 ")
 
 
+def _planned(folder, text: str) -> Trajectory:
+    """The planned trajectory of job ``text`` with what it cuts (``meta.cut``)."""
+    path = folder / "job.toml"
+    path.write_text(text)
+    res = plan(load_job(path), None, simulate=False)
+    traj = res.trajectory
+    assert traj is not None and traj.meta.cut is not None
+    return traj
+
+
 @pytest.fixture(scope="module")
 def demo(tmp_path_factory: pytest.TempPathFactory) -> Trajectory:
-    """The demo's planned trajectory with what it cuts (``meta.cut``), at 25 mm/s (each
-    mode's program is played in real time: 10 s of cut instead of 24 s)."""
-    path = tmp_path_factory.mktemp("demo") / "job.toml"
-    path.write_text(FAST_DEMO_JOB)
-    job = load_job(path)
-    res = plan(job, None, simulate=False)
-    traj = res.trajectory
-    assert traj is not None
-    if traj.meta.cut is None:  # until the planner writes it
-        from ruledrobot.wirecut.plan import wire_cut
+    """The demo's planned trajectory with what it cuts (``meta.cut``)."""
+    return _planned(tmp_path_factory.mktemp("demo"), DEMO_JOB)
 
-        traj = Trajectory(traj.t, traj.q, traj.tcp,
-                          traj.meta.replace(cut=wire_cut(job, res.plan.motion)))  # fmt: skip
-    return traj
+
+@pytest.fixture(scope="module")
+def fast_demo(tmp_path_factory: pytest.TempPathFactory) -> Trajectory:
+    """The demo at 25 mm/s: each mode's program is played in real time (10 s of cut
+    instead of 24 s)."""
+    return _planned(tmp_path_factory.mktemp("fast_demo"), FAST_DEMO_JOB)
 
 
 def _calls(text: str) -> list:
@@ -192,13 +197,13 @@ def _record(host: str, emu, program: str, timeout: float) -> tuple[np.ndarray, n
 
 
 @pytest.mark.parametrize("mode", ["servoj", "movel", "movep"])
-def test_each_mode_cuts_at_the_plans_feed_on_the_emulator(demo: Trajectory, mode: str,
+def test_each_mode_cuts_at_the_plans_feed_on_the_emulator(fast_demo: Trajectory, mode: str,
                                                           request) -> None:  # fmt: skip
     """The demo's cut (lead-in to lead-out) exported in each mode, run by the emulator
     from its script port; the joints it recorded, through the one model of the wire
     against the block: the feed within the plan's tolerance, the wire on the plan's."""
-    names = {p.name: p for p in demo.meta.phases}
-    cut = demo.sliced(names["lead_in"].start, names["lead_out"].stop)
+    names = {p.name: p for p in fast_demo.meta.phases}
+    cut = fast_demo.sliced(names["lead_in"].start, names["lead_out"].stop)
     program = urscript_program(cut, mode=mode)
     emu = start_emulator(request.node.nodeid, model="ur5e", q0=cut.q[0])
     try:
