@@ -33,8 +33,9 @@ translation (``phi = 0``) and stable for ``phi -> 0`` and ``phi -> pi/2``.
 :func:`geodesic` and :func:`geodesic_many` on more than :data:`NUMPY_PAIRS` pairs run
 in a compiled loop (:mod:`ruledrobot.geometry._se3_kernel`, numba: the numpy chunk's
 operations in the same order, one pair at a time in registers), which gives the numpy
-path's results bit for bit where numpy's ``sin``/``cos``/``arctan2`` are libm's (without
-AVX-512; else within 1e-15); once loaded it serves every batch (see :func:`uses_kernel`).
+path's results to rounding (a few float64 epsilons; not bit for bit where numpy's SIMD
+``sin``/``cos``/``arctan2`` differ from libm's); once loaded it serves every batch (see
+:func:`uses_kernel`).
 """
 
 from __future__ import annotations

@@ -1,8 +1,7 @@
-"""The compiled SE(3) geodesic kernel: bit for bit the numpy path, its branches, dispatch."""
+"""The compiled SE(3) geodesic kernel: the numpy path to rounding, its branches, dispatch."""
 
 from __future__ import annotations
 
-import math
 import subprocess
 import sys
 
@@ -16,28 +15,33 @@ from ruledrobot.geometry import se3
 
 from ..conftest import random_poses
 
-
-def _numpy_uses_libm() -> bool:
-    """Whether numpy's float64 sin, cos and arctan2 are the C library's on this machine
-    (they are without AVX-512; with it numpy may use its own, within an ulp)."""
-    x = np.random.default_rng(7).uniform(-10, 10, 4096)
-    y = x[::-1]
-    return (
-        all(np.sin(x) == [math.sin(v) for v in x])
-        and all(np.cos(x) == [math.cos(v) for v in x])
-        and all(np.arctan2(x, y) == [math.atan2(a, b) for a, b in zip(x, y, strict=True)])
-    )
+#: Agreement of the compiled kernel with the numpy path, in units of the float64 epsilon
+#: per unit of ``1 + |t|`` (and per metre of the poses' translations for the translation
+#: column).  Both paths evaluate the same formulas in the same order, but they need not
+#: round alike on every CPU: numpy may take its own SIMD ``sin``/``cos``/``arctan2``
+#: (AVX-512, ARM SVE) where the kernel calls the C library, and LLVM may vectorise or
+#: fuse differently.  Measured here (AMD EPYC, AVX-512): at most 2.3 eps on the rotation
+#: block and 1.3 eps per metre on the translation; 64 leaves a factor of 28, while a wrong
+#: sign, branch or series term gives errors of 1e-7 and more.
+KERNEL_EPS = 64
 
 
-LIBM = _numpy_uses_libm()
-
-
-def assert_same(a: np.ndarray, b: np.ndarray) -> None:
-    """Bit for bit where numpy's transcendentals are libm's, else to 1e-12."""
-    if LIBM:
-        assert np.array_equal(a, b), np.abs(a - b).max()
-    else:
-        np.testing.assert_allclose(a, b, rtol=0, atol=1e-12)
+def assert_same(a: np.ndarray, b: np.ndarray, t: np.ndarray | float, A=None, B=None) -> None:
+    """``a`` and ``b`` (n, 4, 4) agree to :data:`KERNEL_EPS` (see there); ``A``, ``B`` the
+    inputs, whose translations scale the translation column's bound."""
+    a, b = np.asarray(a).reshape(-1, 4, 4), np.asarray(b).reshape(-1, 4, 4)
+    tt = 1.0 + np.abs(np.broadcast_to(np.asarray(t, dtype=np.float64), (len(a),)))
+    size = np.ones(len(a))
+    for P in (A, B):
+        if P is not None:
+            trans = np.abs(np.asarray(P).reshape(-1, 4, 4)[:, :3, 3]).max(axis=1)
+            size = size + np.broadcast_to(trans, (len(a),))
+    eps = KERNEL_EPS * np.finfo(np.float64).eps
+    d = np.abs(a - b)
+    assert np.array_equal(a[:, 3], b[:, 3])  # the last row is written, not computed
+    rot = d[:, :3, :3].max(axis=(1, 2)) / (eps * tt)
+    trans = d[:, :3, 3].max(axis=1) / (eps * tt * size)
+    assert rot.max() <= 1.0 and trans.max() <= 1.0, (rot.max(), trans.max())
 
 
 def numpy_geodesic(A: np.ndarray, B: np.ndarray, t: np.ndarray) -> np.ndarray:
@@ -80,21 +84,33 @@ def edge_pairs(rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
 
 
 @pytest.mark.parametrize("t", [0.0, 0.5, 1.0, -0.7, 1.9, 1e-9])
-def test_kernel_is_the_numpy_path_bit_for_bit(rng, t):
+def test_kernel_is_the_numpy_path(rng, t):
     A, B = random_poses(rng, 3000), random_poses(rng, 3000, scale=5.0)
     tt = np.full(len(A), t)
-    assert_same(kernel_geodesic(A, B, tt), numpy_geodesic(A, B, tt))
+    assert_same(kernel_geodesic(A, B, tt), numpy_geodesic(A, B, tt), tt, A, B)
 
 
-def test_kernel_edge_cases_bit_for_bit(rng):
+def test_start_is_the_first_pose_bit_for_bit_on_both_paths(rng):
+    """At t = 0 both paths return ``A`` exactly on any CPU: sin(0) = 0 and cos(0) = 1 in
+    every libm and SIMD library, so the relative motion is the identity rotation and a zero
+    translation exactly, and ``A``'s entries pass through products by 1 and sums with 0."""
+    A, B = random_poses(rng, 500), random_poses(rng, 500, scale=5.0)
+    EA, EB = edge_pairs(rng)
+    for a, b in ((A, B), (EA, EB)):
+        zero = np.zeros(len(a))
+        assert np.array_equal(kernel_geodesic(a, b, zero), a)
+        assert np.array_equal(numpy_geodesic(a, b, zero), a)
+
+
+def test_kernel_edge_cases_are_the_numpy_path(rng):
     A, B = edge_pairs(rng)
     for t in (0.0, 0.25, 0.5, 1.0, -1.3, 2.0):
         tt = np.full(len(A), t)
         got = kernel_geodesic(A, B, tt)
-        assert_same(got, numpy_geodesic(A, B, tt))
+        assert_same(got, numpy_geodesic(A, B, tt), tt, A, B)
         assert np.all(np.isfinite(got))
     tt = rng.uniform(-2, 3, len(A))
-    assert_same(kernel_geodesic(A, B, tt), numpy_geodesic(A, B, tt))
+    assert_same(kernel_geodesic(A, B, tt), numpy_geodesic(A, B, tt), tt, A, B)
 
 
 def test_kernel_edge_cases_are_geodesics(rng):
@@ -139,16 +155,16 @@ unit = arrays(np.float64, 3, elements=st.floats(-1, 1)).filter(lambda v: np.lina
     t=st.floats(-3, 3),
     seed=st.integers(0, 2**31),
 )
-def test_kernel_bit_for_bit_property(axis, angle, p, t, seed):
+def test_kernel_is_the_numpy_path_property(axis, angle, p, t, seed):
     A = random_poses(np.random.default_rng(seed), 1)
     B = A @ pose(axis, angle, p)
     tt = np.array([t])
-    assert_same(kernel_geodesic(A, B, tt), numpy_geodesic(A, B, tt))
+    assert_same(kernel_geodesic(A, B, tt), numpy_geodesic(A, B, tt), tt, A, B)
 
 
 def test_public_api_dispatch_gives_the_same_bytes(rng, monkeypatch):
     """geodesic / geodesic_many (broadcasting, scalar and per-pair t) through the kernel
-    equal the numpy path."""
+    agree with the numpy path (to :data:`KERNEL_EPS`)."""
     A, B = random_poses(rng, 50), random_poses(rng, 1)[0]
     t = rng.uniform(-1, 2, 50)
     se3.load_kernel()
@@ -159,12 +175,12 @@ def test_public_api_dispatch_gives_the_same_bytes(rng, monkeypatch):
     monkeypatch.setattr(se3, "NUMPY_PAIRS", 10**9)
     assert not se3.uses_kernel(10**6)
     slow = (se3.geodesic(A, B, t), se3.geodesic(A, B, 0.3), se3.geodesic_many(A, B, [0.2, 1.5]))
-    assert_same(fast[0], slow[0])
-    assert_same(fast[1], slow[1])
-    for f, s in zip(fast[2], slow[2], strict=True):
-        assert_same(f, s)
+    assert_same(fast[0], slow[0], t, A, B)
+    assert_same(fast[1], slow[1], 0.3, A, B)
+    for f, s, tk in zip(fast[2], slow[2], (0.2, 1.5), strict=True):
+        assert_same(f, s, tk, A, B)
     assert fast_one.shape == (4, 4)
-    assert_same(fast_one, se3.geodesic(A[0], B, 0.7))
+    assert_same(fast_one, se3.geodesic(A[0], B, 0.7), 0.7, A[:1], B)
 
 
 def test_small_geodesics_do_not_load_numba():
