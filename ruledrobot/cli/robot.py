@@ -112,7 +112,8 @@ class RunModeName(str, Enum):
 def run(
     trajectory: Path = typer.Argument(..., help="Trajectory CSV."),
     host: str | None = typer.Option(
-        None, help="Robot controller address; default: an embedded emulator on 127.0.0.42."
+        None, help="Robot controller address; default: an embedded emulator on 127.0.0.42 "
+        "(or the next free loopback address when another emulator runs there)."
     ),
     mode: RunModeName = typer.Option(
         RunModeName.servoj, help="servoj (stream one servoJ per period) or path (the plan's "
@@ -193,10 +194,15 @@ def stream(trajectory: Path, host: str | None, *, yes: bool = False, **options):
     try:
         with contextlib.ExitStack() as stack:
             if host is None and not dry_run:
-                target = EMBEDDED_HOST
-                console.print(f"no --host: starting the embedded MuJoCo-backed controller "
-                              f"emulator on {target}")  # fmt: skip
-                emu = stack.enter_context(embedded_emulator(traj.meta.robot, traj.q[0], target))
+                try:
+                    emu = stack.enter_context(embedded_emulator(traj.meta.robot, traj.q[0]))
+                except OSError as exc:
+                    raise fail(f"the embedded controller emulator cannot start: {exc}") from None
+                target = emu.host
+                moved = ("" if target == EMBEDDED_HOST else
+                         f"{EMBEDDED_HOST} is taken (another emulator runs there?): ")
+                console.print(f"no --host: {moved}the embedded MuJoCo-backed controller "
+                              f"emulator listens on {target}", highlight=False)  # fmt: skip
             try:
                 result = run_trajectory(trajectory, target, traj.meta.robot,
                                         progress=bar.update, confirm=confirm,
@@ -264,9 +270,16 @@ def say_emulator_clock(emu) -> None:
                        f"{s['gap_max_ms']:.1f} ms)"), highlight=False)  # fmt: skip
 
 
+#: where ``ruledrobot ursim`` listens without ``--host`` (or the next free loopback address)
+DEFAULT_URSIM_HOST = "127.0.0.1"
+
+
 @app.command(epilog="Example:  ruledrobot ursim --host 127.0.0.2 --model ur5e")
 def ursim(
-    host: str = typer.Option("127.0.0.1", help="Address to listen on (loopback by default)."),
+    host: str | None = typer.Option(
+        None, help="Address to listen on [default: 127.0.0.1, or the next free loopback "
+        "address (127.0.0.2, ...) when it is taken]; a given address that is taken is an "
+        "error."),
     model: str = typer.Option("ur5e", help="Robot model."),
     programs: Path | None = typer.Option(
         None, help="Folder the dashboard's `load` serves programs from (default: an empty one)."
@@ -296,6 +309,7 @@ def ursim(
     secondary 30002) until Ctrl-C, optionally calibrated and with faults on a timer or on a
     signal (docs/rtde.md)."""
     from ..ursim import serve
+    from ..ursim.address import address_in_use
     from ..ursim.arm.emulated import emulated_model
     from ..ursim.faults import FaultSchedule, parse_fault
 
@@ -319,8 +333,11 @@ def ursim(
 
     def ready(emu) -> None:  # printed once the ports are bound, never before
         p = emu.ports
+        if emu.host != first:
+            console.print(f"{first} is taken (another emulator runs there?): listening on "
+                          f"{emu.host} instead", highlight=False, markup=False)  # fmt: skip
         console.print(
-            f"UR controller emulator ({model}, {physics}, {kinematics}) listening on {host}: "
+            f"UR controller emulator ({model}, {physics}, {kinematics}) listening on {emu.host}: "
             f"RTDE {p['rtde']}, dashboard {p['dashboard']}, script {p['script']}, primary "
             f"{p['primary']}, secondary {p['secondary']}; programs in {emu.programs_dir}; "
             "Ctrl-C to stop", highlight=False, markup=False,
@@ -336,11 +353,19 @@ def ursim(
         options["backend"] = MujocoBackend
     if arm is not None:
         options["calibration"] = arm.calibration
+    first = DEFAULT_URSIM_HOST if host is None else host
     try:
-        serve(host, model, duration=duration, ready=ready, **options)
+        serve(first, model, duration=duration, ready=ready, find_free_host=host is None,
+              **options)  # fmt: skip
     except KeyboardInterrupt:
         pass
-    except (ValueError, OSError) as exc:
+    except OSError as exc:
+        if host is not None and address_in_use(exc):
+            raise fail(f"--host {host} is taken (another emulator or controller listens "
+                       f"there: {exc}); give another --host, or none to take a free "
+                       "loopback address") from None  # fmt: skip
+        raise fail(str(exc)) from None
+    except ValueError as exc:
         raise fail(str(exc)) from None
     finally:
         schedule.stop()

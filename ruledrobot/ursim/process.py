@@ -34,6 +34,7 @@ from numpy.typing import ArrayLike
 from ..protocol.modes import RobotMode, RuntimeState, SafetyMode
 from ..protocol.primary import KinematicsInfo
 from ..robot import Calibration, RobotModel
+from .address import start_on_free_host
 from .arm.backend import ArmBackend
 from .arm.emulated import emulated_model
 from .server import ThreadedEmulator
@@ -91,16 +92,21 @@ def _child_entry(fd: int) -> None:  # pragma: no cover - runs in the child
     conn = Connection(fd)
     try:
         kwargs = conn.recv()
-        emu = ThreadedEmulator(**kwargs).start()
+        find_free_host = kwargs.pop("find_free_host", False)
+        emu = start_on_free_host(
+            kwargs["host"], lambda h: ThreadedEmulator(**dict(kwargs, host=h)).start(),
+            find_free_host=find_free_host,
+        )  # fmt: skip
         # everything allocated so far lives as long as the process: keep it out of
         # the cyclic collector so that full collections stay short (no clock stalls)
         gc.collect()
         gc.freeze()
     except BaseException as exc:
+        text = str(exc) if type(exc) is OSError else f"{type(exc).__name__}: {exc}"
         with contextlib.suppress(OSError):
-            conn.send(("error", f"{type(exc).__name__}: {exc}"))
+            conn.send(("error", (text, getattr(exc, "errno", None))))
         return
-    conn.send(("ready", emu.ports))
+    conn.send(("ready", (emu.host, emu.ports)))
     try:
         while True:
             try:
@@ -136,6 +142,10 @@ class Emulator:
     ----------
     host : loopback address to bind, e.g. ``"127.0.0.2"`` (see ``allow_remote``).
     model : robot model name (``"ur5e"``, ...) or a :class:`RobotModel`.
+    find_free_host : when ``host`` is taken (another emulator listens there), listen on
+        the next free loopback address instead (:func:`~.address.start_on_free_host`);
+        :attr:`host` says where once started.  False: a taken ``host`` is an
+        ``OSError`` (``errno.EADDRINUSE``).
     calibration : the robot's factory calibration (a :class:`~ruledrobot.robot.Calibration`
         or a ``ruledrobot.calibration/1`` file) or None (nominal kinematics).  Checked
         here: a calibration of another model raises ValueError before anything starts.
@@ -156,6 +166,7 @@ class Emulator:
         host: str = "127.0.0.1",
         model: str | RobotModel = "ur5e",
         *,
+        find_free_host: bool = False,
         in_process: bool = False,
         start_timeout: float = 20.0,
         backend: ArmBackend | Callable[[RobotModel], ArmBackend] | None = None,
@@ -167,6 +178,7 @@ class Emulator:
         self.model_name = model if isinstance(model, str) else model.name
         self.in_process = in_process
         self.start_timeout = float(start_timeout)
+        self.find_free_host = bool(find_free_host)
         self._kwargs: dict[str, Any] = dict(options, host=host, model=model, backend=backend)
         if calibration is not None:  # refused here, before a child process starts
             self._kwargs["calibration"] = emulated_model(model, calibration).calibration
@@ -185,7 +197,14 @@ class Emulator:
     def start(self) -> Emulator:
         """Start serving (in the child process unless ``in_process``); returns self."""
         if self._local is not None:
-            self._local.start()
+            if not self._local.running:
+                first = self._local
+                self._local = start_on_free_host(
+                    self.host, lambda h: (first if h == first.host else
+                                          ThreadedEmulator(**dict(self._kwargs, host=h))).start(),
+                    find_free_host=self.find_free_host,
+                )  # fmt: skip
+                self.host = self._local.host
             self._ports = self._local.ports
             return self
         if self._proc is not None:
@@ -201,7 +220,7 @@ class Emulator:
         theirs.close()
         conn = Connection(ours.detach())
         try:
-            conn.send(self._kwargs)
+            conn.send(dict(self._kwargs, find_free_host=self.find_free_host))
             if not conn.poll(self.start_timeout):
                 raise RuntimeError(
                     f"emulator on {self.host}: did not start in {self.start_timeout} s"
@@ -220,8 +239,12 @@ class Emulator:
         if status != "ready":
             _kill(proc)
             conn.close()
-            raise OSError(f"emulator on {self.host}: {payload}")
-        self._proc, self._conn, self._ports = proc, conn, payload
+            text, code = payload
+            error = OSError(f"emulator on {self.host}: {text}")
+            error.errno = code  # EADDRINUSE: the address is taken
+            raise error
+        self._proc, self._conn = proc, conn
+        self.host, self._ports = payload
         return self
 
     def close(self, timeout: float = 5.0) -> None:
@@ -402,14 +425,25 @@ class Emulator:
 
 @contextlib.contextmanager
 def embedded_emulator(
-    model: str | RobotModel, q0: ArrayLike, host: str = EMBEDDED_HOST
+    model: str | RobotModel,
+    q0: ArrayLike,
+    host: str = EMBEDDED_HOST,
+    *,
+    find_free_host: bool = True,
 ) -> Iterator[Emulator]:
     """The default target of ``ruledrobot run`` and ``demo`` without a robot address: a
     MuJoCo-backed emulator of ``model`` with the arm at ``q0`` (rad), on loopback, closed
-    on exit."""
+    on exit.
+
+    It listens on ``host`` or, when that is taken (another emulator runs there) and
+    ``find_free_host``, on the next free loopback address: ``emulator.host`` says where.
+    An ``OSError`` (``errno.EADDRINUSE`` when every address tried is taken) when it
+    cannot listen.
+    """
     from .arm.physics import MujocoBackend
 
-    emu = Emulator(host, model, q0=q0, backend=MujocoBackend).start()
+    emu = Emulator(host, model, q0=q0, backend=MujocoBackend,
+                   find_free_host=find_free_host).start()  # fmt: skip
     try:
         yield emu
     finally:

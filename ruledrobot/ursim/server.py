@@ -28,6 +28,7 @@ from numpy.typing import ArrayLike
 
 from ..protocol.modes import RobotMode, RuntimeState, SafetyMode
 from ..robot import Calibration, RobotModel
+from .address import start_on_free_host
 from .arm.backend import ArmBackend, KinematicBackend
 from .arm.emulated import emulated_model, kinematics_info_of
 from .clock import ClockStats
@@ -198,6 +199,8 @@ class ThreadedEmulator:
         except OSError:
             for srv in started:
                 srv.close(timeout=1.0)
+            if self._own_programs:  # nothing started: close() will not run
+                shutil.rmtree(self.programs_dir, ignore_errors=True)
             raise
         self.publisher.start()
         _acquire_switch_interval()
@@ -510,15 +513,21 @@ def serve(
     *,
     duration: float | None = None,
     ready: Callable[[ThreadedEmulator], None] | None = None,
+    find_free_host: bool = False,
     **kwargs: object,
 ) -> None:
     """Run an emulator until Ctrl-C (or for ``duration`` seconds); blocking.
 
-    ``ready(emulator)`` is called once it listens (e.g. to print the address);
-    other keyword arguments go to :class:`ThreadedEmulator`.  The emulator
-    runs in this process: connect clients from another process.
+    ``ready(emulator)`` is called once it listens (e.g. to print the address:
+    ``emulator.host``); with ``find_free_host`` a taken ``host`` is replaced by the
+    next free loopback address (:func:`~.address.start_on_free_host`); other keyword
+    arguments go to :class:`ThreadedEmulator`.  The emulator runs in this process:
+    connect clients from another process.
     """
-    emu = ThreadedEmulator(host, model, **kwargs)  # type: ignore[arg-type]
+    emu = start_on_free_host(
+        host, lambda h: ThreadedEmulator(h, model, **kwargs).start(),  # type: ignore[arg-type]
+        find_free_host=find_free_host,
+    )  # fmt: skip
     with emu:
         if ready is not None:
             ready(emu)

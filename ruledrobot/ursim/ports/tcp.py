@@ -245,9 +245,9 @@ class TcpServer:
             s.bind((self.host, self.port))
         except OSError as exc:
             s.close()
-            raise OSError(
-                f"{self.name} server: cannot listen on {self.host}:{self.port}: {exc}"
-            ) from None
+            error = OSError(f"{self.name} server: cannot listen on {self.host}:{self.port}: {exc}")
+            error.errno = exc.errno  # EADDRINUSE: the address is taken (address.py moves on)
+            raise error from None
         s.listen(16)
         s.settimeout(POLL)
         self.port = s.getsockname()[1]
