@@ -339,8 +339,9 @@ def test_splitter_keeps_its_cuts() -> None:
 
 def test_a_servoj_program_of_some_megabytes_runs(local: ThreadedEmulator) -> None:
     """Limits: MAX_PROGRAM_BYTES per program, MAX_LINE_BYTES per line.  A 2.5 MB program
-    (the size urscript_program refuses by default) is compiled in about a second
-    and runs; one beyond the limit is refused, logged, and its connection closed."""
+    (the size urscript_program refuses by default) is parsed by lark and compiled in a few
+    seconds (2.6-4.6 s measured on 2 cores) and runs; one beyond the limit is refused,
+    logged, and its connection closed."""
     q = "[0.0, -1.5707963, 1.5707963, -1.5707963, -1.5707963, 0.0]"
     line = f"  servoj({q}, t=0.002, lookahead_time=0.1, gain=300)\n"
     n = 2_500_000 // len(line)
@@ -349,7 +350,7 @@ def test_a_servoj_program_of_some_megabytes_runs(local: ThreadedEmulator) -> Non
     try:
         t = time.monotonic()
         _send_script(local.host, local.ports["script"], text)
-        assert local.wait_for(lambda: local.runtime_state == 2, 10.0)
+        assert local.wait_for(lambda: local.runtime_state == 2, 20.0)
         compile_s = time.monotonic() - t
         too_big = b"def huge():\n" + line.encode() * (MAX_PROGRAM_BYTES // len(line) + 1)
         with socket.create_connection((local.host, local.ports["script"]), timeout=5.0) as s:
@@ -364,11 +365,11 @@ def test_a_servoj_program_of_some_megabytes_runs(local: ThreadedEmulator) -> Non
         assert local.runtime_state == 2  # the big program still runs
         # compiling 2.5 MB in this (in-process) emulator holds the GIL in stretches: the
         # stream goes on, with gaps measured up to 0.24 s on 2 cores (a known limit:
-        # parsing costs ~0.5 s of CPU per MB); a stall of seconds would fail here
+        # parsing costs ~1.5 s of CPU per MB); a stall of seconds would fail here
         assert reader.error is None and max(reader.gaps[5:]) < 0.5
     finally:
         reader.stop()
-    assert compile_s < 5.0
+    assert compile_s < 12.0
 
 
 # ---------------------------------------------------------------- 7: memory, caps, idle

@@ -53,7 +53,8 @@ def test_program_with_an_unsupported_line_is_refused_before_any_motion() -> None
         "  set_standard_digital_out(2, True)\n"
         f"  movej({q}, a=1.4, v=1.05)\n"
         "  while True:\n"
-        "    sync()\n"
+        "    force_mode(p[0, 0, 0, 0, 0, 0], [0, 0, 1, 0, 0, 0], [0, 0, 5, 0, 0, 0], 2,\n"
+        "               [0.1, 0.1, 0.1, 0.1, 0.1, 0.1])\n"
         "  end\n"
         "end\n"
     )
@@ -65,8 +66,9 @@ def test_program_with_an_unsupported_line_is_refused_before_any_motion() -> None
     np.testing.assert_allclose(ctrl.values["actual_q"], DEFAULT_Q, atol=0)
     errs = _errors(ctrl)
     assert len(errs) == 1
-    assert "compile error" in errs[0] and "line 4" in errs[0] and "while True:" in errs[0]
-    assert ctrl.popup is not None and "line 4" in ctrl.popup  # what the pendant would show
+    assert "compile error" in errs[0] and "line 5" in errs[0] and "force_mode(" in errs[0]
+    assert "not emulated" in errs[0]
+    assert ctrl.popup is not None and "line 5" in ctrl.popup  # what the pendant would show
 
 
 @pytest.mark.parametrize(
@@ -97,9 +99,10 @@ def test_program_with_an_unsupported_line_is_refused_before_any_motion() -> None
             "force_mode(p[0,0,0,0,0,0], [0,0,1,0,0,0], [0,0,10,0,0,0], 2, [1,1,1,1,1,1])",
             "force_mode",
         ),
-        ("x = 1", "assignment"),
-        ("movej(q_start)", "variables"),
-        ("set_standard_digital_out(1, True) set_standard_digital_out(2, True)", "after the call"),
+        ("x = y + 1", "unknown variable 'y'"),
+        ("movej(q_start)", "unknown variable 'q_start'"),
+        ("set_standard_digital_out(1, True) set_standard_digital_out(2, True)", "syntax error"),
+        ("x = p[0, 0, 0.1]", "6 values"),
         ("write_output_integer_register(48, 1)", "0..47"),
         ("write_output_integer_register(1, 3000000000)", "int32"),
         ("movej([1e999, 0, 0, 0, 0, 0])", "finite"),
@@ -115,6 +118,13 @@ def test_bad_arguments_and_unknown_functions_refuse_the_program(line: str, reaso
     assert len(errs) == 1 and "line 3" in errs[0] and reason in errs[0], errs
 
 
+def test_a_block_without_its_end_is_refused_at_the_programs_end() -> None:
+    ctrl = Controller(MODEL)
+    assert not ctrl.load_script("def p():\n  if True:\n    sync()\nend\n")
+    errs = _errors(ctrl)
+    assert len(errs) == 1 and "line 4" in errs[0] and "missing 'end'" in errs[0], errs
+
+
 def test_a_bare_bad_line_is_refused_too() -> None:
     ctrl = Controller(MODEL)
     assert not ctrl.load_script("set_standard_digital_out(64, True)\n")
@@ -128,7 +138,7 @@ def test_a_refused_program_stops_the_running_one() -> None:
     ctrl = Controller(MODEL)
     assert ctrl.load_script("def rtde_control():\n  sync()\nend\n")
     assert ctrl.runtime_state == 2
-    assert not ctrl.load_script("def p():\n  if True:\n    sync()\n  end\nend\n")
+    assert not ctrl.load_script("def p():\n  if True:\n    sync()\n  end\n  undefined_fn()\nend\n")
     assert ctrl.runtime_state == 1
 
 

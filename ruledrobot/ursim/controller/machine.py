@@ -3,8 +3,8 @@
 One :class:`Controller` owns the state a UR controller publishes over RTDE.
 :meth:`Controller.tick` advances it by one control period (2 ms e-Series,
 8 ms CB3): the running program (ur_rtde's control script, via
-:class:`~..script.handshake.ControlScript`, or a standalone program, via
-:class:`~..script.runner.ScriptRunner`) reads its inputs, the trajectory
+:class:`~..script.handshake.ControlScript`, or any other program, via the URScript
+interpreter :class:`~..script.interpreter.Interpreter`) reads its inputs, the trajectory
 generator produces a setpoint, the arm backend steps, and the published
 variables (``values``, keyed by RTDE name) are refreshed.
 
@@ -19,7 +19,7 @@ State machine (the parts clients see):
   arm brakes, power goes off; :meth:`release_emergency_stop`, then power on
   and brake release).
 * ``runtime_state``: STOPPED / PLAYING / PAUSED of the current program.
-* programs are compiled before they start (:mod:`..script.functions`): one line
+* programs are compiled before they start (:mod:`..script.interpreter`): one line
   the emulator cannot run refuses the whole program, nothing of it runs, the
   running program is stopped, the compile error is logged at error level and
   shown as the pendant's popup (:attr:`Controller.popup`, closed by the
@@ -48,10 +48,11 @@ from ...robot import RobotModel
 from ...robot.motion.arm_kinematics import ArmKinematics
 from ...robot.motion.ur_motion import MotionError, PathMotion, Segment, StopMotion
 from ..arm.backend import ArmBackend, ArmState, KinematicBackend
-from ..script.functions import compile_program
 from ..script.handshake import ControlScript
-from ..script.program import CompileError, PathWaypoint, Program, parse_program
-from ..script.runner import ScriptRunner, move_segment, run_io_statement
+from ..script.interpreter import Interpreter, load_program
+from ..script.program import CompileError, PathWaypoint, Program
+from ..script.runner import move_segment
+from ..script.syntax import warm_up
 from .registers import IN_DOUBLE, IN_INT, OUT_DOUBLE, OUT_INT, IOMixin
 from .safety import SafetyMixin
 
@@ -82,6 +83,9 @@ _SAFETY_BITS = {
 }
 
 Event = tuple[float, int, str]
+
+#: the most control periods a secondary program may take (it may not wait)
+SECONDARY_PERIODS = 8
 
 #: the longest message the controller log keeps [characters]
 MAX_LOG_MESSAGE = 1000
@@ -137,7 +141,7 @@ class Controller(IOMixin, SafetyMixin):
         self.safety_mode = SafetyMode.NORMAL
         self.runtime_state = RuntimeState.STOPPED
         self.program: Program | None = None
-        self.runner: ControlScript | ScriptRunner | _IdleProgram | None = None
+        self.runner: ControlScript | Interpreter | _IdleProgram | None = None
         self.loaded_program: str | None = None
         self._loaded_script: Program | None = None
         self.motion: PathMotion | StopMotion | None = None
@@ -167,6 +171,7 @@ class Controller(IOMixin, SafetyMixin):
         self._watch_last = 0.0
         self._power_off_when_stopped = False
         self.values: dict[str, object] = {}
+        warm_up()  # the URScript parser, before any clock runs
         self._init_values()
         self._update_values()
 
@@ -296,7 +301,7 @@ class Controller(IOMixin, SafetyMixin):
 
     def _script_line(self) -> int:
         r = self.runner
-        return r.line if isinstance(r, ScriptRunner) else 0
+        return r.line if isinstance(r, Interpreter) else 0
 
     def arm_state(self) -> ArmState:
         """The arm's state after the last period (the
@@ -373,10 +378,7 @@ class Controller(IOMixin, SafetyMixin):
 
     def compile(self, text: str) -> Program:
         """Parse and check a program as the controller compiles it (CompileError if not)."""
-        prog = parse_program(text)
-        if prog.kind != "rtde_control":
-            compile_program(prog, max_payload=self.model.payload)
-        return prog
+        return load_program(text, max_payload=self.model.payload)
 
     def refuse(self, error: CompileError, name: str = "") -> None:
         """A program failed to compile: it does not run; the running one stops; log and popup."""
@@ -406,10 +408,28 @@ class Controller(IOMixin, SafetyMixin):
         return self.start_program(prog)
 
     def run_secondary(self, prog: Program) -> bool:
-        """A secondary program: its statements (no motion) run now, the primary goes on."""
+        """A secondary program: it runs now, beside the primary one (which goes on).
+
+        It may not move or wait (refused when it compiles); one that still has not ended
+        after :data:`SECONDARY_PERIODS` steps (a socket read that waits) is ended and
+        logged.  A runtime error is logged; the primary program is not stopped."""
         with self.lock:
-            for st in prog.statements:
-                run_io_statement(self, st)
+            done: list[bool] = []
+            runner = Interpreter(self, prog, on_finish=lambda: done.append(True))
+            try:
+                for _ in range(SECONDARY_PERIODS):
+                    runner.step()
+                    if done:
+                        break
+            except MotionError as exc:
+                self.log(f"secondary program {prog.name}: runtime error: {exc}", level=1)
+                return False
+            finally:
+                runner.close()
+            if not done:
+                self.log(f"secondary program {prog.name} ended: it waited, which a secondary "
+                         "program may not", level=1)  # fmt: skip
+                return False
             self.log(f"secondary program {prog.name} finished")
             return True
 
@@ -433,9 +453,8 @@ class Controller(IOMixin, SafetyMixin):
             elif prog.kind == "idle":
                 self.runner = _IdleProgram()
             else:
-                self.runner = ScriptRunner(self, prog)
-                self.log(f"program {prog.name or '<line>'} started "
-                         f"({len(prog.statements)} statements)")  # fmt: skip
+                self.runner = Interpreter(self, prog)
+                self.log(f"program {prog.name or '<line>'} started")
             self.runtime_state = RuntimeState.PLAYING
             return True
 
@@ -445,6 +464,8 @@ class Controller(IOMixin, SafetyMixin):
             if self.runner is None and self.runtime_state == RuntimeState.STOPPED:
                 return
             name = self.program.name if self.program else ""
+            if isinstance(self.runner, Interpreter):
+                self.runner.close()  # its threads end, its sockets close
             self.runner = None
             self.runtime_state = RuntimeState.STOPPED
             self._watch_name = None

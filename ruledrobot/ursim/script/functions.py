@@ -1,17 +1,13 @@
-"""The URScript functions the emulator runs, their signatures and argument checks.
+"""The URScript functions of the controller's motion, IO and message table: their
+signatures and argument checks.
 
-A program is checked whole before it starts, as the controller compiles a
-program before running it: every statement must call a function of
-:data:`FUNCTIONS` with arguments of the right kind and range.  Anything else
-raises :class:`~ruledrobot.ursim.script.program.CompileError` naming the line, its text and the
-reason, and the program is refused (nothing of it runs).
-
-Arguments are literals (the emulator has no variables), so ranges that the
-controller checks when the line runs (digital output pins 0-7, tool pins 0-1,
-analog values 0-1, servoj lookahead 0.03-0.2 s and gain 100-2000, the payload
-mass) are checked here, before any motion.  :func:`bind` returns the call's
-parameters by name with defaults filled in, which is what
-:class:`~.runner.ScriptRunner` executes.
+:func:`bind` checks a call's arguments by kind and range — digital output pins 0-7, tool
+pins 0-1, analog values 0-1, servoj lookahead 0.03-0.2 s and gain 100-2000, the payload
+mass — and returns the call's parameters by name with defaults filled in.  The
+interpreter (:mod:`.library`) binds every call of these functions when it runs (a bad
+value is a runtime error naming the line); :mod:`.transpile` binds the calls whose
+arguments are all literals when the program compiles, so that such a program is refused
+whole before anything moves, as before variables existed.
 
 Units: metres, radians, seconds, kilograms; analog outputs as a fraction
 0..1 of their range (URScript ``set_standard_analog_out``).
@@ -23,9 +19,9 @@ import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
-from .program import CompileError, Pose, Program, Statement
+from .program import CompileError, Pose, Statement
 
-__all__ = ["FUNCTIONS", "MOTION_FUNCTIONS", "Param", "bind", "compile_program"]
+__all__ = ["FUNCTIONS", "MOTION_FUNCTIONS", "Param", "bind"]
 
 _REQUIRED = object()
 _INT32 = (-(1 << 31), (1 << 31) - 1)
@@ -240,20 +236,3 @@ def bind(st: Statement, functions: dict[str, Function] = FUNCTIONS) -> dict[str,
     except _BadArgument as exc:
         raise CompileError(st.line, st.text, f"{st.name}(): {exc}") from None
     return out
-
-
-def compile_program(prog: Program, *, max_payload: float | None = None) -> Program:
-    """Bind every statement of a standalone program (``st.params``); CompileError if any fails.
-
-    ``max_payload``: the arm's rated payload [kg] (the bound of set_payload's
-    mass), or None.  ``sec`` programs may not move the arm or block.
-    """
-    functions = FUNCTIONS if max_payload is None else _functions(max_payload)
-    for st in prog.statements:
-        st.params = bind(st, functions)
-        if prog.kind == "sec" and st.name in MOTION_FUNCTIONS:
-            raise CompileError(st.line, st.text, f"{st.name}(): a secondary (sec) program "
-                               "cannot move the arm or wait")  # fmt: skip
-        if st.name == "popup" and st.params["blocking"]:
-            raise CompileError(st.line, st.text, "popup(): a blocking popup is not emulated")
-    return prog

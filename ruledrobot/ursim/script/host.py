@@ -1,7 +1,7 @@
 """What a running program may use of the controller: the interface between the
 controller (:class:`~ruledrobot.ursim.controller.machine.Controller`) and the program runners
 (:class:`~.handshake.ControlScript` for ur_rtde's control script,
-:class:`~.runner.ScriptRunner` for standalone programs).
+:class:`~.interpreter.Interpreter` for every other program).
 
 The runners see the controller only through :class:`ProgramHost`, so neither
 imports the controller (no import circle) and neither reaches into its parts:
@@ -40,6 +40,12 @@ class ProgramHost(Protocol):
     last_input_names: frozenset[str]
     #: the actual joint positions of the last periods, newest last
     history: deque[list[float]]
+    #: the published RTDE values by name (registers: ``input_int_register_0``, ...)
+    values: dict[str, object]
+    #: standard, configurable and tool digital output bits
+    std_do: int
+    conf_do: int
+    tool_do: int
 
     def arm_state(self) -> ArmState:
         """The arm's state after the last period (actual and target joints)."""

@@ -1,27 +1,22 @@
-"""URScript programs arriving on the script port (30003): splitting and parsing.
+"""URScript programs arriving on the script port (30003): splitting and classifying.
 
 Two kinds of program matter:
 
-* ``def rtde_control():`` — ur_rtde's control script.  It is not interpreted:
-  the emulator re-implements its register handshake (``commands.py``).  Only
-  two things are read from its text: the register offset ur_rtde injects
-  after ``# float register offset`` (0, or 24 for the upper register range)
-  and the path moves it injects after ``# inject move path`` for
-  ``moveL(path)`` / ``moveJ(path)`` / ``movePath``, one
-  ``\\tmovel(p[x,y,z,rx,ry,rz],a=A,v=V,r=R)`` (or ``movej([...])``,
-  ``movep(p[...])``) line per waypoint.
-* any other program — e.g. the standalone programs
-  :mod:`ruledrobot.export.urscript` writes — is parsed into its top-level
-  statements, which :class:`~ruledrobot.ursim.controller.machine.Controller` runs with a small
-  interpreter (:mod:`.runner`; the functions and their argument checks
-  are in :mod:`.functions`).  A ``sec`` program is a secondary program:
-  it runs beside the primary one (no motion, no waiting).
+* ``def rtde_control():`` — ur_rtde's control script.  The emulator re-implements its
+  register handshake (:mod:`.handshake`, the documented fallback until the interpreter runs
+  the script itself).  Only two things are read from its text: the register offset
+  ur_rtde injects after ``# float register offset`` (0, or 24 for the upper register
+  range) and the path moves it injects after ``# inject move path`` for ``moveL(path)`` /
+  ``moveJ(path)`` / ``movePath``, one ``\\tmovel(p[x,y,z,rx,ry,rz],a=A,v=V,r=R)`` (or
+  ``movej([...])``, ``movep(p[...])``) line per waypoint.
+* any other program — ``def name(): ... end``, ``sec name(): ... end`` (a secondary
+  program: it runs beside the primary one, no motion, no waiting) or bare lines — is
+  parsed by lark and run by the interpreter (:mod:`.interpreter`: variables, lists and
+  poses, ``if``/``while``, functions, threads, sockets, the motion and IO functions).
+  :func:`~.interpreter.load_program` classifies with :func:`parse_program` and compiles.
 
-The emulator has no variables and no control flow.  A line it cannot run
-(``if``/``while``/``thread``, an assignment, a variable, a syntax error, an
-unknown function, a bad argument) makes the whole program fail to compile:
-:class:`CompileError` names the line and its text, and nothing of the program
-runs — as a controller refuses a program that does not compile.
+A program that does not compile is refused whole: :class:`CompileError` names the line,
+its text and the reason, and nothing of the program runs — as a controller refuses it.
 """
 
 from __future__ import annotations
@@ -31,6 +26,8 @@ import re
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 
+from ...robot.motion.ur_motion import MotionError
+
 __all__ = [
     "MAX_LINE_BYTES",
     "MAX_PROGRAM_BYTES",
@@ -39,6 +36,7 @@ __all__ = [
     "Pose",
     "Program",
     "ProgramSplitter",
+    "ScriptRuntimeError",
     "ScriptSyntaxError",
     "Statement",
     "parse_call",
@@ -64,6 +62,11 @@ class CompileError(ScriptSyntaxError):
         super().__init__(f"line {self.line}: {self.text!r}: {reason}")
 
 
+class ScriptRuntimeError(MotionError):
+    """A runtime error of a running program (an index out of range, a bad argument, a pose
+    out of reach): the program stops; the interpreter adds the line."""
+
+
 @dataclass(frozen=True)
 class Pose:
     """A URScript pose literal ``p[x, y, z, rx, ry, rz]``."""
@@ -76,7 +79,7 @@ class Statement:
     """A top-level call ``name(args..., key=value...)``, its 1-based line number and text.
 
     ``params``: the checked arguments by name (filled by
-    :func:`~.functions.compile_program`).
+    :func:`~.functions.bind`).
     """
 
     name: str
@@ -101,14 +104,15 @@ class PathWaypoint:
 
 @dataclass
 class Program:
-    """A parsed program; ``kind`` is ``"rtde_control"``, ``"script"`` or ``"sec"``."""
+    """A program; ``kind`` is ``"rtde_control"``, ``"script"``, ``"sec"`` or ``"idle"``."""
 
     name: str
     text: str
     kind: str
     register_offset: int = 0
     path: list[PathWaypoint] = field(default_factory=list)
-    statements: list[Statement] = field(default_factory=list)
+    #: the program compiled by :func:`~.interpreter.compile_script` (None for rtde_control)
+    compiled: object = None
 
 
 # ------------------------------------------------------------------ tokenizer / parser
@@ -293,10 +297,12 @@ def _rtde_control(text: str) -> Program:
 
 
 def parse_program(text: str) -> Program:
-    """Classify and parse one complete program (``def name(): ... end``, or lines).
+    """Classify one complete program (``def name(): ... end``, ``sec``, or lines).
 
-    Raises :class:`CompileError` (line, text, reason) when a line cannot be
-    run; arguments are checked by :func:`~.functions.compile_program`.
+    ur_rtde's control script is read here (register offset, injected path); any other
+    program is returned with its name and kind, for :func:`~.interpreter.compile_script`.
+    Raises :class:`CompileError` (line, text, reason) for an empty program, a ``def`` not
+    at column 0 or a program without its closing ``end``.
     """
     lines = text.splitlines()
     first_i = next((i for i, ln in enumerate(lines) if ln.strip()), None)
@@ -309,23 +315,13 @@ def parse_program(text: str) -> Program:
     name = m.group(2) if m else ""
     if name == "rtde_control":
         return _rtde_control(text)
-    prog = Program(name, text, "sec" if m and m.group(1) == "sec" else "script")
-    body: list[tuple[int, str]]
     if m:
         close = next((i for i in range(len(lines) - 1, first_i, -1)
                       if lines[i].strip()), None)  # fmt: skip
         if close is None or lines[close].rstrip() != "end":
             raise CompileError(len(lines), lines[-1] if lines else "",
                                "the program has no closing 'end' at column 0")  # fmt: skip
-        body = list(enumerate(lines[first_i + 1 : close], start=first_i + 2))
-    else:
-        body = list(enumerate(lines, start=1))
-    for i, raw in body:
-        s = raw.strip()
-        if not s or s.startswith("#"):
-            continue
-        prog.statements.append(_call(s, i))
-    return prog
+    return Program(name, text, "sec" if m and m.group(1) == "sec" else "script")
 
 
 #: the largest program the script port takes [bytes]: 4 times what
