@@ -66,7 +66,7 @@ from ...protocol.rtde import (
 )
 from ...protocol.rtde_types import TYPE_SIZES
 from ..controller.machine import Controller
-from .tcp import Connection, QueuedConnection, TcpServer, writable_fds
+from .tcp import Connection, QueuedConnection, TcpServer, quick_ack, writable_fds
 
 __all__ = ["RTDEConnection", "RTDEServer", "StreamStats", "due"]
 
@@ -178,6 +178,9 @@ class RTDEServer(TcpServer):
         framer = PacketFramer()
 
         def on_data(data: bytes) -> None:
+            # input packages get no reply: acknowledge them at once, or a client's next
+            # package waits up to 40 ms for the ACK (Nagle; see quick_ack)
+            quick_ack(conn.sock)
             framer.feed(data)
             for kind, payload in framer.packets():
                 self._packet(conn, kind, payload)

@@ -32,7 +32,15 @@ import threading
 import time
 from collections.abc import Callable
 
-__all__ = ["IDLE_WAIT", "POLL", "Connection", "QueuedConnection", "TcpServer", "writable_fds"]
+__all__ = [
+    "IDLE_WAIT",
+    "POLL",
+    "Connection",
+    "QueuedConnection",
+    "TcpServer",
+    "quick_ack",
+    "writable_fds",
+]
 
 log = logging.getLogger("ruledrobot.ursim")
 
@@ -168,6 +176,24 @@ def writable_fds(conns: list[QueuedConnection]) -> set[int]:
         return {fd for fd, ev in p.poll(0) if ev & select.POLLOUT}
     except (OSError, ValueError):
         return set()
+
+
+def quick_ack(sock: socket.socket) -> None:
+    """Acknowledge what ``sock`` received at once instead of after Linux's delayed-ACK timer
+    (up to 40 ms); call it after each ``recv``.
+
+    A peer that sends small packets with Nagle's algorithm on (ur_rtde's sockets: their
+    no-delay option is lost when boost::asio's connect reopens the socket) holds its next
+    packet until the previous one is acknowledged.  A connection that sends nothing back
+    to carry the ACK (ur_rtde's IO interface: inputs without replies, after the
+    request-reply set-up that put the socket into delayed-ACK mode) would get it 40 ms
+    late.  ``TCP_QUICKACK`` sends a pending ACK now and leaves that mode; it does not
+    stick, hence once per ``recv``.  No effect where the option does not exist.
+    """
+    option = getattr(socket, "TCP_QUICKACK", None)
+    if option is not None:
+        with contextlib.suppress(OSError):
+            sock.setsockopt(socket.IPPROTO_TCP, option, 1)
 
 
 #: the nice value a thread asks for when real-time scheduling is refused
