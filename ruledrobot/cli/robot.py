@@ -99,7 +99,8 @@ def export(
 
 
 class RunModeName(str, Enum):
-    """How ``run`` drives the robot (``--mode``): ``servoj`` or ``path``."""
+    """How ``run`` drives the robot (``--mode``): ``forward``, ``servoj`` or ``path``."""
+    forward = "forward"
     servoj = "servoj"
     path = "path"
 
@@ -116,8 +117,14 @@ def run(
         "(or the next free loopback address when another emulator runs there)."
     ),
     mode: RunModeName = typer.Option(
-        RunModeName.servoj, help="servoj (stream one servoJ per period) or path (the plan's "
-        "movel/movej program at its speeds, verified before motion)."
+        RunModeName.forward, help="forward (the samples sent ahead of time to a program that "
+        "plays them on the controller's clock: a busy PC changes nothing), servoj (stream one "
+        "servoJ per period on this computer's clock) or path (the plan's movel/movej program "
+        "at its speeds, verified before motion)."
+    ),
+    buffer: float = typer.Option(
+        0.5, min=0.05, max=5.0, help="forward mode: the longest stall of this computer the "
+        "motion rides through unchanged [s]; a longer one stops along the path, heat off."
     ),
     speed_scale: float = typer.Option(1.0, min=0.01, max=1.0, help="Slow the whole run down."),
     resume: int | None = typer.Option(
@@ -150,7 +157,7 @@ def run(
                   markup=False)  # fmt: skip
     result = stream(trajectory, host, yes=yes, mode=mode.value, speed_scale=speed_scale,
                      dry_run=dry_run, start_index=resume or 0, force_kinematics=force,
-                     wire_tolerance=wire_tolerance)  # fmt: skip
+                     wire_tolerance=wire_tolerance, buffer=buffer)  # fmt: skip
     if not result.ok:
         raise typer.Exit(code=1)
 
@@ -216,7 +223,7 @@ def stream(trajectory: Path, host: str | None, *, yes: bool = False, **options):
     if not shown and result.verdict is not None:
         from ..export import RunPlan
 
-        show_plan(RunPlan(result.verdict, result.entry, target, options.get("mode", "servoj"),
+        show_plan(RunPlan(result.verdict, result.entry, target, options.get("mode", "forward"),
                           traj, options.get("approach_speed", 0.25),
                           options.get("speed_scale", 1.0)))  # fmt: skip
     style = "bold green" if result.completed else "bold red"
@@ -236,7 +243,7 @@ def stream(trajectory: Path, host: str | None, *, yes: bool = False, **options):
                        "a busy machine may delay its commands"), highlight=False)  # fmt: skip
     if result.stop is not None and result.status != "completed":
         console.print(Text(f"  stopped at {result.stop.describe()}"), highlight=False)
-        cmd = resume_command(trajectory, host, options.get("mode", "servoj"),
+        cmd = resume_command(trajectory, host, options.get("mode", "forward"),
                              options.get("speed_scale", 1.0), result.resume_index)  # fmt: skip
         console.print(Text(f"  resume with: {cmd}", style="bold"), highlight=False)
     if result.client:

@@ -21,6 +21,7 @@ from enum import IntEnum
 import numpy as np
 
 from ..protocol.modes import RobotMode, SafetyMode
+from ..protocol.primary import DASHBOARD_PORT
 from ..robot.arm.ur_tables import nominal_dh
 from ..robot.motion.trajectory import KinematicsRef, TrajectoryMeta
 from ..robot.verdict import Check
@@ -33,7 +34,6 @@ __all__ = [
     "readiness_check",
 ]
 
-DASHBOARD_PORT = 29999
 
 _VERSION_RE = re.compile(r"(\d+)\.(\d+)\.(\d+)(?:\.(\d+))?")
 

@@ -35,6 +35,8 @@ from multiprocessing.connection import Connection
 import numpy as np
 
 from ..robot.motion.trajectory import Heat
+from .forward import ForwardSettings
+from .forward.client import forward
 from .run_motion import approach, preheat, run_program, stream
 from .run_session import Link, Session, SessionError, Stop
 
@@ -107,7 +109,12 @@ def _motion(s: Session, m: dict) -> None:
     approach(s, q_grid[0], m["approach_speed"], m["approach_acceleration"], m["heartbeat"])
     if hot is not None and hot[0]:  # entering a cut where it stopped: heat before moving
         preheat(s, float(heat["preheat"]), m["heartbeat"])
-    if m["mode"] == "servoj":
+    if m["mode"] == "forward":
+        settings = ForwardSettings(1.0 / s.frequency, m["buffer"], m["stop_time"],
+                                   m["lookahead"], m["gain"])  # fmt: skip
+        hv = None if heat is None else Heat(heat["kind"], heat["index"], heat["value"])
+        forward(s, q_grid, hot, settings, hv, m["heartbeat"], m["connect_timeout"])
+    elif m["mode"] == "servoj":
         stream(s, q_grid, m["lookahead"], m["gain"], m["heartbeat"], hot)
     else:  # the path program switches the heat where the plan does
         run_program(s, q_grid, m["program"], m["heartbeat"])

@@ -59,7 +59,7 @@ def resume_command(trajectory: str | Path, host: str | None, mode: str, speed_sc
     cmd = ["ruledrobot", "run", str(trajectory)]
     if host is not None:
         cmd += ["--host", host]
-    if mode != "servoj":
+    if mode != "forward":  # the default
         cmd += ["--mode", mode]
     if speed_scale != 1.0:
         cmd += ["--speed-scale", f"{speed_scale:g}"]

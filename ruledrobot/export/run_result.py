@@ -20,9 +20,12 @@ __all__ = ["ControllerError", "RunMode", "RunPlan", "RunResult"]
 
 
 class RunMode(str, Enum):
-    """How the motion is sent: one servoJ per controller period, or the plan's path program
-    (UR moves at the plan's speeds, verified before motion: :mod:`.run_program`)."""
+    """How the motion is sent: forwarded ahead of time to a program that plays it on the
+    controller's clock (:mod:`.forward`, the default), one servoJ per controller period
+    streamed on this computer's clock, or the plan's path program (UR moves at the plan's
+    speeds, verified before motion: :mod:`.run_program`)."""
 
+    forward = "forward"
     servoj = "servoj"
     path = "path"
 
@@ -75,7 +78,9 @@ class RunResult:
     ``status``: ``"completed"``, ``"dry_run"``, ``"refused"`` (a check failed;
     nothing moved), ``"cancelled"`` (not confirmed), or why the motion stopped:
     ``"deviation"``, ``"protective_stop"``, ``"emergency_stop"``,
-    ``"connection_lost"``, ``"controller_slow"``, ``"client_slow"``, ``"program_stopped"``,
+    ``"connection_lost"``, ``"controller_slow"``, ``"client_slow"``, ``"buffer_dry"`` (a
+    forwarded run's samples ran short: the controller stopped along the path),
+    ``"program_stopped"``,
     ``"command_failed"``, ``"interrupted"``, ``"client_died"`` (the ur_rtde
     process crashed), ``"client_hung"`` (it stopped answering and was killed).
     ``start_index``: the first sample streamed (the entry), ``requested_index``:

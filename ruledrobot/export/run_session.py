@@ -23,11 +23,13 @@ The supervisor may send ``("stop", status, message)`` (Ctrl-C) at any time;
 from __future__ import annotations
 
 import math
+import socket
 import time
 from typing import Any
 
 import numpy as np
 
+from ..protocol.primary import DASHBOARD_PORT
 from ..robot.motion.trajectory import Heat
 from .heat import set_heat_rtde
 
@@ -424,6 +426,9 @@ class Session:
                 self.hot = False
             except Exception:
                 pass
+        if mode == "forward":  # the program is ours (it stops along the path on request)
+            self._dashboard_stop(budget)
+            return
         c = self.c
         if c is None:
             return
@@ -438,6 +443,20 @@ class Session:
         try:
             if c.isConnected() and c.isProgramRunning():
                 c.stopScript()
+        except Exception:
+            pass
+
+    def _dashboard_stop(self, budget: float) -> None:
+        """Stop a program that still runs through the dashboard's ``stop`` (a forwarding
+        program ends by itself; this is for one that does not)."""
+        try:
+            if self.r is None or int(self.r.getRuntimeState()) != RUNTIME_PLAYING:
+                return
+            with socket.create_connection((self.host, DASHBOARD_PORT), timeout=budget) as d:
+                d.settimeout(budget)
+                d.recv(256)  # the greeting
+                d.sendall(b"stop\n")
+                d.recv(256)
         except Exception:
             pass
 

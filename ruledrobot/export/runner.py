@@ -46,6 +46,7 @@ from ..robot import RobotModel, load, model_for
 from ..robot.motion.trajectory import Trajectory
 from ..robot.verdict import Check, Verdict
 from . import settings  # the defaults a run shares with the exported program
+from .forward import ForwardSettings
 from .heat import send_heat_off
 from .limits import check_trajectory
 from .run_checks import controller_checks, kinematics_check, query_dashboard, readiness_check
@@ -80,8 +81,8 @@ def _validate(
     if robot.name != planned.name:
         raise ValueError(f"trajectory planned for a {planned.name}, not for the {robot.name} given")
     mode = mode.value if isinstance(mode, Enum) else str(mode)
-    if mode not in ("servoj", "path"):
-        raise ValueError(f"mode: expected 'servoj' or 'path', got {mode!r}")
+    if mode not in ("forward", "servoj", "path"):
+        raise ValueError(f"mode: expected 'forward', 'servoj' or 'path', got {mode!r}")
     check_servo_options(lookahead, gain)
     if not deviation_limit > 0:
         raise ValueError(f"deviation_limit: must be positive, got {deviation_limit}")
@@ -96,7 +97,7 @@ def run_trajectory(
     host: str | None = "127.0.0.1",
     model: RobotModel | str | None = None,
     *,
-    mode: str | RunMode = "servoj",
+    mode: str | RunMode = "forward",
     lookahead: float = settings.SERVO_LOOKAHEAD,
     gain: float = settings.SERVO_GAIN,
     speed_scale: float = 1.0,
@@ -121,6 +122,8 @@ def run_trajectory(
     stop_budget: float = 1.0,
     connect_timeout: float = 15.0,
     wire_tolerance: float | None = None,
+    buffer: float = settings.FORWARD_BUFFER,
+    stop_time: float = settings.FORWARD_STOP_TIME,
 ) -> RunResult:
     """Run a joint trajectory on the UR controller at ``host`` (ur_rtde), checked and monitored.
 
@@ -131,8 +134,11 @@ def run_trajectory(
         None only with ``dry_run`` (the controller is not contacted).
     model : the robot model or its name; default, and it must agree with, the
         trajectory's metadata (:func:`ruledrobot.robot.model_for`).
-    mode : ``"servoj"`` (one servoJ per controller period) or ``"path"`` (the path program
-        an export writes for the samples the run plays, :mod:`.run_program`: ``movel`` /
+    mode : ``"forward"`` (the default: the samples forwarded ahead of time to a program
+        that plays them on the controller's clock, :mod:`.forward`), ``"servoj"`` (one
+        servoJ per controller period, streamed on this computer's clock) or
+        ``"path"`` (the path program an export writes for the samples the run plays,
+        :mod:`.run_program`: ``movel`` /
         ``movej`` at the plan's speeds with ``path_blend`` m blends and ``path_acceleration``
         m/s^2, sleeps, heat switches; the TCP path decimated to ``path_tolerance`` m, by
         default a quarter of ``wire_tolerance``; its motion generated and measured against
@@ -160,6 +166,9 @@ def run_trajectory(
     heartbeat : the longest the ur_rtde process may stay silent while moving [s].
     stop_budget : the longest the safe stop (servoStop/stopJ, stopScript) may take [s].
     connect_timeout : the longest a connection step may take [s].
+    buffer : forward mode: the longest stall of this computer the motion rides through
+        unchanged [s]; a longer one ends in a controlled stop along the path, heat off.
+    stop_time : forward mode: the controlled stop's duration [s].
     wire_tolerance : the largest distance of the actual wire from the planned wire in the
         block [m], in the run's verdict and the path program's check; default the plan's
         (``meta.cut.wire_tolerance``: the job's ``[cut] wire_tolerance``, the strictest of
@@ -182,6 +191,8 @@ def run_trajectory(
     else:
         robot = load(model) if isinstance(model, str) else model
     mode = _validate(traj, robot, planned, mode, lookahead, gain, deviation_limit, start_index)
+    if mode == "forward":  # its settings checked now: bad input, before any motion
+        ForwardSettings(robot.control_period, buffer, stop_time, lookahead, gain)
     if host is None and not dry_run:
         raise ValueError("host: a controller address is needed unless dry_run")
     check_trajectory(traj, robot, speed_scale=speed_scale)
@@ -280,6 +291,8 @@ def run_trajectory(
                 max_latency=max_latency,
                 deviation_limit=deviation_limit,
                 wire_tolerance=wire_tolerance,
+                buffer=buffer,
+                stop_time=stop_time,
             ),
         )
     finally:
@@ -399,6 +412,8 @@ def _move(
         "checked_q": state["q"],
         "moved_tolerance": 1e-3,
         "heat": _heat_message(traj, k0, grid_to_input),
+        "buffer": o["buffer"],
+        "stop_time": o["stop_time"],
     }
     result.start_index = k0
     child.send("go", motion)

@@ -8,6 +8,8 @@ from __future__ import annotations
 __all__ = [
     "APPROACH_ACCELERATION",
     "APPROACH_SPEED",
+    "FORWARD_BUFFER",
+    "FORWARD_STOP_TIME",
     "PATH_ACCELERATION",
     "PATH_BLEND",
     "SERVO_GAIN",
@@ -25,3 +27,7 @@ APPROACH_ACCELERATION = 0.5
 PATH_BLEND = 0.002
 #: m/s²: the tool acceleration of a movel/movep path program's moves
 PATH_ACCELERATION = 1.0
+#: s: a forwarded run's buffer: the longest stall of the PC the motion rides through
+FORWARD_BUFFER = 0.5
+#: s: a forwarded run's controlled stop (the path rate falls from 1 to 0 over it)
+FORWARD_STOP_TIME = 0.2

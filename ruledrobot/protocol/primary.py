@@ -56,6 +56,7 @@ from dataclasses import dataclass
 import numpy as np
 
 __all__ = [
+    "DASHBOARD_PORT",
     "KINEMATICS_INFO",
     "KINEMATICS_INFO_SIZE",
     "MAX_MESSAGE_SIZE",
@@ -63,6 +64,7 @@ __all__ = [
     "ROBOT_MESSAGE",
     "ROBOT_MODE_DATA",
     "ROBOT_STATE",
+    "SCRIPT_PORT",
     "SECONDARY_PORT",
     "KinematicsInfo",
     "PrimaryProtocolError",
@@ -82,6 +84,10 @@ __all__ = [
 
 PRIMARY_PORT = 30001
 SECONDARY_PORT = 30002
+#: the real-time client interface, where ur_rtde and forwarded runs send their programs
+SCRIPT_PORT = 30003
+#: the dashboard server
+DASHBOARD_PORT = 29999
 #: message types
 ROBOT_STATE = 16
 ROBOT_MESSAGE = 20
