@@ -99,9 +99,11 @@ def export(
 
 
 class RunModeName(str, Enum):
-    """How ``run`` drives the robot (``--mode``): ``forward``, ``servoj`` or ``path``."""
+    """How ``run`` drives the robot (``--mode``): ``forward``, ``servoj`` (or its other
+    name ``stream``) or ``path``."""
     forward = "forward"
     servoj = "servoj"
+    stream = "stream"
     path = "path"
 
 
@@ -118,8 +120,8 @@ def run(
     ),
     mode: RunModeName = typer.Option(
         RunModeName.forward, help="forward (the samples sent ahead of time to a program that "
-        "plays them on the controller's clock: a busy PC changes nothing), servoj (stream one "
-        "servoJ per period on this computer's clock) or path (the plan's movel/movej program "
+        "plays them on the controller's clock: a busy PC changes nothing), servoj or stream "
+        "(stream one servoJ per period on this computer's clock) or path (the plan's movel/movej program "
         "at its speeds, verified before motion)."
     ),
     buffer: float = typer.Option(
@@ -260,8 +262,9 @@ def stream(trajectory: Path, host: str | None, *, yes: bool = False, **options):
 
 
 def say_emulator_clock(emu) -> None:
-    """After a run on the embedded emulator: say when its clock could not run at real-time
-    priority, or missed periods."""
+    """After a run on the embedded emulator: its clock in one line (on time, or how many
+    periods it ran late to catch up after its host stalled), and when it could not run
+    at real-time priority."""
     from rich.text import Text
 
     try:
@@ -273,8 +276,17 @@ def say_emulator_clock(emu) -> None:
                        "refused: no CAP_SYS_NICE): a busy machine may delay the controller's "
                        "periods"), highlight=False)  # fmt: skip
     if s.get("missed", 0.0):
-        err.print(Text(f"  emulator: its clock missed {s['missed']:.0f} periods (longest gap "
-                       f"{s['gap_max_ms']:.1f} ms)"), highlight=False)  # fmt: skip
+        console.print(Text(f"  emulator clock: its host woke it late; it ran "
+                           f"{s['missed']:.0f} of {s['ticks']:.0f} periods late to catch up "
+                           f"(longest stall {s.get('stall_max_ms', 0.0):.1f} ms): the arm "
+                           "moved on controller time, the stall was the emulator's, not the "
+                           "robot's"), highlight=False)  # fmt: skip
+    else:
+        console.print(Text(f"  emulator clock: on time ({s['ticks']:.0f} periods, latest "
+                           f"{s['lateness_max_ms']:.1f} ms)"), highlight=False)  # fmt: skip
+    if s.get("resyncs", 0.0):
+        err.print(Text(f"  emulator: its host stalled beyond the catch-up bound "
+                       f"{s['resyncs']:.0f} times: controller time jumped"), highlight=False)
 
 
 #: where ``ruledrobot ursim`` listens without ``--host`` (or the next free loopback address)

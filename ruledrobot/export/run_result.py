@@ -27,6 +27,7 @@ class RunMode(str, Enum):
 
     forward = "forward"
     servoj = "servoj"
+    stream = "stream"  #: servoj's other name
     path = "path"
 
 

@@ -81,6 +81,7 @@ def _validate(
     if robot.name != planned.name:
         raise ValueError(f"trajectory planned for a {planned.name}, not for the {robot.name} given")
     mode = mode.value if isinstance(mode, Enum) else str(mode)
+    mode = "servoj" if mode == "stream" else mode  # the streaming mode's other name
     if mode not in ("forward", "servoj", "path"):
         raise ValueError(f"mode: expected 'forward', 'servoj' or 'path', got {mode!r}")
     check_servo_options(lookahead, gain)

@@ -17,8 +17,10 @@ RECENT = 20_000
 class ClockStats:
     """Timing of the controller clock.
 
-    ``ticks``: control periods run.  ``missed``: periods the clock was too
-    late to publish (it steps the controller to catch up, without sending).
+    ``ticks``: control periods run.  ``missed``: periods the clock ran late, after its
+    host woke it late (it runs them, and publishes them with their controller time, to
+    catch up: the controller's time never stretches).  ``stall_max``: the longest such
+    lateness [s] — the emulator's host, not the robot, was slow.
     ``lateness``: recent publish times minus their scheduled times [s].
     ``tick_errors`` / ``publish_errors``: controller periods / publishes that
     raised (logged, rate-limited; the clock goes on).  ``gaps``: recent
@@ -34,6 +36,7 @@ class ClockStats:
     tick_errors: int = 0
     publish_errors: int = 0
     gc_max: float = 0.0
+    stall_max: float = 0.0
     lateness: deque[float] = field(default_factory=lambda: deque(maxlen=RECENT))
     gaps: deque[float] = field(default_factory=lambda: deque(maxlen=RECENT))
 
@@ -52,5 +55,6 @@ class ClockStats:
             "gap_max_ms": float(gap.max() * 1e3),
             "gaps_over_10ms": float(np.count_nonzero(gap > 0.010)),
             "resyncs": float(self.resyncs),
+            "stall_max_ms": self.stall_max * 1e3,
             "gc_max_ms": self.gc_max * 1e3,
         }

@@ -13,6 +13,7 @@ import contextlib
 import gc
 import ipaddress
 import logging
+import math
 import os
 import shutil
 import socket
@@ -58,6 +59,11 @@ CB3_VERSION = (3, 15, 7, 106331)
 _switch_lock = threading.Lock()
 _switch_users = 0
 _switch_saved = 0.005
+
+
+#: s: the longest stall of the emulator's host the clock catches up on (it runs the missed
+#: periods, as the controller would have); a longer one makes the controller's time jump
+MAX_CATCH_UP = 10.0
 
 
 def _check_host(host: str, allow_remote: bool) -> None:
@@ -181,6 +187,8 @@ class ThreadedEmulator:
             srv.realtime = realtime
             srv.frozen = self.frozen
         self.stats = ClockStats()
+        #: periods the clock runs late to catch up after a stall of its host (MAX_CATCH_UP s)
+        self.max_catch_up_ticks = math.ceil(MAX_CATCH_UP / self.controller.period)
         self._stop = threading.Event()
         self._clock: threading.Thread | None = None
         self._started = False
@@ -270,14 +278,20 @@ class ThreadedEmulator:
             now = time.perf_counter()
             late = now - next_t
             if late > period:
-                # behind: step the controller through the missed periods without publishing
+                # the host woke us late: the controller does not pause, so run the periods
+                # it would have run (and publish them, with their controller time), then
+                # this one; only a stall beyond MAX_CATCH_UP s resynchronises (the
+                # controller's time then jumps: logged and counted)
                 missed = int(late // period)
-                if missed > 25:
+                if missed > self.max_catch_up_ticks:
                     stats.resyncs += 1
+                    self._log_error(f"emulator: its host stalled {1e3 * late:.0f} ms: "
+                                    "controller time jumped", stats.resyncs)  # fmt: skip
                     next_t = now
                     missed = 0
+                stats.stall_max = max(stats.stall_max, late)
                 for _ in range(missed):
-                    self._tick()
+                    self._publish(self._tick(), now)
                     stats.ticks += 1
                 stats.missed += missed
                 next_t += missed * period
@@ -286,14 +300,17 @@ class ThreadedEmulator:
             if last_publish is not None:
                 gaps.append(now - last_publish)
             last_publish = now
-            try:
-                self.rtde.publish(state, now, ctrl.ticks)
-            except Exception:  # publish isolates connections; this is a bug, keep the clock
-                stats.publish_errors += 1
-                self._log_error("emulator: publishing failed", stats.publish_errors)
+            self._publish(state, now)
             stats.ticks += 1
             lateness.append(late)
             next_t += period
+
+    def _publish(self, state: dict[str, object], now: float) -> None:
+        try:
+            self.rtde.publish(state, now, self.controller.ticks)
+        except Exception:  # publish isolates connections; this is a bug, keep the clock
+            self.stats.publish_errors += 1
+            self._log_error("emulator: publishing failed", self.stats.publish_errors)
 
     def _gc_timer(self, phase: str, info: dict) -> None:
         """gc callback: the longest collector pause (``stats.gc_max``)."""
