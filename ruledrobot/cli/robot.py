@@ -121,8 +121,8 @@ def run(
     mode: RunModeName = typer.Option(
         RunModeName.forward, help="forward (the samples sent ahead of time to a program that "
         "plays them on the controller's clock: a busy PC changes nothing), servoj or stream "
-        "(stream one servoJ per period on this computer's clock) or path (the plan's movel/movej program "
-        "at its speeds, verified before motion)."
+        "(stream one servoJ per period on this computer's clock) or path (the plan's "
+        "movel/movej program at its speeds, verified before motion)."
     ),
     buffer: float = typer.Option(
         0.5, min=0.05, max=5.0, help="forward mode: the longest stall of this computer the "
