@@ -10,7 +10,8 @@ range) and the sample ranges with the heat on.
   heat off when a run ended without its client (:func:`heat_off_program`);
 * :func:`set_heat_rtde` — the same through ur_rtde's ``RTDEIOInterface`` during a
   streamed run;
-* :func:`send_heat_off` — the secondary program above, sent to a controller.
+* :func:`send_heat_off` — the secondary program above, sent to a controller;
+* :func:`heat_from_outputs` — the heat's state read back from a run's recorded outputs.
 """
 
 from __future__ import annotations
@@ -18,10 +19,13 @@ from __future__ import annotations
 import socket
 from typing import Any
 
+import numpy as np
+
 from ..protocol.primary import SECONDARY_PORT
 from ..robot.motion.trajectory import Heat
 
-__all__ = ["heat_off_program", "send_heat_off", "set_heat_rtde", "urscript_heat"]
+__all__ = ["heat_from_outputs", "heat_off_program", "send_heat_off", "set_heat_rtde",
+           "urscript_heat"]
 
 
 def urscript_heat(heat: Heat, on: bool) -> str:
@@ -30,6 +34,18 @@ def urscript_heat(heat: Heat, on: bool) -> str:
         value = heat.value if on else 0.0
         return f"set_standard_analog_out({heat.index}, {value:.6g})"
     return f"set_{heat.kind}_digital_out({heat.index}, {'True' if on else 'False'})"
+
+
+def heat_from_outputs(heat: Heat, outputs: np.ndarray) -> np.ndarray:
+    """(M,) bool: ``heat`` on in recorded outputs ``outputs`` (M, 3): RTDE's
+    ``actual_digital_output_bits`` (standard 0-7, configurable 8-15, tool 16-17) and
+    ``standard_analog_output0/1`` (on above zero).  NaN rows (not read) count as off."""
+    o = np.asarray(outputs, dtype=float).reshape(-1, 3)
+    if heat.kind == "analog":
+        return np.nan_to_num(o[:, 1 + heat.index], nan=0.0) > 0.0
+    bit = heat.index + {"standard": 0, "configurable": 8, "tool": 16}[heat.kind]
+    bits = np.nan_to_num(o[:, 0], nan=0.0).astype(np.int64)
+    return ((bits >> bit) & 1).astype(bool)
 
 
 def heat_off_program(heat: Heat) -> str:

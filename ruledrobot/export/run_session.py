@@ -8,10 +8,11 @@ through a :class:`Link`:
 
 * ``("stage", name, timeout)`` before every step: the supervisor kills the
   child when no message follows within ``timeout`` seconds;
-* ``("rec", t, q, tcp, k, info)`` every ``CHUNK`` seconds while recording: the
-  recording so far (controller time, actual joints, actual TCP, and the grid sample
+* ``("rec", t, q, tcp, k, outs, info)`` every ``CHUNK`` seconds while recording: the
+  recording so far (controller time, actual joints, actual TCP, the grid sample
   the deviation match put each at, -1 where none was made: the settling after a
-  stop), plus the progress (``info``: matched grid sample, samples sent, largest
+  stop, and the outputs the heat is switched on: digital bits, analog 0 and 1), plus
+  the progress (``info``: matched grid sample, samples sent, largest
   deviation, samples skipped);
   it doubles as the heartbeat; ``("beat", info)`` when not recording;
 * ``("stopping", status, message)`` when the session stops on a fault.
@@ -38,6 +39,7 @@ __all__ = ["CHUNK", "Link", "Session", "SessionError", "Stop"]
 #: seconds between recording chunks / heartbeats
 CHUNK = 0.05
 RUNTIME_PLAYING = 2
+_NO_OUTPUTS = [float("nan")] * 3
 
 
 class Stop(Exception):
@@ -116,7 +118,7 @@ class Session:
         self.sent = 0
         self.window = 10
         self.recording = False
-        self._buf: list[tuple[float, list[float], list[float], int]] = []
+        self._buf: list[tuple[float, list[float], list[float], int, list[float]]] = []
         self._fresh = False  # the last recorded sample awaits its deviation match
         self._last_ts = -math.inf
         self._ts0: float | None = None
@@ -210,7 +212,8 @@ class Session:
         self._ts0 = None
         self._last_ts = -math.inf
 
-    def record(self, ts: float, q: list[float], tcp: list[float]) -> None:
+    def record(self, ts: float, q: list[float], tcp: list[float],
+               outputs: list[float] | None = None) -> None:  # fmt: skip
         """Append one data package while recording (packages not newer than the
         last are skipped).
 
@@ -223,25 +226,32 @@ class Session:
         tcp : list of float, 6 values
             Actual TCP pose in the base frame as a UR pose vector: position [m],
             rotation vector [rad].
+        outputs : list of float, 3 values, optional
+            The outputs the wire's heat may be on: ``actual_digital_output_bits``,
+            ``standard_analog_output0`` and ``1`` (NaN when not read).
         """
         if self.recording and ts > self._last_ts:
             if self._ts0 is None:
                 self._ts0 = ts
             self._last_ts = ts
-            self._buf.append((ts - self._ts0, q, tcp, -1))
+            outs = _NO_OUTPUTS if outputs is None else outputs
+            self._buf.append((ts - self._ts0, q, tcp, -1, outs))
             self._fresh = True
 
-    def snapshot(self) -> tuple[float, list[float], list[float]]:
-        """(controller time, actual q, actual TCP) of one data package: ur_rtde's getters
-        each read the newest package, so a package arriving between them would mix two;
-        the timestamp read again tells."""
+    def snapshot(self) -> tuple[float, list[float], list[float], list[float]]:
+        """(controller time, actual q, actual TCP, outputs) of one data package (outputs:
+        the digital output bits and the two standard analog outputs, where the wire's
+        heat is switched): ur_rtde's getters each read the newest package, so a package
+        arriving between them would mix two; the timestamp read again tells."""
         r = self.r
         for _ in range(4):
             ts = r.getTimestamp()
             q, tcp = r.getActualQ(), r.getActualTCPPose()
+            outs = [float(r.getActualDigitalOutputBits()), float(r.getStandardAnalogOutput0()),
+                    float(r.getStandardAnalogOutput1())]  # fmt: skip
             if r.getTimestamp() == ts:
                 break
-        return ts, q, tcp
+        return ts, q, tcp, outs
 
     def info(self) -> dict:
         """The progress so far: ``k_match`` (matched grid sample), ``sent``,
@@ -288,8 +298,9 @@ class Session:
             q = np.array([b[1] for b in self._buf])
             tcp = np.array([b[2] for b in self._buf])
             k = np.array([b[3] for b in self._buf], dtype=np.int64)
+            outs = np.array([b[4] for b in self._buf], dtype=float)
             self._buf = []
-            self.link.send("rec", t, q, tcp, k, self.info())
+            self.link.send("rec", t, q, tcp, k, outs, self.info())
         else:
             self.link.send("beat", self.info())
 
@@ -324,8 +335,8 @@ class Session:
             raise Stop("emergency_stop", "the robot is emergency stopped")
         if r.isProtectiveStopped():
             raise Stop("protective_stop", "the robot is protective stopped")
-        ts, qa, tcp = self.snapshot()
-        self.record(ts, qa, tcp)
+        ts, qa, tcp, outs = self.snapshot()
+        self.record(ts, qa, tcp, outs)
         lag = (time.monotonic() - self._wall0) - (ts - self._clock_ts0)
         self._lag_min = min(self._lag_min, lag)
         if lag - self._lag_min > self.max_latency:
@@ -367,7 +378,8 @@ class Session:
         self.k_match = lo + j
         self.k_high = max(self.k_high, self.k_match)
         if self._fresh and self._buf:  # the sample poll() just recorded: where it is
-            self._buf[-1] = (*self._buf[-1][:3], self.k_match)
+            b = self._buf[-1]
+            self._buf[-1] = (b[0], b[1], b[2], self.k_match, b[4])
             self._fresh = False
         self.max_dev = max(self.max_dev, dev)
         if dev > self.deviation_limit:

@@ -43,7 +43,7 @@ class Outcome:
     ``status``/``message``: the child's (``done``) or the supervisor's
     (``client_died``, ``client_hung``, or the stop the child had reported,
     with what happened after); ``info``: the child's last progress
-    (``k_match``, ``sent``, ``max_dev``); ``chunks``: the recording, (t, q, tcp, k)
+    (``k_match``, ``sent``, ``max_dev``); ``chunks``: the recording, (t, q, tcp, k, outputs)
     arrays in order (``k``: the grid sample each was matched to, -1 for none);
     ``killed``: the supervisor killed the child;
     ``exit``: how the child ended, in words; ``log``: the tail of its output;

@@ -24,6 +24,12 @@ the same way, nearest in joint space near the last match).  From them:
   the recording (a skip the servo smoothed is no defect of the part).  Only where nothing
   physical can be measured (no ``meta.cut``, nothing recorded) do the skips gate the run.
   The skipped samples in all and the longest slip are information;
+* **hot dwell** (``hot_dwell``): the longest time the actual wire stayed in the block
+  with the heat on (the controller's outputs, recorded with the joints) cutting slower
+  than half the slowest set feed (:func:`~ruledrobot.robot.wire.cut.hot_dwell`), at most
+  its plan's own (the corner stops) plus 0.1 s: a wire that waits hot in the foam burns
+  it — what a stall of the PC did to a streamed cut, and what a forwarded run's controlled
+  stop prevents by switching the heat off as it decelerates;
 * **motion** (the run completed) and the **joint deviation** (the live monitor's largest).
 
 A trajectory without ``meta.cut`` (files from before the planner wrote it) has no feed
@@ -40,8 +46,16 @@ import numpy as np
 
 from ..robot.motion.trajectory import Trajectory, model_for
 from ..robot.verdict import Check, Verdict
-from ..robot.wire.cut import FeedMeasure, FeedWindow, WireCut, feed_measures
-from ..robot.wire.in_stock import largest_line_distance, runs_of, wire_ends
+from ..robot.wire.cut import (
+    DWELL_FRACTION,
+    DWELL_SLACK,
+    FeedMeasure,
+    FeedWindow,
+    WireCut,
+    feed_measures,
+    hot_dwell,
+)
+from ..robot.wire.in_stock import WireInStock, largest_line_distance, runs_of, wire_ends
 from .run_plan import inside_mask
 from .urscript import plan_wire_tolerance
 
@@ -155,6 +169,29 @@ def _where(traj: Trajectory, ranges: list[tuple[int, int]], most: int = 4) -> st
     return ", ".join(parts) + more
 
 
+def _dwell_check(traj: Trajectory, wis: WireInStock, hot: np.ndarray | None,
+                 speed_scale: float, idx: np.ndarray) -> Check:  # fmt: skip
+    """``hot_dwell``: the longest time the recorded hot wire stayed in the block cutting
+    slower than half the slowest set feed, against its plan's own (corner stops) plus
+    :data:`~ruledrobot.robot.wire.cut.DWELL_SLACK`."""
+    label = "longest hot dwell of the actual wire in the block"
+    cut, heat = traj.meta.cut, traj.meta.heat
+    if heat is None or hot is None or cut is None or not cut.feeds:
+        why = "the trajectory switches no heat" if heat is None else "heat not recorded"
+        return Check.info("hot_dwell", label, f"not measured: {why}")
+    speed = min(f.speed for f in cut.feeds) * speed_scale
+    plan_wis = traj.wire_in_stock()
+    assert plan_wis is not None
+    planned = hot_dwell(plan_wis, heat.on(traj.n), speed / speed_scale).seconds / speed_scale
+    got = hot_dwell(wis, np.asarray(hot, dtype=bool)[: wis.n], speed)
+    where = (f" from plan sample {int(idx[got.start])} (t = {traj.t[int(idx[got.start])]:.3f}"
+             f" s, {traj.phase_at(int(idx[got.start]))})" if got.start >= 0 else "")
+    return Check.at_most("hot_dwell", label, got.seconds, planned + DWELL_SLACK, "s",
+                         f"{got.seconds:.3f} s with the heat on below "
+                         f"{1e3 * DWELL_FRACTION * speed:.1f} mm/s{where}; the plan's own "
+                         f"{planned:.3f} s (corner stops)")  # fmt: skip
+
+
 def measure_run(
     traj: Trajectory,
     rec: Trajectory | None,
@@ -169,13 +206,16 @@ def measure_run(
     deviation_limit: float = DEVIATION_LIMIT,
     speed_scale: float = 1.0,
     wire_tolerance: float | None = None,
+    hot: np.ndarray | None = None,
 ) -> RunMeasures:
     """The run's verdict and measures (module doc).  ``traj``: the plan; ``rec``: the
     recording (None when nothing was recorded); ``plan_index`` (R,): the plan sample of
     each recorded sample (:func:`align_recording` mapped to input samples);
     ``skipped_ranges``: the skipped samples as half-open plan-sample ranges;
     ``wire_tolerance`` (m): the wire deviation's limit, default the plan's
-    (:func:`~.urscript.plan_wire_tolerance`: the strictest of its cuts')."""
+    (:func:`~.urscript.plan_wire_tolerance`: the strictest of its cuts'); ``hot`` (R,):
+    the heat on at each recorded sample, as the controller's outputs said (None: not
+    recorded), for the hot dwell."""
     wire_tolerance = plan_wire_tolerance(traj, wire_tolerance)
     checks = [
         Check("motion", "the motion ran to the end", status, "completed", "", "==",
@@ -235,6 +275,7 @@ def measure_run(
         wdev, wat = float("nan"), -1
         checks.append(Check.info("wire_deviation", "actual wire from the planned wire in the "
                                  "block", "the actual wire never entered the block"))  # fmt: skip
+    checks.append(_dwell_check(traj, wis, hot, speed_scale, idx))
     feeds = feed_measures(wis, rcut)
     of = len(feeds) > 1
     for f in feeds:

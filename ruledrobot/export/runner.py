@@ -47,7 +47,7 @@ from ..robot.motion.trajectory import Trajectory
 from ..robot.verdict import Check, Verdict
 from . import settings  # the defaults a run shares with the exported program
 from .forward import ForwardSettings
-from .heat import send_heat_off
+from .heat import heat_from_outputs, send_heat_off
 from .limits import check_trajectory
 from .run_checks import controller_checks, kinematics_check, query_dashboard, readiness_check
 from .run_plan import Entry, plan_entry, recording_path_for, resample, stop_place
@@ -474,8 +474,12 @@ def _move(
         plan_index = to_input[np.clip(kg, 0, to_input.size - 1)]
     else:
         plan_index = np.zeros(0, dtype=np.int64)
+    heat = traj.meta.heat
+    hot_rec = None  # the heat as the controller's outputs reported it, per recorded sample
+    if rec is not None and heat is not None:
+        hot_rec = heat_from_outputs(heat, np.concatenate([c[4] for c in out.chunks]))
     measures = measure_run(traj, rec, plan_index, status=result.status,
-                           message=result.message, skipped_ranges=skips,
+                           message=result.message, skipped_ranges=skips, hot=hot_rec,
                            max_slip=result.max_slip, max_latency=o["max_latency"],
                            max_deviation=result.max_deviation,
                            deviation_limit=o["deviation_limit"], speed_scale=speed_scale,

@@ -26,7 +26,7 @@ from ruledrobot.export.run_plan import inside_mask, plan_entry, stop_place
 from ruledrobot.export.run_verdict import align_recording, measure_run, recording_cut
 from ruledrobot.geometry.box import Box
 from ruledrobot.io.trajectory import read_trajectory, write_trajectory
-from ruledrobot.robot.motion.trajectory import Trajectory
+from ruledrobot.robot.motion.trajectory import Heat, Trajectory
 from ruledrobot.robot.wire.cut import FeedWindow, WireCut
 from ruledrobot.robot.wire.in_stock import runs_of
 from ruledrobot.ursim import Emulator
@@ -136,6 +136,40 @@ def test_skipped_samples_in_the_stock_are_information_the_feed_decides() -> None
     jumped = Trajectory(traj.t, q, traj.tcp, traj.meta)
     m = _measure(traj, jumped, skipped_ranges=[(400, 430)], max_slip=0.06)
     assert not m.verdict.ok and "feed_max" in [c.name for c in m.verdict.failed]
+
+
+def _held_in_the_block(traj: Trajectory, at: int, samples: int) -> tuple[Trajectory, np.ndarray]:
+    """A recording of ``traj`` that holds still at plan sample ``at`` for ``samples``
+    periods, then goes on as planned; and its plan index."""
+    dt = float(traj.t[1] - traj.t[0])
+    idx = np.r_[np.arange(at + 1), np.full(samples, at), np.arange(at + 1, traj.n)]
+    t = np.arange(idx.size) * dt
+    return Trajectory(t, traj.q[idx], traj.tcp[idx], traj.meta), idx
+
+
+def test_a_hot_wire_that_waits_in_the_block_fails_the_run() -> None:
+    """The hot dwell (issue 31): a wire held 0.3 s in the block with the heat on (the
+    outputs recorded say so) burns the foam: it fails ``hot_dwell``, which says where; the
+    same hold with the heat off passes (what a forwarded run's controlled stop does); a
+    heat that was not recorded is not measured."""
+    traj = block_trajectory()
+    hot_plan = Heat("standard", 0, windows=((100, 900),))
+    traj = Trajectory(traj.t, traj.q, traj.tcp, traj.meta.replace(heat=hot_plan))
+    dt = float(traj.t[1] - traj.t[0])
+    held = round(0.3 / dt)
+    rec, idx = _held_in_the_block(traj, 500, held)
+    hot = hot_plan.on(traj.n)[idx]
+    m = _measure(traj, rec, plan_index=idx, hot=hot)
+    c = m.verdict["hot_dwell"]
+    assert not c.ok and c.gating and c.value == pytest.approx(held * dt, abs=2 * dt), c
+    assert "plan sample 50" in c.detail and "cut" in c.detail
+    cold = hot.copy()
+    cold[500:] = False  # the heat switched off where the wire stopped
+    m = _measure(traj, rec, plan_index=idx, hot=cold)
+    assert m.verdict["hot_dwell"].ok and m.verdict["hot_dwell"].value < 0.01
+    assert "not measured" in str(_measure(traj, rec, plan_index=idx).verdict["hot_dwell"].value)
+    # the plan's own slow samples (its corner stops) are allowed: the plan on itself passes
+    assert _measure(traj, traj, hot=hot_plan.on(traj.n)).verdict.ok
 
 
 def test_a_recording_whose_feed_broke_the_tolerance_fails() -> None:

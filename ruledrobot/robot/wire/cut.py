@@ -24,14 +24,19 @@ from numpy.typing import ArrayLike
 
 from ...geometry.box import Box
 from ..verdict import Check
-from .in_stock import WireInStock, wire_ends, wire_in_stock
+from .in_stock import WireInStock, runs_of, wire_ends, wire_in_stock
 
-__all__ = ["WIRE_TOLERANCE", "FeedMeasure", "FeedWindow", "WireCut", "feed_checks",
-           "feed_measures"]
+__all__ = ["DWELL_FRACTION", "DWELL_SLACK", "WIRE_TOLERANCE", "FeedMeasure", "FeedWindow",
+           "HotDwell", "WireCut", "feed_checks", "feed_measures", "hot_dwell"]
 
 #: m: how far the wire may stray from its target in the stock, by default (a job's
 #: ``wire_tolerance``; a trajectory whose sidecar names none)
 WIRE_TOLERANCE = 0.0005
+#: a hot wire in the block cutting slower than this fraction of the slowest set feed
+#: dwells: the melt widens the kerf there, and a wire that stops burns a hole
+DWELL_FRACTION = 0.5
+#: s: how much longer than its plan's a run's longest hot dwell may be
+DWELL_SLACK = 0.1
 
 
 def _ranges(value: object, what: str) -> tuple[tuple[int, int], ...]:
@@ -213,3 +218,29 @@ def feed_measures(wis: WireInStock, cut: WireCut) -> tuple[FeedMeasure, ...]:
         lo, _, k_lo, _ = wis.feed_extremes(held)
         out.append(FeedMeasure(name, ws[0].speed, ws[0].tolerance, hi, lo, k_hi, k_lo))
     return tuple(out)
+
+
+@dataclass(frozen=True)
+class HotDwell:
+    """The longest time the hot wire stayed in the block cutting slower than
+    :data:`DWELL_FRACTION` of the slowest set feed: ``seconds``, from sample ``start`` to
+    ``stop`` (half-open; ``start = -1`` and 0 s when it never did)."""
+
+    seconds: float
+    start: int = -1
+    stop: int = -1
+
+
+def hot_dwell(wis: WireInStock, hot: ArrayLike, speed: float) -> HotDwell:
+    """:class:`HotDwell` of a motion: ``wis`` the wire against the block (M samples),
+    ``hot`` (M,) the heat on, ``speed`` (m/s) the slowest set feed.  A dwell lasts from
+    its first sample to the first sample after it (the time the wire spent there)."""
+    h = np.asarray(hot, dtype=bool)
+    slow = wis.inside & h & ~(np.nan_to_num(wis.feed, nan=0.0) >= DWELL_FRACTION * speed)
+    best = HotDwell(0.0)
+    t, n = wis.t, wis.n
+    for a, b in runs_of(slow):
+        secs = float(t[min(b, n - 1)] - t[a])
+        if secs > best.seconds:
+            best = HotDwell(secs, a, b)
+    return best
