@@ -41,6 +41,13 @@ class ClockStats:
     gaps: deque[float] = field(default_factory=lambda: deque(maxlen=RECENT))
 
     def summary(self) -> dict[str, float]:
+        """The statistics as one flat dict of floats, durations in milliseconds.
+
+        Counts (``ticks``, ``missed``, ``tick_errors``, ``resyncs``, ``gaps_over_10ms``: gaps longer
+        than 10 ms), ``missed_fraction`` (of the ticks), ``lateness_mean_ms``, ``lateness_p99_ms``,
+        ``lateness_max_ms``, ``gap_p99_ms``, ``gap_max_ms``, ``stall_max_ms`` and ``gc_max_ms``; an
+        empty record counts as a single 0.
+        """
         lat = np.asarray(self.lateness or [0.0])
         gap = np.asarray(self.gaps or [0.0])
         return {

@@ -45,14 +45,40 @@ _SECONDS = re.compile(r"^(\d+(?:\.\d*)?|\.\d+)(ms|s)?$")
 class FaultTarget(Protocol):
     """What a fault acts on (:class:`~.server.ThreadedEmulator`, :class:`~.process.Emulator`)."""
 
-    def protective_stop(self, reason: str = ...) -> None: ...
-    def emergency_stop(self, reason: str = ...) -> None: ...
-    def release_emergency_stop(self) -> None: ...
-    def drop_connections(self, refuse_for: float = ...) -> int: ...
-    def freeze(self, duration: float | None = ...) -> None: ...
-    def unfreeze(self) -> None: ...
-    def set_slow(self, delay: float, jitter: float = ...) -> None: ...
-    def clear_faults(self) -> None: ...
+    def protective_stop(self, reason: str = ...) -> None:
+        """Protective stop: the arm brakes, the program stops; ``reason`` is logged."""
+        ...
+
+    def emergency_stop(self, reason: str = ...) -> None:
+        """Robot emergency stop: the arm brakes, then power goes off; ``reason`` is logged."""
+        ...
+
+    def release_emergency_stop(self) -> None:
+        """Release the emergency stop (safety NORMAL; power on and brake release follow)."""
+        ...
+
+    def drop_connections(self, refuse_for: float = ...) -> int:
+        """Close every client connection; refuse new ones for ``refuse_for`` [s].
+
+        Returns how many connections were closed.
+        """
+        ...
+
+    def freeze(self, duration: float | None = ...) -> None:
+        """Freeze the controller for ``duration`` [s] (None: until :meth:`unfreeze`)."""
+        ...
+
+    def unfreeze(self) -> None:
+        """End the frozen-controller fault."""
+        ...
+
+    def set_slow(self, delay: float, jitter: float = ...) -> None:
+        """Hold every RTDE data package back by ``delay`` [s] (plus up to ``jitter`` [s])."""
+        ...
+
+    def clear_faults(self) -> None:
+        """Back to safety NORMAL and robot RUNNING at once, the stream without delay."""
+        ...
 
 
 @dataclass(frozen=True)
@@ -66,6 +92,7 @@ class FaultSpec:
     text: str = ""
 
     def describe(self) -> str:
+        """One line for people: kind, argument and when, e.g. ``freeze (3 s) 10 s after start``."""
         when = f"{self.at:g} s after start" if self.signal is None else f"on {self.signal}"
         arg = f" ({self.arg:g} s)" if self.arg is not None else ""
         return f"{self.kind}{arg} {when}"
@@ -142,6 +169,12 @@ class FaultSchedule:
         self.fired: list[FaultSpec] = []
 
     def start(self, emu: FaultTarget) -> FaultSchedule:
+        """Arm the faults against ``emu``; returns self.
+
+        Signal faults get their handlers now (the previous ones are kept for :meth:`stop`; call this
+        in the main thread).  Timed faults fire from a daemon thread, each ``at`` seconds after this
+        call (monotonic clock), in order of ``at``.
+        """
         t0 = time.monotonic()
         timed = sorted((s for s in self.specs if s.at is not None), key=lambda s: s.at or 0.0)
         by_signal: dict[str, list[FaultSpec]] = {}
@@ -175,6 +208,7 @@ class FaultSchedule:
             self.on_fire(spec)
 
     def stop(self) -> None:
+        """Stop the timer thread (waiting up to 2 s) and restore the saved signal handlers."""
         self._stop.set()
         if self._thread is not None:
             self._thread.join(2.0)

@@ -278,6 +278,7 @@ class Emulator:
 
     @property
     def running(self) -> bool:
+        """True while the emulator serves: the child process lives, or the in-process clock runs."""
         if self._local is not None:
             return self._local.running
         return self._proc is not None and self._proc.poll() is None
@@ -345,6 +346,11 @@ class Emulator:
     # state
     @property
     def ports(self) -> dict[str, int]:
+        """The bound ports, keyed by server name; empty before :meth:`start`.
+
+        Keys ``rtde``, ``dashboard``, ``script``, ``primary`` and ``secondary``; where port 0 was
+        asked for, the port the system picked.
+        """
         return dict(self._ports)
 
     @property
@@ -359,14 +365,17 @@ class Emulator:
 
     @property
     def robot_mode(self) -> RobotMode:
+        """The controller's robot mode (RUNNING, IDLE, POWER_OFF, ...)."""
         return RobotMode(self._call("robot_mode"))
 
     @property
     def safety_mode(self) -> SafetyMode:
+        """The controller's safety mode (NORMAL, PROTECTIVE_STOP, ROBOT_EMERGENCY_STOP, ...)."""
         return SafetyMode(self._call("safety_mode"))
 
     @property
     def runtime_state(self) -> RuntimeState:
+        """The runtime state of the controller's program (STOPPED, PLAYING, PAUSED)."""
         return RuntimeState(self._call("runtime_state"))
 
     @property

@@ -248,6 +248,7 @@ class ThreadedEmulator:
 
     @property
     def running(self) -> bool:
+        """True between :meth:`start` and :meth:`close` while the clock thread lives."""
         return self._started and self._clock is not None and self._clock.is_alive()
 
     def _hello(self) -> bytes:
@@ -404,6 +405,7 @@ class ThreadedEmulator:
 
     @property
     def actual_q(self) -> np.ndarray:
+        """Actual joint positions [rad], shape (6,), base to wrist 3 (a copy)."""
         with self.controller.lock:
             return self.controller.backend.state().q.copy()
 
@@ -415,14 +417,17 @@ class ThreadedEmulator:
 
     @property
     def robot_mode(self) -> RobotMode:
+        """The controller's robot mode (RUNNING, IDLE, POWER_OFF, ...)."""
         return self.controller.robot_mode
 
     @property
     def safety_mode(self) -> SafetyMode:
+        """The controller's safety mode (NORMAL, PROTECTIVE_STOP, ROBOT_EMERGENCY_STOP, ...)."""
         return self.controller.safety_mode
 
     @property
     def runtime_state(self) -> RuntimeState:
+        """The runtime state of the controller's program (STOPPED, PLAYING, PAUSED)."""
         return self.controller.runtime_state
 
     @property

@@ -20,7 +20,7 @@ ROOT = Path(__file__).resolve().parents[2] / "ruledrobot"
 #: packages whose every public definition and module has a docstring
 PACKAGES = ("subdivision", "algorithms", "geometry", "robot", "io", "sim", "export", "wirecut",
             "place", "batch", "cli", "protocol", "view",
-            "carve", "gallery")  # fmt: skip
+            "carve", "gallery", "ursim")  # fmt: skip
 #: packages whose docstrings also open with a one-line summary (numpydoc); the others
 #: still hold docstrings of the older style, a paragraph from the first line
 SUMMARY_PACKAGES = ("subdivision", "algorithms")

@@ -144,6 +144,10 @@ class KinematicBackend:
         return self._mode
 
     def reset(self, q: ArrayLike) -> None:
+        """Put the arm at rest at joint positions ``q`` [rad], shape (6,), in hold mode.
+
+        Actual and target state alike: zero speed and acceleration, ``limited`` cleared.
+        """
         q = np.array(q, dtype=float).reshape(6)
         s = self._state
         s.q = q.copy()
@@ -157,11 +161,23 @@ class KinematicBackend:
         self._ref = q.copy()
 
     def track(self, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) -> None:
+        """Trajectory mode: follow the setpoint ``q`` [rad] moving at ``qd`` [rad/s].
+
+        ``qdd`` is not used (the acceleration follows from consecutive setpoints).  Exact when the
+        step respects the speed and acceleration limits, else braked and clipped to them
+        (``ArmState.limited``).
+        """
         self._mode = "track"
         self._goal = np.asarray(q, dtype=float)
         self._goal_qd = np.asarray(qd, dtype=float)
 
     def servo(self, q: ArrayLike, lookahead_time: float, gain: float) -> None:
+        """Servo mode (servoJ): approach ``q`` [rad] through a first-order filter.
+
+        Time constant ``lookahead_time * clip(300 / gain, 0.2, 1)`` [s], with ``lookahead_time``
+        clipped to [0, 1] s and a ``gain`` <= 0 taken as 300.  Entering the mode starts the filter
+        at the current setpoint.
+        """
         if self._mode != "servo":
             self._ref = self._state.target_q.copy()
             self._mode = "servo"
@@ -171,11 +187,20 @@ class KinematicBackend:
         self._tau = la * min(max(300.0 / g, 0.2), 1.0)
 
     def speed(self, qd: ArrayLike, acceleration: float) -> None:
+        """Speed mode (speedJ): ramp the joint speeds to ``qd`` [rad/s] and keep them.
+
+        The ramp's acceleration is ``|acceleration|`` [rad/s^2] (1 when zero), capped by the limit;
+        the target speeds are clipped to ``max_velocity`` (``ArmState.limited``).
+        """
         self._mode = "speed"
         self._goal_qd = np.asarray(qd, dtype=float)
         self._speed_acc = abs(float(acceleration)) or 1.0
 
     def hold(self) -> None:
+        """Hold mode: brake to rest, within the limits, on the setpoint where the hold began.
+
+        Nothing changes when the arm already holds.
+        """
         if self._mode != "hold":
             self._ref = self._state.target_q.copy()
             self._mode = "hold"
@@ -218,6 +243,7 @@ class KinematicBackend:
         s.q, s.qd, s.qdd = clipped, qd_new, qdd
 
     def step(self, dt: float) -> None:
+        """Advance the setpoint, and the ideal arm with it, by ``dt`` [s] (none for ``dt <= 0``)."""
         if dt <= 0.0:
             return
         s = self._state
@@ -238,4 +264,5 @@ class KinematicBackend:
             self._follow(self._ref, np.zeros(6), dt)
 
     def state(self) -> ArmState:
+        """The state after the last step: the backend's own :class:`ArmState` (copy to keep it)."""
         return self._state

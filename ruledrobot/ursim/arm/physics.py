@@ -37,6 +37,7 @@ class MujocoBackend(KinematicBackend):
         super().__init__(model, **kwargs)  # calls reset(), which needs the model above
 
     def reset(self, q: ArrayLike) -> None:
+        """Put the kinematic setpoint and the MuJoCo arm at rest at ``q`` [rad], shape (6,)."""
         super().reset(q)
         J = self._J
         self._d.qpos[:J] = np.asarray(q, dtype=float)
@@ -46,6 +47,12 @@ class MujocoBackend(KinematicBackend):
         self._phys = ArmState(q=self._d.qpos[:J].copy(), target_q=self._d.qpos[:J].copy())
 
     def step(self, dt: float) -> None:
+        """Advance the setpoint by ``dt`` [s], then the MuJoCo arm tracking it for ``dt``.
+
+        The actuators get the setpoint's positions and speeds; ``round(dt / timestep)`` physics
+        steps (at least one) follow.  The actual state is then MuJoCo's ``qpos`` and ``qvel``, their
+        finite-difference acceleration and the joint torque sensors [N m] (zeros without them).
+        """
         super().step(dt)  # the setpoint of this period
         sp = super().state()
         J, d = self._J, self._d
@@ -62,4 +69,5 @@ class MujocoBackend(KinematicBackend):
         )  # fmt: skip
 
     def state(self) -> ArmState:
+        """The simulated arm's state after the last step (target: the kinematic setpoint)."""
         return self._phys

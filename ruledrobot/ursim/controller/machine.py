@@ -1,33 +1,28 @@
 """The emulated controller: robot/safety/program state machine, registers, I/O, motion.
 
-One :class:`Controller` owns the state a UR controller publishes over RTDE.
-:meth:`Controller.tick` advances it by one control period (2 ms e-Series,
-8 ms CB3): the running program (ur_rtde's control script, via
-:class:`~..script.handshake.ControlScript`, or any other program, via the URScript
-interpreter :class:`~..script.interpreter.Interpreter`) reads its inputs, the trajectory
-generator produces a setpoint, the arm backend steps, and the published
-variables (``values``, keyed by RTDE name) are refreshed.
+One :class:`Controller` owns the state a UR controller publishes over RTDE.  :meth:`Controller.tick`
+advances it by one control period (2 ms e-Series, 8 ms CB3): the running program (ur_rtde's
+control script, via :class:`~..script.handshake.ControlScript`, or any other program, via the
+URScript interpreter :class:`~..script.interpreter.Interpreter`) reads its inputs, the trajectory
+generator produces a setpoint, the arm backend steps, and the published variables (``values``,
+keyed by RTDE name) are refreshed.
 
 State machine (the parts clients see):
 
-* ``robot_mode``: RUNNING after start-up; ``power off`` -> POWER_OFF,
-  ``power on`` -> IDLE, ``brake release`` -> RUNNING (dashboard).  Programs
-  only start while RUNNING with safety NORMAL.
-* ``safety_mode``: NORMAL; :meth:`protective_stop` -> PROTECTIVE_STOP (the
-  arm brakes, the program stops; ``unlock protective stop`` after
-  ``unlock_delay`` s); :meth:`emergency_stop` -> ROBOT_EMERGENCY_STOP (the
-  arm brakes, power goes off; :meth:`release_emergency_stop`, then power on
-  and brake release).
+* ``robot_mode``: RUNNING after start-up; ``power off`` -> POWER_OFF, ``power on`` -> IDLE,
+  ``brake release`` -> RUNNING (dashboard).  Programs only start while RUNNING with safety NORMAL.
+* ``safety_mode``: NORMAL; :meth:`protective_stop` -> PROTECTIVE_STOP (the arm brakes, the program
+  stops; ``unlock protective stop`` after ``unlock_delay`` s); :meth:`emergency_stop` ->
+  ROBOT_EMERGENCY_STOP (the arm brakes, power goes off; :meth:`release_emergency_stop`, then power
+  on and brake release).
 * ``runtime_state``: STOPPED / PLAYING / PAUSED of the current program.
-* programs are compiled before they start (:mod:`..script.interpreter`): one line
-  the emulator cannot run refuses the whole program, nothing of it runs, the
-  running program is stopped, the compile error is logged at error level and
-  shown as the pendant's popup (:attr:`Controller.popup`, closed by the
-  dashboard's ``close popup``).
+* programs are compiled before they start (:mod:`..script.interpreter`): one line the emulator
+  cannot run refuses the whole program, nothing of it runs, the running program is stopped, the
+  compile error is logged at error level and shown as the pendant's popup
+  (:attr:`Controller.popup`, closed by the dashboard's ``close popup``).
 
-Thread safety: every public method takes ``lock`` (re-entrant); the RTDE,
-dashboard and script-port threads call in concurrently with the clock thread.
-"""
+Thread safety: every public method takes ``lock`` (re-entrant); the RTDE, dashboard and
+script-port threads call in concurrently with the clock thread."""
 
 from __future__ import annotations
 
@@ -324,6 +319,7 @@ class Controller(IOMixin, SafetyMixin):
     # ------------------------------------------------------------ motion
 
     def start_motion(self, motion: PathMotion | StopMotion) -> None:
+        """Run ``motion`` (a path or a stop) from the next period; no check that it may move."""
         with self.lock:
             self.motion = motion
             self.mode = "move"
@@ -338,6 +334,7 @@ class Controller(IOMixin, SafetyMixin):
             return stop
 
     def set_servo(self, q: ArrayLike, lookahead_time: float, gain: float) -> None:
+        """Servo mode (servoj) towards ``q`` [rad], (6,); ignored unless the robot may move."""
         with self.lock:
             if not self._can_move():
                 return
@@ -347,6 +344,7 @@ class Controller(IOMixin, SafetyMixin):
             self.backend.servo(q, lookahead_time, gain)
 
     def set_speed(self, qd: ArrayLike, acceleration: float) -> None:
+        """Speed mode (speedj): joint speeds ``qd`` [rad/s]; ignored unless the robot may move."""
         with self.lock:
             if not self._can_move():
                 return
@@ -394,8 +392,7 @@ class Controller(IOMixin, SafetyMixin):
         """A program arrived on the script port: compiled, then it replaces the running one.
 
         A ``sec`` (secondary) program runs at once beside the primary program.
-        Returns False when the program was refused (compile error) or cannot start.
-        """
+        Returns False when the program was refused (compile error) or cannot start."""
         try:
             prog = self.compile(text)
         except CompileError as exc:
@@ -434,6 +431,7 @@ class Controller(IOMixin, SafetyMixin):
             return True
 
     def start_program(self, prog: Program) -> bool:
+        """Start ``prog`` as the primary program (PLAYING), replacing the running one, or False."""
         with self.lock:
             if self.robot_mode != RobotMode.RUNNING:
                 self.log(f"cannot start program {prog.name!r}: robot mode "
@@ -475,6 +473,7 @@ class Controller(IOMixin, SafetyMixin):
                 self.stop_motion(4.0)
 
     def program_finished(self) -> None:
+        """The program reached its end: logged, then stopped (:meth:`stop_program`)."""
         with self.lock:
             name = self.program.name if self.program else ""
             self.log(f"program {name or '<line>'} finished")
@@ -487,6 +486,7 @@ class Controller(IOMixin, SafetyMixin):
             self.stop_program("runtime error", decelerate=True)
 
     def pause_program(self) -> bool:
+        """Dashboard ``pause``: PLAYING -> PAUSED, a moving arm brakes; False when none plays."""
         with self.lock:
             if self.runtime_state != RuntimeState.PLAYING:
                 return False

@@ -54,18 +54,27 @@ class IOMixin:
     speed_fraction: float
 
     def in_int(self, i: int) -> int:
+        """RTDE input integer register ``i`` (0-47), as a client last set it (0 before)."""
         return self.values.get(IN_INT[i], 0)  # type: ignore[return-value]
 
     def in_double(self, i: int) -> float:
+        """RTDE input double register ``i`` (0-47), as a client last set it (0.0 before)."""
         return self.values.get(IN_DOUBLE[i], 0.0)  # type: ignore[return-value]
 
     def set_out_int(self, i: int, value: int) -> None:
+        """Set RTDE output integer register ``i`` (0-47) to ``value`` wrapped to int32."""
         self.values[OUT_INT[i]] = int32(value)
 
     def set_out_double(self, i: int, value: float) -> None:
+        """Set RTDE output double register ``i`` (0-47)."""
         self.values[OUT_DOUBLE[i]] = float(value)
 
     def set_out_bit(self, i: int, value: bool) -> None:
+        """Set RTDE output bit register ``i`` (0-127); another ``i`` is ignored.
+
+        Bits 0-63 live in the words ``output_bit_registers0_to_31`` and
+        ``output_bit_registers32_to_63``, bits 64-127 each in ``output_bit_register_<i>``.
+        """
         with self.lock:
             if 64 <= i <= 127:
                 self.values[f"output_bit_register_{i}"] = int(value)

@@ -29,6 +29,10 @@ class SafetyMixin:
     unlock_delay: float
 
     def power_on(self) -> bool:
+        """Dashboard ``power on``: POWER_OFF or POWER_ON -> IDLE; False unless safety is NORMAL.
+
+        In another robot mode nothing changes (and the answer is True).
+        """
         with self.lock:
             if self.safety_mode != SafetyMode.NORMAL:
                 return False
@@ -37,6 +41,10 @@ class SafetyMixin:
             return True
 
     def brake_release(self) -> bool:
+        """Dashboard ``brake release``: a powered robot -> RUNNING.
+
+        False, nothing changed, unless safety is NORMAL and the robot is at least POWER_ON.
+        """
         with self.lock:
             if self.safety_mode != SafetyMode.NORMAL or self.robot_mode < RobotMode.POWER_ON:
                 return False
@@ -44,6 +52,10 @@ class SafetyMixin:
             return True
 
     def power_off(self) -> None:
+        """Dashboard ``power off``: the program stops, motion ends, robot mode POWER_OFF.
+
+        No braking path is planned: the backend holds (brakes within its own limits).
+        """
         with self.lock:
             self.stop_program("power off", decelerate=False)
             self.motion = None

@@ -46,6 +46,12 @@ class DashboardServer(TcpServer):
         self.commands: deque[str] = deque(maxlen=100)
 
     def handle(self, conn: Connection) -> None:
+        """Greet, then answer each command line (:meth:`answer`) until the client leaves.
+
+        Lines end with a newline; empty ones get no reply.  ``quit`` or ``close`` ends the
+        connection after its reply; a line longer than 4096 bytes closes it (a ValueError the server
+        logs).
+        """
         if not conn.sendall((GREETING + "\n").encode()):
             return
         buf = bytearray()

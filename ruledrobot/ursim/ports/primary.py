@@ -123,6 +123,11 @@ class PrimaryServer(TcpServer):
         self.programs_received = 0
 
     def make_connection(self, sock: socket.socket, addr: tuple) -> Connection:
+        """A :class:`PrimaryConnection` with a small send buffer and ``hello()`` already queued.
+
+        The kernel send buffer is :data:`SEND_BUFFER`; the greeting (version message, then the
+        current robot state) is queued before the publisher can send to the connection.
+        """
         with contextlib.suppress(OSError):
             sock.setsockopt(socket.SOL_SOCKET, socket.SO_SNDBUF, SEND_BUFFER)
         conn = PrimaryConnection(sock, addr)
@@ -225,13 +230,16 @@ class PrimaryPublisher:
         return version_message(self.version, round(self.controller.time * 1e6)) + self.message()
 
     def message(self) -> bytes:
+        """The robot-state message now (:func:`robot_state`: robot mode data and KinematicsInfo)."""
         return robot_state(self.controller, self._kin, self._reserved)
 
     def start(self) -> None:
+        """Start the publisher thread (a daemon)."""
         self._thread = threading.Thread(target=self._run, name="emu-primary-publish", daemon=True)
         self._thread.start()
 
     def close(self, timeout: float = 1.0) -> None:
+        """Stop the publisher thread; wait up to ``timeout`` [s] for it to end."""
         self._stop.set()
         if self._thread is not None and self._thread is not threading.current_thread():
             self._thread.join(timeout)

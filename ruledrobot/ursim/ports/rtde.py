@@ -167,6 +167,7 @@ class RTDEServer(TcpServer):
     def make_connection(self, sock: socket.socket, addr: tuple) -> Connection:
         # a bounded kernel buffer: a client that stops reading is "stuck" (no more send
         # attempts, see publish) within a fraction of a second instead of after megabytes
+        """An :class:`RTDEConnection` with its kernel send buffer bounded to :data:`SEND_BUFFER`."""
         with contextlib.suppress(OSError):
             sock.setsockopt(socket.SOL_SOCKET, socket.SO_SNDBUF, SEND_BUFFER)
         return RTDEConnection(sock, addr)
@@ -174,6 +175,12 @@ class RTDEServer(TcpServer):
     # ------------------------------------------------------------ reading
 
     def handle(self, conn: Connection) -> None:
+        """Read ``conn``'s packets and answer them until it closes; a protocol error closes it.
+
+        Each setup request gets exactly one reply; an input data package is applied to the
+        controller at once and its TCP acknowledgement sent at once (:func:`~.tcp.quick_ack`).  A
+        protocol error is counted (``protocol_errors``) and logged.
+        """
         assert isinstance(conn, RTDEConnection)
         framer = PacketFramer()
 
@@ -192,6 +199,7 @@ class RTDEServer(TcpServer):
             log.warning("rtde: closing %s: protocol error: %s", conn.peer, exc)
 
     def on_close(self, conn: Connection) -> None:
+        """Release the input names ``conn`` had set up: another client may now set them up."""
         assert isinstance(conn, RTDEConnection)
         with self._owner_lock:
             for name in conn.owned:

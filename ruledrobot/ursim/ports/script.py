@@ -38,6 +38,11 @@ class ScriptPortServer(TcpServer):
         self.last_program: str = ""
 
     def handle(self, conn: Connection) -> None:
+        """Hand ``conn``'s URScript to the controller program by program, counting them.
+
+        :func:`receive_programs`; ``programs_received`` and ``last_program`` (its first 4096
+        characters) record what arrived.
+        """
         def received(text: str) -> None:
             self.programs_received += 1
             self.last_program = text[:4096]
@@ -61,6 +66,11 @@ class ProgramReceiver:
         self._decoder = codecs.getincrementaldecoder("utf-8")(errors="replace")
 
     def feed(self, data: bytes) -> None:
+        """Decode ``data`` and hand each program it completes to the controller.
+
+        UTF-8, undecodable bytes replaced; a character cut between two chunks waits for the next.
+        Raises ValueError beyond the size bounds (see the class).
+        """
         for text in self._splitter.feed(self._decoder.decode(data)):
             if self.received is not None:
                 self.received(text)

@@ -74,6 +74,7 @@ class Connection:
 
     @property
     def peer(self) -> str:
+        """The peer's address as ``"host:port"`` (for log lines)."""
         return f"{self.addr[0]}:{self.addr[1]}" if len(self.addr) >= 2 else str(self.addr)
 
     def sendall(self, data: bytes) -> bool:
@@ -89,6 +90,7 @@ class Connection:
             return False
 
     def close(self) -> None:
+        """Shut the socket down and close it; a second call does nothing, errors are ignored."""
         if self.closed:
             return
         self.closed = True
@@ -142,6 +144,7 @@ class QueuedConnection(Connection):
                 self.broken = True
 
     def flush(self) -> None:
+        """Send what of the queue the socket takes now, never blocking."""
         with self.write_lock:
             if not self.closed and not self.broken and self.backlog:
                 self._flush_locked()
@@ -265,6 +268,12 @@ class TcpServer:
     # ------------------------------------------------------------ lifecycle
 
     def start(self) -> None:
+        """Listen on (``host``, ``port``) and start the accept thread.
+
+        With ``single_thread`` also the selector thread that reads every connection.  Port 0 picks a
+        free port (:attr:`port` says which).  OSError, with the bind's ``errno`` (EADDRINUSE: the
+        address is taken), when the address cannot be bound.
+        """
         s = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
         s.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
         try:
@@ -293,6 +302,7 @@ class TcpServer:
 
     @property
     def stopping(self) -> bool:
+        """True once :meth:`close` was called."""
         return self._stop.is_set()
 
     def close(self, timeout: float = 2.0) -> None:
@@ -311,6 +321,7 @@ class TcpServer:
                 t.join(max(0.0, deadline - time.monotonic()))
 
     def connections(self) -> list[Connection]:
+        """The open connections now (a copy of the list)."""
         with self._lock:
             return list(self._conns.values())
 
@@ -535,9 +546,15 @@ class TcpServer:
     # ------------------------------------------------------------ for subclasses
 
     def make_connection(self, sock: socket.socket, addr: tuple) -> Connection:
+        """Wrap an accepted socket; servers that need more per client return a subclass."""
         return Connection(sock, addr)
 
     def handle(self, conn: Connection) -> None:
+        """The per-connection loop (a thread each unless ``single_thread``).
+
+        It returns, or raises (logged), when the connection is to close; :meth:`recv_loop` is the
+        usual body.
+        """
         raise NotImplementedError
 
     def on_data(self, conn: Connection, data: bytes) -> None:

@@ -203,21 +203,27 @@ class ControlScript:
     # ------------------------------------------------------------ registers
 
     def in_int(self, i: int) -> int:
+        """Input integer register ``i`` of the script (RTDE register ``i`` + the offset)."""
         return self.c.in_int(i + self.off)
 
     def in_d(self, i: int) -> float:
+        """Input double register ``i`` of the script (RTDE register ``i`` + the offset)."""
         return self.c.in_double(i + self.off)
 
     def in_vec(self, start: int, n: int = 6) -> np.ndarray:
+        """``n`` consecutive input double registers from ``start`` (+ the offset), shape (n,)."""
         return np.array([self.in_d(start + k) for k in range(n)])
 
     def out_int(self, i: int, value: int) -> None:
+        """Set output integer register ``i`` of the script (RTDE register ``i`` + the offset)."""
         self.c.set_out_int(i + self.off, value)
 
     def out_d(self, i: int, value: float) -> None:
+        """Set output double register ``i`` of the script (RTDE register ``i`` + the offset)."""
         self.c.set_out_double(i + self.off, value)
 
     def out_vec(self, values, start: int = 0) -> None:
+        """Write ``values`` to consecutive output double registers from ``start`` (+ the offset)."""
         for k, x in enumerate(values):
             self.out_d(start + k, float(x))
 
@@ -322,6 +328,15 @@ class ControlScript:
     # ------------------------------------------------------------ real-time commands
 
     def realtime(self, cmd: int) -> None:
+        """Carry out one real-time command (:data:`RT_COMMANDS`) this period: no latch, no done.
+
+        servoJ and servoL set the servo target (servoL: the inverse kinematics solution nearest the
+        setpoint, solved once per target); speedJ and speedL set joint speeds (speedL: the
+        least-squares joint speeds of the Jacobian at the setpoint); servoC starts a linear move
+        when its target changes or no motion runs.  The queries (step time [s], a past actual joint
+        position [rad], joint torques, flange pose in the base frame, target joint accelerations
+        [rad/s^2], Jacobian) write their answer to the output double registers.
+        """
         c = self.c
         if cmd == Command.SERVOJ:
             q = self.in_vec(0)

@@ -189,38 +189,66 @@ class Library:
 
     @staticmethod
     def asin(f: float) -> float:
+        """``asin(f)``: the arc sine of ``f`` [rad], in [-pi/2, pi/2].
+
+        A runtime error when ``f`` lies outside [-1, 1], as UR's manual says; values within 1e-12 of
+        the range (rounding) are clamped to it.
+        """
         return math.asin(min(1.0, max(-1.0, f))) if abs(f) <= 1 + 1e-12 else math.asin(f)
 
     @staticmethod
     def acos(f: float) -> float:
+        """``acos(f)``: the arc cosine of ``f`` [rad], in [0, pi].
+
+        A runtime error when ``f`` lies outside [-1, 1], as UR's manual says; values within 1e-12 of
+        the range (rounding) are clamped to it.
+        """
         return math.acos(min(1.0, max(-1.0, f))) if abs(f) <= 1 + 1e-12 else math.acos(f)
 
     @staticmethod
     def atan2(y: float, x: float) -> float:
+        """``atan2(y, x)``: the arc tangent of ``y / x`` [rad], in [-pi, pi].
+
+        The signs of both arguments give the quadrant.
+        """
         return math.atan2(y, x)
 
     @staticmethod
     def pow(base: float, exponent: float) -> float:
+        """``pow(base, exponent)``: ``base`` raised to the power ``exponent`` (a float).
+
+        A runtime error for a negative ``base`` with a non-integral ``exponent`` or a zero ``base``
+        with a negative one, as UR's manual says.
+        """
         return math.pow(base, exponent)
 
     @staticmethod
     def floor(f: float) -> int:
+        """``floor(f)``: the largest integer not greater than ``f`` (an int)."""
         return math.floor(f)
 
     @staticmethod
     def ceil(f: float) -> int:
+        """``ceil(f)``: the smallest integer not less than ``f`` (an int)."""
         return math.ceil(f)
 
     @staticmethod
     def d2r(d: float) -> float:
+        """``d2r(d)``: ``d`` degrees in radians [rad]."""
         return math.radians(d)
 
     @staticmethod
     def r2d(r: float) -> float:
+        """``r2d(r)``: ``r`` radians [rad] in degrees."""
         return math.degrees(r)
 
     @staticmethod
     def norm(a: object) -> float:
+        """``norm(a)``: the norm of ``a``: ``|a|`` of a number, the Euclidean norm of a list.
+
+        For a pose UR's manual says "the Euclidean norm of the pose"; the emulator takes the norm of
+        its position part [m].
+        """
         if isinstance(a, PoseValue):
             return float(np.linalg.norm(np.asarray(a[:3], dtype=float)))
         if isinstance(a, list):
@@ -229,6 +257,10 @@ class Library:
 
     @staticmethod
     def length(v: object) -> int:
+        """``length(v)``: the number of elements of a list or characters of a string (an int).
+
+        A runtime error for another type.  ``get_list_length`` is the same function.
+        """
         if isinstance(v, (list, str)):
             return len(v)
         raise ScriptRuntimeError(f"length(): expected a list or a string, got {v!r}")
@@ -237,24 +269,42 @@ class Library:
 
     @staticmethod
     def random() -> float:
+        """``random()``: a pseudo-random float in [0, 1) (Python's generator, not seeded)."""
         return random.random()
 
     @staticmethod
     def to_str(v: object) -> str:
+        """``to_str(val)``: the string representation of ``val``.
+
+        Booleans as ``True`` / ``False``, lists and poses as ``[...]`` / ``p[...]``, numbers as
+        Python's ``str`` writes them (``0.1 + 0.2`` gives ``0.30000000000000004``): the
+        controller's own float formatting may differ.
+        """
         if isinstance(v, bool):
             return "True" if v else "False"
         return repr(v) if isinstance(v, list) else str(v)
 
     @staticmethod
     def str_cat(a: object, b: object) -> str:
+        """``str_cat(op1, op2)``: the string representations (:meth:`to_str`) of both, joined."""
         return Library.to_str(a) + Library.to_str(b)
 
     @staticmethod
     def str_len(s: str) -> int:
+        """``str_len(str)``: the length of a string (an int).
+
+        UR's manual returns the number of bytes, the emulator counts characters: they differ
+        beyond ASCII.
+        """
         return len(s)
 
     @staticmethod
     def to_num(s: str) -> int | float:
+        """``to_num(str)``: the number ``str`` writes: an int when written as one, else a float.
+
+        A runtime error when it is not a number.  Parsed by Python's ``int``, then ``float``, which
+        also take ``1_000``, ``inf`` and ``nan``.
+        """
         try:
             return int(s)
         except ValueError:
@@ -265,24 +315,46 @@ class Library:
 
     @staticmethod
     def binary_list_to_integer(bits: list) -> int:
+        """``binary_list_to_integer(l)``: the integer the booleans of ``l`` write, bit 0 first.
+
+        Index 0 is the least significant bit; 0 for an empty list.  UR's manual reads the list as a
+        signed binary number and only its first 32 booleans; the emulator adds every bit as an
+        unsigned number (a list of 32 with bit 31 set gives 2**31, not a negative int).
+        """
         return sum(1 << i for i, b in enumerate(bits) if b)
 
     @staticmethod
     def integer_to_binary_list(x: int) -> list[bool]:
+        """``integer_to_binary_list(x)``: the 32 bits of ``x`` (two's complement) as booleans.
+
+        A list of 32, index 0 the least significant bit.
+        """
         return [bool((int(x) >> i) & 1) for i in range(32)]
 
     # ------------------------------------------------------------ poses
     @staticmethod
     def pose_trans(p_from: list, p_from_to: list) -> PoseValue:
+        """``pose_trans(p_from, p_from_to)``: ``p_from_to`` taken in the frame of ``p_from``.
+
+        The pose of ``T(p_from) T(p_from_to)``: start at the frame ``p_from`` places and move by
+        ``p_from_to`` in it.  A UR pose [m, rad].
+        """
         T = _matrix(p_from, "pose_trans") @ _matrix(p_from_to, "pose_trans")
         return _pose(se3.ur_vector_from_pose(T))
 
     @staticmethod
     def pose_inv(p: list) -> PoseValue:
+        """``pose_inv(p_from)``: the inverse pose transformation, ``T(p_from)^-1`` [m, rad]."""
         return _pose(se3.ur_vector_from_pose(se3.inverse(_matrix(p, "pose_inv"))))
 
     @staticmethod
     def pose_add(p1: list, p2: list) -> PoseValue:
+        """``pose_add(p_1, p_2)``: positions added [m], rotations multiplied (a pose).
+
+        UR's manual: ``p_3.P = p_1.P + p_2.P``, ``p_3.R = p_1.R * p_2.R``.  The emulator computes
+        the rotation matrix ``R(p_2) R(p_1)``: the manual's order only when the rotations commute
+        (about one axis).
+        """
         a, b = _matrix(p1, "pose_add"), _matrix(p2, "pose_add")
         T = np.eye(4)
         T[:3, :3] = b[:3, :3] @ a[:3, :3]
@@ -291,6 +363,11 @@ class Library:
 
     @staticmethod
     def pose_sub(p_to: list, p_from: list) -> PoseValue:
+        """``pose_sub(p_to, p_from)``: positions subtracted [m], rotation ``R(p_to) R(p_from)^T``.
+
+        On UR's forum it undoes :meth:`pose_add` (``pose_add(pose_sub(p_1, p_2), p_2) == p_1``);
+        with the emulator's :meth:`pose_add` that holds only when the two rotations commute.
+        """
         a, b = _matrix(p_to, "pose_sub"), _matrix(p_from, "pose_sub")
         T = np.eye(4)
         T[:3, :3] = a[:3, :3] @ b[:3, :3].T
@@ -299,15 +376,30 @@ class Library:
 
     @staticmethod
     def pose_dist(p_from: list, p_to: list) -> float:
+        """``pose_dist(p_from, p_to)``: the distance between two poses.
+
+        UR's controller also weighs the rotation (two poses differing only in orientation are a
+        non-zero distance apart, in no particular unit); the emulator returns the distance of the
+        positions [m], as :meth:`point_dist`.
+        """
         return float(np.linalg.norm(_vec(p_to, 6, "pose_dist")[:3] - _vec(p_from, 6,
                                                                           "pose_dist")[:3]))
 
     @staticmethod
     def point_dist(p_from: list, p_to: list) -> float:
+        """``point_dist(p_from, p_to)``: the distance between the two poses' positions [m].
+
+        Rotations are not considered.
+        """
         return Library.pose_dist(p_from, p_to)
 
     @staticmethod
     def interpolate_pose(p_from: list, p_to: list, alpha: float) -> PoseValue:
+        """``interpolate_pose(p_from, p_to, alpha)``: the pose a fraction ``alpha`` along.
+
+        The position on the straight line [m], the orientation on the shortest rotation between the
+        two [rad]; ``alpha`` 0 gives ``p_from``, 1 ``p_to``, values outside [0, 1] extrapolate.
+        """
         A, B = _matrix(p_from, "interpolate_pose"), _matrix(p_to, "interpolate_pose")
         T = np.eye(4)
         T[:3, :3] = se3.geodesic(A, B, float(alpha))[:3, :3]
@@ -316,30 +408,54 @@ class Library:
 
     # ------------------------------------------------------------ the arm
     def get_actual_joint_positions(self) -> list[float]:
+        """``get_actual_joint_positions()``: the actual joint positions [rad], base to wrist 3."""
         return [float(x) for x in self.c.arm_state().q]
 
     def get_target_joint_positions(self) -> list[float]:
+        """``get_target_joint_positions()``: the target joint positions [rad], base to wrist 3."""
         return [float(x) for x in self.c.arm_state().target_q]
 
     def get_actual_joint_speeds(self) -> list[float]:
+        """``get_actual_joint_speeds()``: the actual joint speeds [rad/s], base to wrist 3."""
         return [float(x) for x in self.c.arm_state().qd]
 
     def get_target_joint_speeds(self) -> list[float]:
+        """``get_target_joint_speeds()``: the target joint speeds [rad/s], base to wrist 3."""
         return [float(x) for x in self.c.arm_state().target_qd]
 
     def get_actual_tcp_pose(self) -> PoseValue:
+        """``get_actual_tcp_pose()``: the TCP pose in the base frame [m, rad], actual.
+
+        Forward kinematics of the actual joint positions with the active TCP.
+        """
         return _pose(self.c.kin.tcp_vector(self.get_actual_joint_positions()))
 
     def get_target_tcp_pose(self) -> PoseValue:
+        """``get_target_tcp_pose()``: the TCP pose in the base frame [m, rad], target.
+
+        Forward kinematics of the target joint positions with the active TCP.
+        """
         return _pose(self.c.kin.tcp_vector(self.get_target_joint_positions()))
 
     def get_forward_kin(self, q: list | None = None, tcp: list | None = None) -> PoseValue:
+        """``get_forward_kin(q, tcp)``: the TCP pose in the base frame [m, rad] at joints ``q``.
+
+        ``q`` [rad] defaults to the actual joint positions, ``tcp`` (a pose in the flange frame)
+        to the active TCP; the kinematics are the controller's (calibrated when it is).
+        """
         qv = self.get_actual_joint_positions() if q is None else _vec(q, 6, "get_forward_kin")
         offset = None if tcp is None else _vec(tcp, 6, "get_forward_kin")
         return _pose(self.c.kin.fk_vector(np.asarray(qv, dtype=float), offset))
 
     def get_inverse_kin(self, x: list, qnear: list | None = None, maxPositionError: float = 1e-10,
                         maxOrientationError: float = 1e-10, tcp: list | None = None) -> list:
+        """``get_inverse_kin(x, qnear, ...)``: joint positions [rad] putting the TCP at ``x``.
+
+        ``x`` is a pose in the base frame [m, rad]; the solution within the joint limits nearest
+        ``qnear`` (default: the actual joint positions), a runtime error when there is none.
+        ``maxPositionError`` and ``maxOrientationError`` are accepted and not used (the solution is
+        analytic); ``tcp=`` is a runtime error (``set_tcp`` first).
+        """
         if tcp is not None:
             raise ScriptRuntimeError("get_inverse_kin(): tcp= is not emulated (set_tcp first)")
         near = self.get_actual_joint_positions() if qnear is None else qnear
@@ -349,12 +465,26 @@ class Library:
         return [float(v) for v in q]
 
     def get_steptime(self) -> float:
+        """``get_steptime()``: the duration of the controller's time step [s].
+
+        0.002 s on e-Series, 0.008 s on CB3.
+        """
         return float(self.c.period)
 
     def is_steady(self) -> bool:
+        """``is_steady()``: True when the robot is fully at rest.
+
+        The emulator: no motion planned and every actual joint speed below 1e-4 rad/s.
+        """
         return bool(np.all(np.abs(self.c.arm_state().qd) < 1e-4)) and self.c.motion is None
 
     def is_within_safety_limits(self, pose: list, qnear: list | None = None) -> bool:
+        """``is_within_safety_limits(pose, qnear)``: True when ``pose`` is reachable and allowed.
+
+        The emulator checks that an inverse kinematics solution within the joint limits exists
+        (nearest ``qnear``, default the actual joint positions); it has no other safety limits.  UR
+        also takes joint positions; here any list of 6 is read as a pose.
+        """
         v = _vec(pose, 6, "is_within_safety_limits")
         near = self.get_actual_joint_positions() if qnear is None else qnear
         return self.c.kin.ik_nearest(v, _vec(near, 6, "is_within_safety_limits")) is not None
@@ -366,15 +496,31 @@ class Library:
         return self.c.values.get(f"{key}_{i}", 0)
 
     def read_input_integer_register(self, address: int) -> int:
+        """``read_input_integer_register(address)``: the int in RTDE input integer register 0-47.
+
+        A runtime error for another ``address``.
+        """
         return int(self._reg("input_int_register", address, 47))
 
     def read_input_float_register(self, address: int) -> float:
+        """``read_input_float_register(address)``: the float in RTDE input double register 0-47.
+
+        A runtime error for another ``address``.
+        """
         return float(self._reg("input_double_register", address, 47))
 
     def read_output_integer_register(self, address: int) -> int:
+        """``read_output_integer_register(address)``: the int in RTDE output integer register 0-47.
+
+        A runtime error for another ``address``.
+        """
         return int(self._reg("output_int_register", address, 47))
 
     def read_output_float_register(self, address: int) -> float:
+        """``read_output_float_register(address)``: the float in RTDE output double register 0-47.
+
+        A runtime error for another ``address``.
+        """
         return float(self._reg("output_double_register", address, 47))
 
     def _bit(self, prefix: str, address: int) -> bool:
@@ -388,9 +534,17 @@ class Library:
         return bool((int(self.c.values.get(key, 0)) >> (address % 32)) & 1)
 
     def read_input_boolean_register(self, address: int) -> bool:
+        """``read_input_boolean_register(address)``: the bool in RTDE input bit register 0-127.
+
+        A runtime error for another ``address``.
+        """
         return self._bit("input", address)
 
     def read_output_boolean_register(self, address: int) -> bool:
+        """``read_output_boolean_register(address)``: the bool in RTDE output bit register 0-127.
+
+        A runtime error for another ``address``.
+        """
         return self._bit("output", address)
 
     def _pin(self, word: int, n: int, top: int) -> bool:
@@ -399,12 +553,24 @@ class Library:
         return bool((word >> n) & 1)
 
     def get_standard_digital_out(self, n: int) -> bool:
+        """``get_standard_digital_out(n)``: the level of standard digital output ``n``.
+
+        A bool; ``n`` 0-7, a runtime error for another pin.
+        """
         return self._pin(self.c.std_do, n, 7)
 
     def get_configurable_digital_out(self, n: int) -> bool:
+        """``get_configurable_digital_out(n)``: the level of configurable digital output ``n``.
+
+        A bool; ``n`` 0-7, a runtime error for another pin.
+        """
         return self._pin(self.c.conf_do, n, 7)
 
     def get_tool_digital_out(self, n: int) -> bool:
+        """``get_tool_digital_out(n)``: the level of tool digital output ``n``.
+
+        A bool; ``n`` 0-1, a runtime error for another pin.
+        """
         return self._pin(self.c.tool_do, n, 1)
 
     def join(self, handle: int) -> Gen:
