@@ -188,6 +188,10 @@ def _play_path(s: Session, q_grid: np.ndarray, block: list[tuple], heartbeat: fl
     end, q_end = int(last[6]), np.asarray(last[7], dtype=float)
     duration = max(0.0, (end - s.sent) / s.frequency)
     s.sent = end
+    # the arm at rest before the upload: the recording's controller time runs from here (the
+    # upload blocks; an emulator that builds the path late catches up on controller time,
+    # so the first package after it may already be in motion)
+    s.record(*s.snapshot())
     s.link.stage("path upload", 15.0)  # movePath re-uploads the control script
     t_up = time.monotonic()
     if not c.movePath(path, True):

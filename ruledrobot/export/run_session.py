@@ -124,6 +124,7 @@ class Session:
         self._ts0: float | None = None
         self._last_flush = 0.0
         self._lag_min = math.inf
+        self._last_poll = math.inf
         self._wall0 = 0.0
         self._clock_ts0 = 0.0
 
@@ -316,6 +317,7 @@ class Session:
         self._wall0 = time.monotonic()
         self._clock_ts0 = self.r.getTimestamp()
         self._lag_min = math.inf
+        self._last_poll = self._wall0
 
     def connected(self) -> bool:
         """Whether the receive interface (and the control one, when made) is connected;
@@ -337,7 +339,14 @@ class Session:
             raise Stop("protective_stop", "the robot is protective stopped")
         ts, qa, tcp, outs = self.snapshot()
         self.record(ts, qa, tcp, outs)
-        lag = (time.monotonic() - self._wall0) - (ts - self._clock_ts0)
+        now = time.monotonic()
+        if now - self._last_poll > self.max_latency / 2:
+            # this process was not run for a while (the machine busy, a stop signal): its
+            # own stall, not the controller's — the newest data may lag behind until
+            # ur_rtde's receive thread has caught up, so the watch starts again from here
+            self._lag_min = math.inf
+        self._last_poll = now
+        lag = (now - self._wall0) - (ts - self._clock_ts0)
         self._lag_min = min(self._lag_min, lag)
         if lag - self._lag_min > self.max_latency:
             raise Stop(
@@ -351,7 +360,7 @@ class Session:
         return np.asarray(qa)
 
     def check_deviation(self, plan: np.ndarray, qa: np.ndarray, upto: int,
-                        timed: bool = True) -> None:  # fmt: skip
+                        timed: bool = True, anchored: bool = False) -> None:  # fmt: skip
         """Deviation of ``qa`` from the nearest plan sample in ``[k_high - window / 4,
         upto]`` (at most ``window`` ahead of ``k_match``), ``k_high`` the furthest sample
         matched so far; moves ``k_match`` there.  ``timed`` (streaming: sample ``upto``
@@ -366,9 +375,16 @@ class Session:
         nearest-sample match, like its arrival run backwards, and a match allowed to
         step back from wherever it is would walk back along the arrival while the arm
         goes on (found on the part demo: 0.05 rad reported for an arm 0.001 rad from the
-        plan)."""
+        plan).  ``anchored``: ``upto`` is the sample the controller reports playing (a
+        forwarded run), so a match more than a window behind it moves up to the window
+        behind it (the gap a stall of this process leaves in the recording)."""
         lo = max(0, self.k_high - self.window // 4)
         hi = max(lo, min(upto, self.k_match + self.window)) + 1
+        if anchored and upto - self.window > lo:
+            # the controller reports the sample it plays (a forwarded run): after a stall of
+            # this process the recording has a gap, and the arm is near ``upto``, further
+            # than a window from the last match — search the window behind it
+            lo, hi = upto - self.window, upto + 1
         d = np.max(np.abs(plan[lo:hi] - qa), axis=1)
         # the last of the minima (equal to a micro-radian): through a hold longer than
         # the window (the wire heating) the plan repeats one sample, up to rounding of

@@ -183,6 +183,7 @@ class ThreadedEmulator:
                                           self.kinematics_info, (major, minor, bugfix, build),
                                           self.frozen)  # fmt: skip
         self._servers = (self.rtde, self.dashboard, self.script, self.primary, self.secondary)
+        self.controller.realtime = realtime  # the threads its programs start (sockets)
         for srv in self._servers:
             srv.realtime = realtime
             srv.frozen = self.frozen

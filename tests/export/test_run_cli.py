@@ -63,8 +63,8 @@ def test_a_stopped_run_says_where_and_how_to_resume(request, tmp_path: Path) -> 
     try:
         src = write_trajectory(tmp_path / "cut.csv", traj)
         outs = []
-        for _ in range(2):
-            res = _invoke(str(src), "--host", emu.host, "--yes")
+        for _ in range(2):  # servoj: its stop leaves the arm where the second run may enter
+            res = _invoke(str(src), "--host", emu.host, "--yes", "--mode", "servoj")
             assert res.exit_code == 1, res.output
             outs.append(res.output)
     finally:
@@ -77,6 +77,7 @@ def test_a_stopped_run_says_where_and_how_to_resume(request, tmp_path: Path) -> 
     k = int(m.group(1))
     assert m.group(2) == traj.phase_at(k)
     assert m.group(3) == ("inside" if traj.inside_stock()[k] else "outside")
-    assert f"resume with: ruledrobot run {src} --host {emu.host} --resume {k}" in out
+    assert (f"resume with: ruledrobot run {src} --host {emu.host} --mode servoj --resume {k}"
+            in out)
     assert "cut.run-001.csv" in outs[0] and "cut.run-002.csv" in outs[1]
     assert (tmp_path / "cut.run-001.csv").exists() and (tmp_path / "cut.run-002.json").exists()

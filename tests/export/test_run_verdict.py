@@ -320,3 +320,14 @@ def test_run_exits_1_when_the_executed_cut_broke_a_check(
     doc = json.loads((tmp_path / "cut.run-001.json").read_text())
     assert doc["run"]["status"] == "completed" and not doc["run"]["ok"]
     assert "feed_max" in doc["run"]["verdict"]["failed"]
+
+
+def test_a_slice_renumbers_the_heat_windows() -> None:
+    """Found (issue 31): ``Trajectory.sliced`` shifted the phases, ``in_stock`` and the cut
+    but left the heat's windows in the whole plan's sample numbers."""
+    traj = block_trajectory()
+    heat = Heat("standard", 0, windows=((100, 300), (600, 900)))
+    traj = Trajectory(traj.t, traj.q, traj.tcp, traj.meta.replace(heat=heat))
+    part = traj.sliced(250, 700)
+    assert part.meta.heat is not None and part.meta.heat.windows == ((0, 50), (350, 450))
+    np.testing.assert_array_equal(part.meta.heat.on(part.n), heat.on(traj.n)[250:700])

@@ -102,7 +102,8 @@ def _play(s: Session, conn: socket.socket, q_grid: np.ndarray, hot: np.ndarray |
             break
         try:
             qa = s.poll()
-            s.check_deviation(q_grid, qa, max(playing, 0), timed=playing >= 0)
+            s.check_deviation(q_grid, qa, max(playing, 0), timed=playing >= 0,
+                              anchored=playing >= 0)
             s.service()
         except Stop as st:
             stop = st

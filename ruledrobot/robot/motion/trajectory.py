@@ -414,7 +414,8 @@ class Trajectory:
         return float(dp[k]), float(ang.max()), k
 
     def sliced(self, start: int, stop: int | None = None) -> Trajectory:
-        """Samples ``start:stop`` with times from 0 and phases clipped to them."""
+        """Samples ``start:stop`` with times from 0; phases, ``in_stock`` ranges, the cut's
+        feed windows and the heat's windows clipped and renumbered to them."""
         stop = self.n if stop is None else stop
         if not 0 <= start < stop <= self.n:
             raise ValueError(f"slice [{start}, {stop}) outside the {self.n} samples")
@@ -428,7 +429,11 @@ class Trajectory:
         )
         stock = tuple(c for a, b in self.meta.in_stock if (c := clip(a, b)))
         cut = None if self.meta.cut is None else self.meta.cut.sliced(start, stop)
-        meta = self.meta.replace(phases=phases, in_stock=stock, cut=cut)
+        heat = self.meta.heat
+        if heat is not None:  # its windows renumbered too (they stayed the whole plan's)
+            windows = tuple(c for a, b in heat.windows if (c := clip(a, b)))
+            heat = dataclasses.replace(heat, windows=windows)
+        meta = self.meta.replace(phases=phases, in_stock=stock, cut=cut, heat=heat)
         return Trajectory(self.t[start:stop] - self.t[start], self.q[start:stop],
                           self.tcp[start:stop], meta)  # fmt: skip
 

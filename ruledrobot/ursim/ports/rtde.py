@@ -73,10 +73,12 @@ __all__ = ["RTDEConnection", "RTDEServer", "StreamStats", "due"]
 log = logging.getLogger("ruledrobot.ursim")
 
 
-#: bytes queued for a client beyond which it is disconnected: about 0.45 s of ur_rtde's
-#: 58-variable stream at 500 Hz, after the kernel buffers (another 0.4 s) are full
-#: (ur_rtde's own receive timeout is 2.5 s; its receive thread is native, it keeps up)
-MAX_BACKLOG = 256 * 1024
+#: bytes queued for a client beyond which it is disconnected: about 2.2 s of ur_rtde's
+#: 58-variable stream at 500 Hz (576 KiB/s), after the kernel buffers (another 0.4 s)
+#: are full: a client stalled as long as ur_rtde's own receive timeout (2.5 s) keeps its
+#: connection (a forwarded run rides through a stall of its buffer and more; at 256 KiB,
+#: 0.45 s, a 1 s stall of the runner closed it: issue 31)
+MAX_BACKLOG = 1280 * 1024
 
 #: the fraction of a control period the clock may spend in socket calls per publish
 SEND_BUDGET = 0.4

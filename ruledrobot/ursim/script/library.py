@@ -89,7 +89,7 @@ class Library:
         self.pending: list[tuple[str, np.ndarray, bool, float, float, float]] = []
         from .sockets import ScriptSockets
 
-        self.sockets = ScriptSockets(host.period)
+        self.sockets = ScriptSockets(host.period, bool(getattr(host, "realtime", False)))
 
     def namespace(self) -> dict[str, Callable[..., Any]]:
         """``b_<name>`` for every built-in."""

@@ -23,6 +23,7 @@ import threading
 from collections.abc import Generator
 from typing import Any
 
+from ..ports.tcp import try_realtime_priority
 from .program import ScriptRuntimeError
 
 __all__ = ["ScriptSockets"]
@@ -37,10 +38,14 @@ MAX_BUFFER = 4 << 20
 
 
 class _Conn:
-    """One open socket: its connection thread, its receive buffer."""
+    """One open socket: its connection thread, its receive buffer.  ``realtime``: the
+    thread asks for the emulator's server threads' real-time priority (it takes the GIL
+    to store what it read: at normal priority, preempted while holding it, it would hold
+    up the controller's clock thread behind it)."""
 
-    def __init__(self, host: str, port: int) -> None:
+    def __init__(self, host: str, port: int, realtime: bool = False) -> None:
         self.host, self.port = host, int(port)
+        self.realtime = realtime
         self.sock: socket.socket | None = None
         self.buf = bytearray()
         self.lock = threading.Lock()
@@ -52,6 +57,8 @@ class _Conn:
         self.thread.start()
 
     def _run(self) -> None:
+        if self.realtime:
+            try_realtime_priority(5)
         try:
             s = socket.create_connection((self.host, self.port), timeout=OPEN_TIMEOUT)
         except OSError:
@@ -114,10 +121,12 @@ class _Conn:
 
 
 class ScriptSockets:
-    """The sockets of one program run; ``period`` is the control period [s]."""
+    """The sockets of one program run; ``period`` is the control period [s]; ``realtime``:
+    their threads ask for real-time priority (the emulator's setting)."""
 
-    def __init__(self, period: float) -> None:
+    def __init__(self, period: float, realtime: bool = False) -> None:
         self.period = float(period)
+        self.realtime = realtime
         self.conns: dict[str, _Conn] = {}
 
     def close_all(self) -> None:
@@ -139,7 +148,7 @@ class ScriptSockets:
         old = self.conns.pop(str(socket_name), None)
         if old is not None:
             old.close()
-        conn = _Conn(str(address), int(port))
+        conn = _Conn(str(address), int(port), self.realtime)
         self.conns[str(socket_name)] = conn
         while not conn.ready.is_set():
             yield
