@@ -62,12 +62,16 @@ from .urscript import plan_wire_tolerance
 __all__ = [
     "DEVIATION_LIMIT",
     "MAX_LATENCY",
+    "RESUME_RAMP",
     "RunMeasures",
     "align_recording",
     "measure_run",
     "recording_cut",
 ]
 
+#: s: the longest ramp from rest to the feed a resume inside the block is allowed (the
+#: resume mark: left out of feed_min, and added with the pre-heat to the hot dwell's limit)
+RESUME_RAMP = 0.5
 #: rad: the largest joint deviation of the arm from the plan a run tolerates (the run
 #: stops beyond it; ``run_trajectory``'s and the verdict's default)
 DEVIATION_LIMIT = 0.05
@@ -169,8 +173,28 @@ def _where(traj: Trajectory, ranges: list[tuple[int, int]], most: int = 4) -> st
     return ", ".join(parts) + more
 
 
+def _without_resume_ramp(rcut: WireCut, wis: WireInStock) -> tuple[WireCut, int]:
+    """``rcut`` with the recorded samples of a resume's ramp left out of the held ranges:
+    from the first sample until the wire first cuts at the lower feed bound (at most
+    :data:`RESUME_RAMP` s); and the number of samples left out."""
+    if not rcut.feeds:
+        return rcut, 0
+    lo = min(f.speed * (1.0 - f.tolerance) for f in rcut.feeds)
+    t = wis.t
+    within = t <= t[0] + RESUME_RAMP
+    fast = np.flatnonzero(within & (np.nan_to_num(wis.feed, nan=0.0) >= lo))
+    ramp = int(fast[0]) if fast.size else int(np.count_nonzero(within))
+    feeds = []
+    for f in rcut.feeds:
+        held = tuple((max(a, ramp), b) for a, b in f.held if b > max(a, ramp))
+        feeds.append(FeedWindow(f.name, f.start, f.stop, f.speed, f.tolerance, held,
+                                f.wire_tolerance))  # fmt: skip
+    return WireCut(rcut.stock, rcut.wire_length, tuple(feeds)), ramp
+
+
 def _dwell_check(traj: Trajectory, wis: WireInStock, hot: np.ndarray | None,
-                 speed_scale: float, idx: np.ndarray) -> Check:  # fmt: skip
+                 speed_scale: float, idx: np.ndarray,
+                 entry_in_block: float | None = None) -> Check:  # fmt: skip
     """``hot_dwell``: the longest time the recorded hot wire stayed in the block cutting
     slower than half the slowest set feed, against its plan's own (corner stops) plus
     :data:`~ruledrobot.robot.wire.cut.DWELL_SLACK`."""
@@ -186,10 +210,16 @@ def _dwell_check(traj: Trajectory, wis: WireInStock, hot: np.ndarray | None,
     got = hot_dwell(wis, np.asarray(hot, dtype=bool)[: wis.n], speed)
     where = (f" from plan sample {int(idx[got.start])} (t = {traj.t[int(idx[got.start])]:.3f}"
              f" s, {traj.phase_at(int(idx[got.start]))})" if got.start >= 0 else "")
-    return Check.at_most("hot_dwell", label, got.seconds, planned + DWELL_SLACK, "s",
+    limit = planned + DWELL_SLACK
+    mark = ""
+    if entry_in_block is not None:
+        limit += entry_in_block + RESUME_RAMP
+        mark = (f"; a resume in the kerf: its pre-heat ({entry_in_block:g} s) and ramp (up to "
+                f"{RESUME_RAMP:g} s) allowed: the resume mark")  # fmt: skip
+    return Check.at_most("hot_dwell", label, got.seconds, limit, "s",
                          f"{got.seconds:.3f} s with the heat on below "
                          f"{1e3 * DWELL_FRACTION * speed:.1f} mm/s{where}; the plan's own "
-                         f"{planned:.3f} s (corner stops)")  # fmt: skip
+                         f"{planned:.3f} s (corner stops){mark}")  # fmt: skip
 
 
 def measure_run(
@@ -207,6 +237,7 @@ def measure_run(
     speed_scale: float = 1.0,
     wire_tolerance: float | None = None,
     hot: np.ndarray | None = None,
+    entry_in_block: float | None = None,
 ) -> RunMeasures:
     """The run's verdict and measures (module doc).  ``traj``: the plan; ``rec``: the
     recording (None when nothing was recorded); ``plan_index`` (R,): the plan sample of
@@ -215,7 +246,11 @@ def measure_run(
     ``wire_tolerance`` (m): the wire deviation's limit, default the plan's
     (:func:`~.urscript.plan_wire_tolerance`: the strictest of its cuts'); ``hot`` (R,):
     the heat on at each recorded sample, as the controller's outputs said (None: not
-    recorded), for the hot dwell."""
+    recorded), for the hot dwell; ``entry_in_block``: the pre-heat [s] of a run that
+    entered the trajectory from rest with the wire in the block (a resume that continues
+    in the kerf), None otherwise — its **resume mark** is allowed: the ramp from rest to
+    the feed (at most :data:`RESUME_RAMP` s) is left out of ``feed_min`` and the pre-heat
+    added to the hot dwell's limit, both said in the checks' details."""
     wire_tolerance = plan_wire_tolerance(traj, wire_tolerance)
     checks = [
         Check("motion", "the motion ran to the end", status, "completed", "", "==",
@@ -259,6 +294,9 @@ def measure_run(
     robot = model_for(traj.meta).with_base(np.eye(4))
     rcut = recording_cut(cut, idx, speed_scale)
     wis = rcut.measure(rec.t, robot.fk(rec.q))
+    ramp = 0
+    if entry_in_block is not None:  # the resume mark: the ramp from rest to the feed
+        rcut, ramp = _without_resume_ramp(rcut, wis)
     # the actual chord's ends from the planned wire (a line) at the matched plan sample
     plan_ends = wire_ends(traj.tcp_poses()[idx], cut.wire_length)
     a, b = plan_ends[:, 0], plan_ends[:, 1]
@@ -275,8 +313,19 @@ def measure_run(
         wdev, wat = float("nan"), -1
         checks.append(Check.info("wire_deviation", "actual wire from the planned wire in the "
                                  "block", "the actual wire never entered the block"))  # fmt: skip
-    checks.append(_dwell_check(traj, wis, hot, speed_scale, idx))
+    checks.append(_dwell_check(traj, wis, hot, speed_scale, idx, entry_in_block))
+    if entry_in_block is not None:
+        checks.append(Check.info(
+            "resume_mark", "a resume in the kerf: the mark it leaves (allowed)",
+            float(wis.t[min(ramp, wis.n - 1)] - wis.t[0]), "s",
+            f"the run entered at plan sample {int(idx[0])} from rest with the wire in the "
+            f"block: its ramp to the feed ({ramp} recorded samples, at most {RESUME_RAMP:g} s) "
+            f"is left out of feed_min, its pre-heat ({entry_in_block:g} s) and ramp are added "
+            "to the hot dwell's limit"))  # fmt: skip
     feeds = feed_measures(wis, rcut)
+    mark = (f"; a resume in the kerf: its ramp from rest ({ramp} recorded samples, "
+            f"{float(wis.t[min(ramp, wis.n - 1)] - wis.t[0]):.3f} s) left out: the resume mark"
+            if ramp else "")  # fmt: skip
     of = len(feeds) > 1
     for f in feeds:
         key, name = (f":{f.name}", f" ({f.name})") if of else ("", "")
@@ -289,6 +338,7 @@ def measure_run(
             f"{1e3 * f.highest:.2f} mm/s at plan sample {at_hi} against "
             f"{1e3 * f.speed:.2f} mm/s +{100 * f.tolerance:g} %: the wire drags",
             f"{1e3 * f.lowest:.2f} mm/s at plan sample {at_lo} against "
-            f"{1e3 * f.speed:.2f} mm/s -{100 * f.tolerance:g} %: a wider kerf there")))  # fmt: skip
+            f"{1e3 * f.speed:.2f} mm/s -{100 * f.tolerance:g} %: a wider kerf "
+            f"there{mark}")))  # fmt: skip
     return RunMeasures(Verdict(tuple(checks)), idx, rcut, wis.runs(), feeds, wdev, wat,
                        skipped, n_bad, tuple(bad_runs), max_slip)  # fmt: skip

@@ -50,7 +50,7 @@ from .forward import ForwardSettings
 from .heat import heat_from_outputs, send_heat_off
 from .limits import check_trajectory
 from .run_checks import controller_checks, kinematics_check, query_dashboard, readiness_check
-from .run_plan import Entry, plan_entry, recording_path_for, resample, stop_place
+from .run_plan import Entry, inside_mask, plan_entry, recording_path_for, resample, stop_place
 from .run_program import PathRun, plan_path_run
 from .run_result import ControllerError, RunMode, RunPlan, RunResult
 from .run_supervisor import Child, ChildGone
@@ -478,8 +478,13 @@ def _move(
     hot_rec = None  # the heat as the controller's outputs reported it, per recorded sample
     if rec is not None and heat is not None:
         hot_rec = heat_from_outputs(heat, np.concatenate([c[4] for c in out.chunks]))
+    # a run that entered from rest with the wire in the block (a resume in the kerf): its
+    # resume mark (ramp, pre-heat) is allowed and said (run_verdict.measure_run)
+    in_block = entry.kind == "continue" and bool(inside_mask(traj)[entry.sample])
+    entry_in_block = (heat.preheat if heat is not None else 0.0) if in_block else None
     measures = measure_run(traj, rec, plan_index, status=result.status,
                            message=result.message, skipped_ranges=skips, hot=hot_rec,
+                           entry_in_block=entry_in_block,
                            max_slip=result.max_slip, max_latency=o["max_latency"],
                            max_deviation=result.max_deviation,
                            deviation_limit=o["deviation_limit"], speed_scale=speed_scale,

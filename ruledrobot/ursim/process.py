@@ -37,6 +37,7 @@ from ..robot import Calibration, RobotModel
 from .address import start_on_free_host
 from .arm.backend import ArmBackend
 from .arm.emulated import emulated_model
+from .ports.tcp import try_realtime_priority
 from .server import ThreadedEmulator
 
 __all__ = ["EMBEDDED_HOST", "Emulator", "embedded_emulator"]
@@ -101,6 +102,8 @@ def _child_entry(fd: int) -> None:  # pragma: no cover - runs in the child
         # the cyclic collector so that full collections stay short (no clock stalls)
         gc.collect()
         gc.freeze()
+        if emu.realtime:  # this thread answers the parent (stats, events) holding the GIL:
+            try_realtime_priority(5)  # preempted at normal priority, it stalls the clock
     except BaseException as exc:
         text = str(exc) if type(exc) is OSError else f"{type(exc).__name__}: {exc}"
         with contextlib.suppress(OSError):

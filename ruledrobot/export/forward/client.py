@@ -91,6 +91,9 @@ def _play(s: Session, conn: socket.socket, q_grid: np.ndarray, hot: np.ndarray |
     while int(r.getRuntimeState()) != 2 and time.monotonic() < deadline:
         time.sleep(0.002)
     s.link.stage("forwarding", heartbeat)
+    # the controller plays from its buffer: its data late by less than the buffer endangers
+    # nothing (an emulator whose host stalls catches up); a controller silent longer stops
+    s.max_latency = max(s.max_latency, settings.buffer)
     s.start_recording()
     s.start_clock()
     stop: Stop | None = None
