@@ -26,7 +26,7 @@ from dataclasses import asdict, dataclass, field, fields
 from pathlib import Path
 from typing import Any
 
-from ..io.atomic import atomic_write_text
+from ..io.atomic import atomic_write_json, atomic_write_text
 from ..io.outdir import read_manifest
 from .jobs import BatchInputError
 
@@ -211,7 +211,7 @@ def write_manifest(out: Path, records: list[JobRecord], earlier: list[JobRecord]
         "jobs": [r.as_dict() for r in records],
         "earlier": [r.as_dict() for r in earlier],
     }
-    path = atomic_write_text(out / BATCH_JSON, json.dumps(doc, indent=1) + "\n")
+    path = atomic_write_json(out / BATCH_JSON, doc)
     atomic_write_text(out / BATCH_CSV, _csv_text(records + earlier))
     return path
 

@@ -16,6 +16,7 @@ from itertools import pairwise
 
 import numpy as np
 
+from ..geometry.ranges import runs_of
 from ..geometry.se3 import pose_from_rotvec, rotvec_from_matrix
 from .settings import PATH_BLEND
 
@@ -223,9 +224,7 @@ def path_steps(
     turn = np.linalg.norm(rotvec_from_matrix(np.einsum("nji,njk->nik", R[:-1], R[1:])), axis=-1)
     still = (speed < STILL_SPEED) & (turn / dt < STILL_TURN)
     jspeed = np.zeros(M - 1) if q is None else np.abs(np.diff(q, axis=0)).max(axis=1) / dt
-    d = np.diff(np.r_[0, still.astype(np.int8), 0])
-    runs = zip(np.flatnonzero(d == 1), np.flatnonzero(d == -1), strict=True)
-    dwells = {int(a): int(b) for a, b in runs if t[b] - t[a] >= min_dwell}
+    dwells = {a: b for a, b in runs_of(still) if t[b] - t[a] >= min_dwell}
     edges = np.flatnonzero(np.diff(on.astype(np.int8))) + 1
     tight_edges = np.flatnonzero(np.diff(tight.astype(np.int8))) + 1
     cuts = {0, M - 1, *(int(k) for k in boundaries if 0 < k < M - 1), *edges.tolist(),

@@ -44,6 +44,7 @@ from typing import Any
 
 import numpy as np
 
+from ..geometry.ranges import runs_of
 from ..robot.motion.trajectory import Trajectory, model_for
 from ..robot.verdict import Check, Verdict
 from ..robot.wire.cut import (
@@ -55,7 +56,7 @@ from ..robot.wire.cut import (
     feed_measures,
     hot_dwell,
 )
-from ..robot.wire.in_stock import WireInStock, largest_line_distance, runs_of, wire_ends
+from ..robot.wire.in_stock import WireInStock, largest_line_distance, wire_ends
 from .run_plan import inside_mask
 from .urscript import plan_wire_tolerance
 

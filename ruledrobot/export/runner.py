@@ -40,7 +40,7 @@ from typing import Any
 
 import numpy as np
 
-from ..io.atomic import atomic_write_text
+from ..io.atomic import atomic_write_json
 from ..io.trajectory import read_trajectory, sidecar_path, write_trajectory
 from ..robot import RobotModel, load, model_for
 from ..robot.motion.trajectory import Trajectory
@@ -524,7 +524,7 @@ def _write_run(path: Path, result: RunResult, measures: RunMeasures, source: Pat
         "ok": result.ok,
         **measures.as_dict(),
     }
-    atomic_write_text(side, json.dumps(doc, indent=1) + "\n")
+    atomic_write_json(side, doc)
 
 
 def _heat_message(traj: Trajectory, k0: int, grid_to_input: np.ndarray) -> dict | None:

@@ -34,8 +34,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..geometry.ranges import runs_of
 from ..robot.motion.arm_kinematics import ArmKinematics
-from ..robot.motion.trajectory import Trajectory, model_for, runs
+from ..robot.motion.trajectory import Trajectory, model_for
 from ..robot.motion.ur_motion import PathMotion, Segment, joint_segment, linear_segment
 from ..robot.wire.cut import WIRE_TOLERANCE, FeedMeasure, FeedWindow, WireCut, feed_measures
 from ..robot.wire.in_stock import largest_line_distance, wire_ends
@@ -238,7 +239,7 @@ def _carried(cut: WireCut, match: np.ndarray) -> WireCut:
         for a, b in w.held:
             held |= (match >= a) & (match < b)
         feeds.append(FeedWindow(w.name, int(k[0]), int(k[-1]) + 1, w.speed, w.tolerance,
-                                runs(held & inwin)))  # fmt: skip
+                                runs_of(held & inwin)))  # fmt: skip
     return WireCut(cut.stock, cut.wire_length, tuple(feeds))
 
 

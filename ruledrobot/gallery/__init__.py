@@ -33,14 +33,13 @@ The examples (surfaces from :mod:`ruledrobot.geometry.surfaces`):
 
 from __future__ import annotations
 
-import json
 import math
 import time
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from ..io.atomic import atomic_write_bytes, atomic_write_text
+from ..io.atomic import atomic_write_bytes, atomic_write_json
 from .examples import _EXAMPLES
 from .render import _render
 
@@ -89,5 +88,5 @@ def run_gallery(out_dir: Path | str, progress: Progress | None = None) -> dict[s
         "examples": examples,
         "passed": all(c["passed"] for ex in examples for c in ex["checks"]),
     }
-    atomic_write_text(out / "checks.json", json.dumps(_json_safe(result), indent=1) + "\n")
+    atomic_write_json(out / "checks.json", _json_safe(result))
     return result

@@ -49,6 +49,7 @@ from . import se3
 from ._arrays import cross, dot, norm
 from .checks import FloatArray
 from .lines import CommonNormal, Lines, common_normal
+from .ranges import run_indices
 
 __all__ = ["RuledSurface", "dh_transform"]
 
@@ -74,21 +75,6 @@ def dh_transform(theta: FloatArray, d: FloatArray, a: FloatArray, alpha: FloatAr
     T[..., 2, 3] = ca * d
     T[..., 3, 3] = 1.0
     return T
-
-
-def _runs(mask: np.ndarray, closed: bool) -> list[np.ndarray]:
-    """Index arrays of maximal runs of True in ``mask`` (wrapping when closed)."""
-    m = mask.size
-    if not mask.any():
-        return []
-    if mask.all():
-        return [np.arange(m)]
-    idx = np.flatnonzero(mask)
-    breaks = np.flatnonzero(np.diff(idx) > 1)
-    runs = np.split(idx, breaks + 1)
-    if closed and mask[0] and mask[-1] and len(runs) > 1:
-        runs = [np.concatenate([runs[-1], runs[0]]), *runs[1:-1]]
-    return runs
 
 
 @dataclass(frozen=True)
@@ -157,7 +143,7 @@ class RuledSurface:
         m = self.n_pairs
         ref = np.full((m, 3), np.nan)
         fallback = None
-        for run in _runs(cn.parallel, self.closed):
+        for run in run_indices(cn.parallel, self.closed):
             outer = []
             before, after = run[0] - 1, run[-1] + 1
             if self.closed:

@@ -13,7 +13,12 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import IO
 
-__all__ = ["atomic_open", "atomic_write_bytes", "atomic_write_text"]
+__all__ = ["JSON_INDENT", "atomic_open", "atomic_write_bytes", "atomic_write_json",
+           "atomic_write_text"]
+
+#: how ruledrobot's JSON files are laid out: one space per level (short lines, small
+#: files), a newline at the end (the formatting rule of every JSON file the product writes)
+JSON_INDENT = 1
 
 
 @contextlib.contextmanager
@@ -67,3 +72,14 @@ def atomic_write_bytes(path: str | os.PathLike[str], data: bytes) -> Path:
     with atomic_open(path, "wb") as fh:
         fh.write(data)
     return Path(path)
+
+
+def atomic_write_json(path: str | os.PathLike[str], doc: object, *, compact: bool = False) -> Path:
+    """Write ``doc`` as JSON to ``path`` atomically (:data:`JSON_INDENT`, a final newline;
+    ``compact``: no whitespace at all, for large arrays); returns the path.  The one
+    writer of the product's JSON files (``tests/architecture/test_one_home.py``)."""
+    import json
+
+    text = (json.dumps(doc, separators=(",", ":")) if compact
+            else json.dumps(doc, indent=JSON_INDENT))  # fmt: skip
+    return atomic_write_text(path, text + "\n")

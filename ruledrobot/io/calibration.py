@@ -17,13 +17,12 @@ file read back gives the same table bit for bit.
 
 from __future__ import annotations
 
-import json
 import os
 from pathlib import Path
 from typing import Any
 
 from ..robot.arm.calibration import _COLUMNS, Calibration, CalibrationError, _column
-from .atomic import atomic_write_text
+from .atomic import atomic_write_json
 from .text import json_object, read_user_text
 
 __all__ = ["CALIBRATION_FORMAT", "load_calibration", "save_calibration"]
@@ -46,7 +45,7 @@ def save_calibration(path: str | os.PathLike[str], cal: Calibration) -> Path:
     """Write ``cal`` as a ``ruledrobot.calibration/1`` JSON file (atomically); returns the path."""
     if not isinstance(cal, Calibration):
         raise TypeError(f"save_calibration: expected a Calibration, got {type(cal).__name__}")
-    return atomic_write_text(path, json.dumps(_to_dict(cal), indent=2) + "\n")
+    return atomic_write_json(path, _to_dict(cal))
 
 
 def load_calibration(path: str | os.PathLike[str]) -> Calibration:

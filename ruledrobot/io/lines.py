@@ -22,7 +22,6 @@ from __future__ import annotations
 
 import csv
 import io
-import json
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -32,7 +31,7 @@ from numpy.typing import ArrayLike
 
 from ..geometry.checks import FloatArray
 from ..geometry.lines import Lines, plucker_from_point_direction, validate_plucker
-from .atomic import atomic_write_text
+from .atomic import atomic_write_json, atomic_write_text
 from .text import json_object, read_user_text
 from .units import unit_scale
 
@@ -242,4 +241,4 @@ def save_lines(
         if st.shape != (n, 3):
             raise ValueError(f"{p}: striction must have shape ({n}, 3), got {st.shape}")
         doc["striction"] = st.tolist()
-    return atomic_write_text(p, json.dumps(doc, indent=1) + "\n")
+    return atomic_write_json(p, doc)

@@ -37,7 +37,7 @@ from fnmatch import fnmatch
 from pathlib import Path
 from typing import Any
 
-from .atomic import atomic_write_text
+from .atomic import atomic_write_json
 
 __all__ = ["MANIFEST", "MANIFEST_FORMAT", "StagedFolder", "check_replaceable", "is_recording",
            "read_manifest"]
@@ -172,7 +172,7 @@ class StagedFolder:
                "files": files}  # fmt: skip
         if kept:
             doc["kept"] = kept
-        atomic_write_text(self.path / MANIFEST, json.dumps(doc, indent=1) + "\n")
+        atomic_write_json(self.path / MANIFEST, doc)
         os.chmod(self.path, 0o755)
         if not self.target.exists():
             os.rename(self.path, self.target)

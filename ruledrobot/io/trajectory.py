@@ -56,7 +56,7 @@ from ..robot.motion.trajectory import (
     TrajectoryMeta,
 )
 from ..robot.wire.cut import WIRE_TOLERANCE, FeedWindow, WireCut
-from .atomic import atomic_write_bytes, atomic_write_text
+from .atomic import atomic_write_bytes, atomic_write_json, atomic_write_text
 from .text import read_user_text
 
 __all__ = [
@@ -331,7 +331,7 @@ def write_trajectory(path: str | os.PathLike[str], traj: Trajectory) -> Path:
         duration_s=traj.duration,
     )
     atomic_write_text(p, text)
-    atomic_write_text(sidecar_path(p), json.dumps(doc, indent=1) + "\n")
+    atomic_write_json(sidecar_path(p), doc)
     return p
 
 
@@ -353,7 +353,7 @@ def write_trajectory_json(path: str | os.PathLike[str], traj: Trajectory) -> Pat
         "q": traj.q.tolist(),
         "tcp": traj.tcp.tolist(),
     }
-    return atomic_write_text(p, json.dumps(doc, indent=None, separators=(",", ":")) + "\n")
+    return atomic_write_json(p, doc, compact=True)
 
 
 def write_trajectory_npz(path: str | os.PathLike[str], traj: Trajectory) -> Path:

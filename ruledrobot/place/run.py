@@ -14,14 +14,13 @@ Output folder (written whole, swapped in at the end):
 
 from __future__ import annotations
 
-import json
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
-from ..io.atomic import atomic_write_text
+from ..io.atomic import atomic_write_json, atomic_write_text
 from ..io.outdir import StagedFolder
 from ..wirecut.job.spec import Job
 from ..wirecut.plan import job_reference
@@ -180,7 +179,7 @@ def run_place(
         lines += list(ev.notes)  # a scorer's notes (chunks scored here)
         doc = _document(job, res, verified, setups, checks, steps, ev, lines, ok)
         doc["closing"] = closing or None
-        atomic_write_text(stage.path / "place.json", json.dumps(doc, indent=1) + "\n")
+        atomic_write_json(stage.path / "place.json", doc)
         target = stage.commit({"kind": "place", "ok": ok})
     files = {"place": target / "place.json", "margin": target / "margin.png"}
     if single_ok and verified is not None:

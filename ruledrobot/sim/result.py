@@ -4,7 +4,6 @@
 from __future__ import annotations
 
 import copy
-import json
 import math
 import os
 from dataclasses import dataclass, field
@@ -15,7 +14,7 @@ import numpy as np
 
 from ..geometry import se3
 from ..geometry.checks import FloatArray
-from ..io.atomic import atomic_open, atomic_write_text
+from ..io.atomic import atomic_open, atomic_write_json
 from ..robot.arm.model import RobotModel
 from ..robot.motion.rates import RATIO_MAX
 from ..robot.verdict import Check, Verdict
@@ -234,7 +233,7 @@ class PlaybackResult:
         paths: dict[str, Path] = {}
         rep = self.report()
         rep["verdict"] = self.verdict().as_dict()
-        paths["report"] = atomic_write_text(out / "report.json", json.dumps(rep, indent=2) + "\n")
+        paths["report"] = atomic_write_json(out / "report.json", rep)
         if plots:
             paths.update(self.plot(out))
         if trajectory and self.robot.n_joints == 6:

@@ -18,10 +18,11 @@ from pathlib import Path
 import numpy as np
 
 from ..geometry.checks import FloatArray
+from ..geometry.ranges import runs_of
 from ..geometry.se3 import transform_points
 from ..robot.arm.model import RobotModel
 from ..robot.motion.rates import trajectory_limits_report
-from ..robot.motion.trajectory import Heat, Trajectory, phases_from_labels, runs
+from ..robot.motion.trajectory import Heat, Trajectory, phases_from_labels
 from ..robot.tool import BowTool
 from ..robot.wire.cut import FeedWindow, WireCut
 from .cut.clearance import SINGULAR_MIN
@@ -142,7 +143,7 @@ def wire_cut(job: Job, motion: Motion, bow: BowTool | None = None) -> WireCut:
         mask = np.zeros(len(motion.pass_of), dtype=bool)
         mask[rows] = True
         feeds.append(FeedWindow(cut.name, int(rows[0]), int(rows[-1]) + 1, cut.feed_speed,
-                                cut.feed_tolerance, runs(held_all & mask),
+                                cut.feed_tolerance, runs_of(held_all & mask),
                                 cut.wire_tolerance))  # fmt: skip
     bow = BowTool.of(job.tool if bow is None else bow)
     return WireCut(job.stock, bow.wire_length, tuple(feeds))
@@ -174,7 +175,7 @@ def _heat(job: Job, motion: Motion) -> Heat | None:
     h = job.tool.heat
     if h is None:
         return None
-    return Heat(h.kind, h.index, h.value, runs(motion.heat), h.preheat)
+    return Heat(h.kind, h.index, h.value, runs_of(motion.heat), h.preheat)
 
 
 def make_plan(

@@ -91,12 +91,10 @@ def plan(
         files = write_plan(stage, p, ver, report, verdict, video=video)
         report["timings"]["write_s"] = time.perf_counter() - t1
         report["timings"]["total_s"] = time.perf_counter() - t0
-        import json
 
-        from ..io.atomic import atomic_write_text
+        from ..io.atomic import atomic_write_json
 
-        files["report"] = atomic_write_text(stage.path / "report.json",
-                                            json.dumps(report, indent=1) + "\n")  # fmt: skip
+        files["report"] = atomic_write_json(stage.path / "report.json", report)  # fmt: skip
         target = stage.commit({"kind": "plan", "feasible": verdict.ok,
                                "verdict": verdict.summary()})  # fmt: skip
         files = {k: target / Path(v).relative_to(stage.path) for k, v in files.items()}

@@ -25,10 +25,10 @@ from ruledrobot.export import run_trajectory
 from ruledrobot.export.run_plan import inside_mask, plan_entry, stop_place
 from ruledrobot.export.run_verdict import align_recording, measure_run, recording_cut
 from ruledrobot.geometry.box import Box
+from ruledrobot.geometry.ranges import runs_of
 from ruledrobot.io.trajectory import read_trajectory, write_trajectory
 from ruledrobot.robot.motion.trajectory import Heat, Trajectory
 from ruledrobot.robot.wire.cut import FeedWindow, WireCut
-from ruledrobot.robot.wire.in_stock import runs_of
 from ruledrobot.ursim import Emulator
 
 from .test_run_plan import cut_trajectory

@@ -24,6 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ...geometry.ranges import runs_of
 from ..text import read_user_text
 from .gcode_parse import FEED_MODES, TowerMoves, check_axes, parse_gcode
 from .options import Options
@@ -82,18 +83,12 @@ def read_gcode_moves(path: str | os.PathLike[str], options: GcodeReadOptions) ->
                        options.feed_mode)  # fmt: skip
 
 
-def _runs(cutting: np.ndarray) -> list[tuple[int, int]]:
-    """Index ranges [a, b) of consecutive True entries."""
-    edges = np.flatnonzero(np.diff(np.r_[0, cutting.astype(np.int8), 0]))
-    return list(zip(edges[::2].tolist(), edges[1::2].tolist(), strict=True))
-
-
 def read_gcode(path: str | os.PathLike[str], options: GcodeReadOptions) -> Rulings:
     """The rulings of the cut in a G-code file, in the cutter frame (see the module doc)."""
     where = str(Path(path))
     mv = read_gcode_moves(path, options)
     cutting = ~mv.rapid & (mv.heat if mv.heat_codes else True)
-    runs = _runs(cutting)
+    runs = list(runs_of(cutting))
     if not runs:
         hint = " while the wire is hot (M3/M4/M8)" if mv.heat_codes else ""
         raise ValueError(f"{where}: no cutting move (G1{hint}) in the file; expected the "

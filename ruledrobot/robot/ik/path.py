@@ -41,6 +41,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ...geometry.angles import TWO_PI, wrap_angle
+from ...geometry.ranges import runs_of_indices
 from .._checks import FloatArray, as_array, as_joint_vector, as_poses
 from . import analytic as _ik
 
@@ -262,16 +263,6 @@ def _fit_joint(
     return out, wraps
 
 
-def _runs(idx: np.ndarray) -> list[tuple[int, int]]:
-    """Consecutive runs of sorted indices as (first, last) pairs."""
-    if idx.size == 0:
-        return []
-    cut = np.flatnonzero(np.diff(idx) != 1)
-    starts = np.concatenate([[0], cut + 1])
-    ends = np.concatenate([cut, [idx.size - 1]])
-    return [(int(idx[a]), int(idx[b])) for a, b in zip(starts, ends, strict=True)]
-
-
 def path_ik(
     model: PathArm,
     poses: ArrayLike,
@@ -481,7 +472,8 @@ def _messages(
     events: list[tuple[int, str]] = []
     for code in (PathStatus.UNREACHABLE, PathStatus.OUT_OF_LIMITS):
         sel = bad[status[bad] == code]
-        for a, b in _runs(sel):
+        for a, stop in runs_of_indices(sel):
+            b = stop - 1
             span = f"sample {a}" if a == b else f"samples {a}-{b}"
             extra = ""
             if code == PathStatus.UNREACHABLE:

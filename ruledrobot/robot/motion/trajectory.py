@@ -38,7 +38,7 @@ from ...geometry.se3 import pose_from_ur_vector, ur_vector_from_pose
 from .._checks import FloatArray, as_array, as_pose_or_vector, readonly
 from ..arm.model import DEFAULT_ACCELERATION, RobotModel
 from ..wire.cut import WireCut
-from ..wire.in_stock import WireInStock, runs_of
+from ..wire.in_stock import WireInStock
 from .rates import finite_difference_rates
 
 __all__ = [
@@ -54,7 +54,6 @@ __all__ = [
     "kinematics_checksum",
     "model_for",
     "phases_from_labels",
-    "runs",
 ]
 
 #: Names of trajectory phases, in the order a cut meets them.
@@ -449,6 +448,3 @@ def phases_from_labels(labels: ArrayLike) -> tuple[Phase, ...]:
     return tuple(Phase(str(lab[a]), int(a), int(b)) for a, b in zip(starts, stops, strict=True))
 
 
-def runs(mask: ArrayLike) -> tuple[tuple[int, int], ...]:
-    """Half-open ranges ``(start, stop)`` of the True runs of a boolean mask (M,)."""
-    return runs_of(mask)

@@ -23,8 +23,9 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ...geometry.box import Box
+from ...geometry.ranges import runs_of
 from ..verdict import Check
-from .in_stock import WireInStock, runs_of, wire_ends, wire_in_stock
+from .in_stock import WireInStock, wire_ends, wire_in_stock
 
 __all__ = ["DWELL_FRACTION", "DWELL_SLACK", "WIRE_TOLERANCE", "FeedMeasure", "FeedWindow",
            "HotDwell", "WireCut", "feed_checks", "feed_measures", "hot_dwell"]

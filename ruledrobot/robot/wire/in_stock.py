@@ -38,6 +38,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ...geometry.box import Box
+from ...geometry.ranges import runs_of
 from .._checks import FloatArray
 
 __all__ = [
@@ -47,7 +48,6 @@ __all__ = [
     "chord_fractions",
     "feed_chord",
     "largest_line_distance",
-    "runs_of",
     "wire_ends",
     "wire_gap",
     "wire_in_stock",
@@ -154,14 +154,6 @@ def _depth(ends: FloatArray, lo: FloatArray, hi: FloatArray, stock: Box) -> Floa
     g = c[:, None, :] + cand[:, :, None] * s[:, None, :]  # (n, 17, 6)
     out[inside] = np.maximum(g.min(axis=2).max(axis=1), 0.0)
     return out
-
-
-def runs_of(mask: ArrayLike) -> tuple[tuple[int, int], ...]:
-    """Half-open ranges ``(start, stop)`` of the True runs of a boolean mask (M,)."""
-    m = np.asarray(mask, dtype=bool).astype(np.int8)
-    d = np.diff(np.r_[0, m, 0])
-    return tuple(zip(np.flatnonzero(d == 1).tolist(), np.flatnonzero(d == -1).tolist(),
-                     strict=True))  # fmt: skip
 
 
 @dataclass(frozen=True, eq=False)

@@ -6,13 +6,12 @@ path the planner chose drawn on it), and its summary in words."""
 from __future__ import annotations
 
 import io
-import json
 from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
 
-from ...io.atomic import atomic_write_bytes, atomic_write_text
+from ...io.atomic import atomic_write_bytes, atomic_write_json
 from ...io.words import index_ranges
 from ..job.spec import Job
 from .map import PassMap, ReachMap
@@ -126,7 +125,7 @@ def write_reach_json(path: str | Path, rm: ReachMap, job_ref: dict | None) -> Pa
         "seconds": rm.seconds,
         "passes": passes,
     }  # fmt: skip
-    return atomic_write_text(path, json.dumps(doc) + "\n")
+    return atomic_write_json(path, doc, compact=True)
 
 
 #: out-of-reach cells are shaded up to this distance (m)

@@ -7,7 +7,6 @@ A plan whose verdict fails leaves its report, its plots and the simulation's rep
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import numpy as np
@@ -15,7 +14,7 @@ import numpy as np
 from ...geometry import se3
 from ...geometry.lines import Lines
 from ...geometry.mesh import box_clipped_mesh
-from ...io.atomic import atomic_write_bytes, atomic_write_text
+from ...io.atomic import atomic_write_bytes, atomic_write_json
 from ...io.lines import save_lines
 from ...io.mesh import write_stl
 from ...io.outdir import StagedFolder
@@ -130,8 +129,7 @@ def write_plan(
         report.setdefault("notes", []).append(
             "no video: the plan fails (--video renders the cut of a plan that passes; "
             "plots.png and report.json show this one)")
-    files["report"] = atomic_write_text(folder / "report.json",
-                                        json.dumps(report, indent=1) + "\n")  # fmt: skip
+    files["report"] = atomic_write_json(folder / "report.json", report)  # fmt: skip
     data = plan.source_bytes if plan.source_bytes is not None else job_source_bytes(plan.job)
     if data is not None:  # the bytes the plan read (and hashed) once
         files["job"] = atomic_write_bytes(folder / "job.toml", data)

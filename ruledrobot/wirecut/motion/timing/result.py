@@ -6,6 +6,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ....geometry.ranges import runs_of
 from .tolerances import RATIO_MAX, BoolArray, FloatArray, IntArray
 
 # --------------------------------------------------------------------------- result
@@ -97,10 +98,6 @@ class TimedPath:
 
 
 def _runs(mask: BoolArray, values: FloatArray) -> FloatArray:
-    if not mask.any():
-        return np.zeros((0, 2))
-    m = np.concatenate([[False], mask, [False]]).astype(np.int8)
-    d = np.diff(m)
-    start = np.flatnonzero(d == 1)
-    stop = np.flatnonzero(d == -1) - 1
-    return np.stack([values[start], values[stop]], axis=1)
+    """(K, 2) ``values`` at the first and the last sample of each True run of ``mask``."""
+    r = np.asarray(runs_of(mask), dtype=np.int64).reshape(-1, 2)
+    return np.stack([values[r[:, 0]], values[r[:, 1] - 1]], axis=1)

@@ -1,0 +1,45 @@
+"""Runs of a boolean mask: the one convention for index ranges in ruledrobot.
+
+Every range of samples the product computes, stores or prints is **half-open**,
+``(start, stop)`` with ``start <= k < stop``, as Python slices are (``mask[start:stop]``
+is the run); messages print them inclusive through :func:`ruledrobot.io.words.index_ranges`.
+``tests/architecture/test_one_home.py`` fails when a second spelling of a run finder
+appears.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+__all__ = ["run_indices", "runs_of", "runs_of_indices"]
+
+
+def runs_of(mask: ArrayLike) -> tuple[tuple[int, int], ...]:
+    """Half-open ranges ``(start, stop)`` of the True runs of a boolean mask (M,)."""
+    m = np.asarray(mask, dtype=bool).astype(np.int8)
+    d = np.diff(np.r_[0, m, 0])
+    return tuple(zip(np.flatnonzero(d == 1).tolist(), np.flatnonzero(d == -1).tolist(),
+                     strict=True))  # fmt: skip
+
+
+def runs_of_indices(idx: ArrayLike) -> tuple[tuple[int, int], ...]:
+    """Half-open ranges ``(first, last + 1)`` of the runs of consecutive values of sorted
+    integer indices ``idx`` (K,)."""
+    i = np.asarray(idx, dtype=np.int64).reshape(-1)
+    if i.size == 0:
+        return ()
+    cut = np.flatnonzero(np.diff(i) != 1)
+    starts = np.r_[0, cut + 1]
+    ends = np.r_[cut, i.size - 1]
+    return tuple((int(i[a]), int(i[b]) + 1) for a, b in zip(starts, ends, strict=True))
+
+
+def run_indices(mask: ArrayLike, closed: bool = False) -> list[np.ndarray]:
+    """The index arrays of the True runs of ``mask`` (M,); with ``closed`` a run through the
+    end continues at the start (one array, wrapping)."""
+    m = np.asarray(mask, dtype=bool)
+    runs = [np.arange(a, b) for a, b in runs_of(m)]
+    if closed and len(runs) > 1 and m[0] and m[-1]:
+        runs = [np.concatenate([runs[-1], runs[0]]), *runs[1:-1]]
+    return runs
