@@ -23,7 +23,7 @@ import numpy as np
 from ..io.atomic import atomic_write_text
 from ..io.mesh import write_stl
 from ..io.outdir import StagedFolder
-from .carved import carved_mesh
+from .carved import Carved, carve_block
 from .cell import Cell, load_cell
 from .jobs import setups_of, write_jobs
 from .meshquery import MeshQuery
@@ -107,12 +107,13 @@ def carve(cell_path: str | os.PathLike[str], out: str | os.PathLike[str],
         t = time.perf_counter()
         progress("meshing the carved block")
         exact = tuple(c for c in plan.cuts if c.kind == "exact")
-        carved = carved_mesh(exact, cell.stock, plan.loops) if plan.cuts else None
-        base = carved_mesh(exact, cell.stock, plan.baseline) if plan.baseline else None
+        made = carve_block(exact, cell.stock, plan.loops) if plan.cuts else None
+        carved = made.mesh if made is not None else None
+        base = carve_block(exact, cell.stock, plan.baseline).mesh if plan.baseline else None
         times["carved"] = time.perf_counter() - t
         t = time.perf_counter()
         files = _write(staged.path, cell, part, plan, carved)
-        report = _report(cell, part, plan, carved, base, query, times)
+        report = _report(cell, part, plan, carved, base, query, times, made)
         atomic_write_text(staged.path / "carve.json", json.dumps(report, indent=1) + "\n")
         progress("drawing")
         from .plot import draw
@@ -140,7 +141,7 @@ def _write(folder: Path, cell: Cell, part: PartMesh, plan: CutPlan, carved) -> d
 
 
 def _report(cell: Cell, part: PartMesh, plan: CutPlan, carved, base, query: MeshQuery,
-            times: dict[str, float]) -> dict[str, Any]:  # fmt: skip
+            times: dict[str, float], made: Carved | None = None) -> dict[str, Any]:  # fmt: skip
     from ..wirecut import signed_volume
 
     vp = part.volume
@@ -186,7 +187,8 @@ def _report(cell: Cell, part: PartMesh, plan: CutPlan, carved, base, query: Mesh
             "carved_volume_l": round(vb * 1e3, 5), "excess": round(vb / vp - 1.0, 5),
             "rough_excess_voxel": round(plan.kept_voxel / vp - 1.0, 5),
             "baseline_excess_voxel": round(plan.baseline_kept_voxel / vp - 1.0, 5)},
-        "notes": list(plan.notes),
+        "carved": None if made is None else made.as_dict(),
+        "notes": list(plan.notes) + ([made.note()] if made is not None and made.note() else []),
         "checks": checks,
         "ok": all(c["ok"] for c in checks),
         "timings_s": {k: round(v, 3) for k, v in times.items()},
