@@ -16,6 +16,26 @@ settings.register_profile(
 settings.register_profile("dev", max_examples=100, deadline=None)
 settings.load_profile("ci" if os.environ.get("CI") else "dev")
 
+#: tests that run real-time servers (500 Hz streams, a controller's clock, timed faults):
+#: marked ``realtime`` so that ``make test`` runs them apart from the parallel rest, one at
+#: a time, where they do not compete with other tests for the two cores
+REALTIME_DIRS = ("tests/export/", "tests/ursim/")
+REALTIME_TESTS = frozenset({"tests/cli/test_cli.py::test_run_streams_to_the_embedded_emulator"})
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    config.addinivalue_line(
+        "markers", "realtime: runs real-time servers; make test runs these after the others, "
+        "not in parallel (tests/conftest.py)")  # fmt: skip
+
+
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+    """Mark the real-time tests (:data:`REALTIME_DIRS`, :data:`REALTIME_TESTS`)."""
+    for item in items:
+        nodeid = item.nodeid.replace("\\", "/")
+        if nodeid.startswith(REALTIME_DIRS) or nodeid.split("[")[0] in REALTIME_TESTS:
+            item.add_marker(pytest.mark.realtime)
+
 
 def random_rotations(rng: np.random.Generator, n: int) -> np.ndarray:
     """Uniform random rotation matrices (n, 3, 3)."""
