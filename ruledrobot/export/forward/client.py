@@ -109,6 +109,9 @@ def _play(s: Session, conn: socket.socket, q_grid: np.ndarray, hot: np.ndarray |
                               anchored=playing >= 0)
             s.service()
         except Stop as st:
+            if st.status == "program_stopped" and int(r.getOutputIntRegister(REG_STATE)) in (
+                    State.DONE, State.DRY, State.STOPPED, State.FAILED):
+                break  # it ended between the two reads (found: a completed run said stopped)
             stop = st
             with contextlib.suppress(OSError):
                 conn.sendall(stop_message())
