@@ -11,7 +11,6 @@ closed mesh that holds the part.
 
 from __future__ import annotations
 
-import json
 import os
 import time
 from dataclasses import dataclass, field
@@ -20,7 +19,7 @@ from typing import Any
 
 import numpy as np
 
-from ..io.atomic import atomic_write_text
+from ..io.atomic import atomic_write_json
 from ..io.mesh import write_stl
 from ..io.outdir import StagedFolder
 from .carved import Carved, carve_block
@@ -114,13 +113,13 @@ def carve(cell_path: str | os.PathLike[str], out: str | os.PathLike[str],
         t = time.perf_counter()
         files = _write(staged.path, cell, part, plan, carved)
         report = _report(cell, part, plan, carved, base, query, times, made)
-        atomic_write_text(staged.path / "carve.json", json.dumps(report, indent=1) + "\n")
+        atomic_write_json(staged.path / "carve.json", report)
         progress("drawing")
         from .plot import draw
 
         draw(staged.path / "carve.png", part, plan, carved, cell.stock, report)
         report["timings_s"]["write"] = round(time.perf_counter() - t, 3)
-        atomic_write_text(staged.path / "carve.json", json.dumps(report, indent=1) + "\n")
+        atomic_write_json(staged.path / "carve.json", report)
         target = staged.commit({"command": "carve", "cell": str(cell.source)})
     files = {k: target / v.relative_to(staged.path) for k, v in files.items()}
     files["report"], files["picture"] = target / "carve.json", target / "carve.png"
