@@ -33,10 +33,11 @@ from .cut.wire_pose import SearchOptions
 from .job.spec import Job
 from .motion.assemble import Motion, assemble_motion
 from .motion.densify import target_frames
+from .motion.transit import TransitFailure, TransitNotFound
 
 __all__ = [
-    "SINGULARITY_MARGIN", "Plan", "PlannedMeasures", "SearchOptions", "make_plan", "wire_cut",
-    "wire_deviation",
+    "SINGULARITY_MARGIN", "Plan", "PlannedMeasures", "SearchOptions", "make_plan",
+    "transit_between", "wire_cut", "wire_deviation",
 ]
 
 #: the verdict's singularity threshold: the wire-pose search's own (one home)
@@ -60,7 +61,8 @@ class PlannedMeasures:
 @dataclass(frozen=True, eq=False)
 class Plan:
     """A planned job.  ``motion``/``trajectory``/``measured`` are None when some pass has
-    no feasible wire motion (``reasons`` say why)."""
+    no feasible wire motion (``reasons`` say why) or a transit between passes has no
+    clear route (``transit_failures`` say which, and what is in the way)."""
 
     job: Job
     model: RobotModel = field(repr=False)  # flange, no tool, the job's base
@@ -77,10 +79,14 @@ class Plan:
     source_bytes: bytes | None = field(default=None, repr=False)
     #: ``{"path", "sha256"}`` of the job file (:func:`job_reference`), hashed once
     job_ref: dict[str, str] | None = field(default=None, repr=False)
+    #: the transits no clear route was found for (the plan has no motion then: no move
+    #: through the stock, the table or the arm is kept), ``what`` naming the passes
+    transit_failures: tuple[TransitFailure, ...] = ()
 
     @property
     def reachable(self) -> bool:
-        """Every pass has a feasible wire motion (``motion`` is not None)."""
+        """Every pass has a feasible wire motion and every transit a clear route
+        (``motion`` is not None)."""
         return self.motion is not None
 
 
@@ -171,6 +177,52 @@ def _bow_outside_cuts(
     return tuple(collisions), tuple(sentences)
 
 
+def _pass_name(passes: list[CutPath], k: int) -> str:
+    """Pass ``k`` in words: ``'side'``, or ``'plug' (pass 2 of 2)`` of a cut in passes."""
+    same = [i for i, cp in enumerate(passes) if cp.name == passes[k].name]
+    name = f"'{passes[k].name}'"
+    return name if len(same) == 1 else f"{name} (pass {same.index(k) + 1} of {len(same)})"
+
+
+def transit_between(job: Job, passes: list[CutPath], failure: TransitFailure) -> str:
+    """The passes a failed transit connects, in words: ``"from 'top' to 'side'"``.
+
+    The assembly names a transit by one pass (``to X``, ``into X``: from the last pass,
+    or home, to X's entry pose and from it into X; ``from X``: out of X to its exit pose;
+    ``home``: back home); the pass is the one of that name whose first (last) joints lie
+    nearest the transit's goal (start): a cut of several passes has one name."""
+    what = failure.what
+    verb, _, name = what.partition(" ")
+    start = job.robot.home is not None
+
+    def nearest(q: tuple[float, ...], end: int) -> int:
+        ks = [k for k, cp in enumerate(passes) if cp.name == name]
+        if not ks or not q:
+            return ks[0] if ks else -1
+        return min(ks, key=lambda k: float(np.abs(passes[k].motion.q[end] - q).max()))
+
+    if verb in ("to", "into"):
+        k = nearest(failure.qb, 0)
+        if k < 0:
+            return what
+        if k == 0 and not start:  # the motion starts at the first pass's entry pose
+            return f"into {_pass_name(passes, k)} from its entry pose"
+        before = _pass_name(passes, k - 1) if k > 0 else "home"
+        how = " (the move from its entry pose into the pass)" if verb == "into" else ""
+        return f"from {before} to {_pass_name(passes, k)}{how}"
+    if verb == "from":
+        k = nearest(failure.qa, -1)
+        if k < 0:
+            return what
+        after = (_pass_name(passes, k + 1) if k + 1 < len(passes)
+                 else "home" if start else "the end")  # fmt: skip
+        how = " (the move out of the pass to its exit pose)"
+        return f"from {_pass_name(passes, k)} to {after}{how}"
+    if what == "home" and passes:
+        return f"from {_pass_name(passes, len(passes) - 1)} to home"
+    return what
+
+
 def _heat(job: Job, motion: Motion) -> Heat | None:
     h = job.tool.heat
     if h is None:
@@ -214,7 +266,14 @@ def make_plan(
                     bow, data, ref)  # fmt: skip
     say("timing the cut")
     t1 = time.perf_counter()
-    motion = assemble_motion(job, model, passes, cell)
+    try:
+        motion = assemble_motion(job, model, passes, cell)
+    except TransitNotFound as exc:  # no move through stock, table or arm is kept
+        timings["timing_s"] = time.perf_counter() - t1
+        failure = dataclasses.replace(exc.failure,
+                                      what=transit_between(job, passes, exc.failure))
+        return Plan(job, model, tuple(passes), None, None, None, reasons, notes, timings,
+                    bow, data, ref, (failure,))  # fmt: skip
     passes = list(motion.passes)
     timings["timing_s"] = time.perf_counter() - t1
     say("measuring the planned motion")

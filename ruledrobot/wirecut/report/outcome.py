@@ -16,7 +16,7 @@ from ..motion.feed_limit import feed_limit_reason
 from ..plan import SINGULARITY_MARGIN, Plan, job_reference
 from ..reach.explain import reach_reasons
 from ..verify import Verification
-from .verdict import CutMeasurements, Measurements, plan_verdict
+from .verdict import CutMeasurements, Measurements, plan_verdict, transits_check
 
 __all__ = ["REPORT_FORMAT", "plan_outcome"]
 
@@ -101,10 +101,18 @@ def _cut_sections(plan: Plan, ver: Verification | None) -> tuple[list[dict], lis
 
 
 def _unreachable(plan: Plan) -> tuple[dict, Verdict]:
+    """A plan without motion: some pass is infeasible (``reach`` fails), or every pass is
+    feasible and a transit found no clear route (``reach`` holds, ``transits`` fails)."""
     reasons = tuple(plan.reasons) + reach_reasons(plan)  # how far, which rule, where to move
-    verdict = Verdict((Check("reach", "every ruling reachable, clear of stock and table",
-                             "no", "yes", relation="==", ok=False,
-                             detail="; ".join(reasons)),))  # fmt: skip
+    ok = bool(plan.transit_failures) and all(cp.feasible for cp in plan.passes)
+    checks = [Check("reach", "every ruling reachable, clear of stock and table",
+                    "yes" if ok else "no", "yes", relation="==", ok=ok,
+                    detail="" if ok else "; ".join(reasons))]  # fmt: skip
+    if ok:
+        failures = tuple(f.sentence() for f in plan.transit_failures)
+        checks.append(transits_check(failures))
+        reasons += failures
+    verdict = Verdict(tuple(checks))
     cp = plan.passes[0]
     report = {
         "format": REPORT_FORMAT,

@@ -7,6 +7,10 @@ Gating (the plan is feasible only when all hold; ``docs/verdict.md``):
 * ``verified`` — the trajectory was played in MuJoCo;
 * ``collisions`` — no contact between arm, bow, wire (outside the cut), stock and
   table, in MuJoCo and in the planner's own bow model;
+* ``transits`` — every transit between passes (and the approach and retract) found a
+  route clear of the cell's whole collision model (:mod:`..motion.transit`); one that
+  did not is named with the passes it connects and the bodies in the direct move's way,
+  and the plan then has no motion at all (no move through them is kept);
 * ``wire_deviation`` — the simulated wire (from the simulated joints) within
   ``[cut] wire_tolerance`` of the target rulings inside the stock;
   ``planned_wire_deviation`` — the same for the planned joints;
@@ -34,7 +38,8 @@ from ...robot.motion.rates import RATIO_MAX
 from ...robot.verdict import Check, Verdict
 from ...robot.wire.cut import feed_checks
 
-__all__ = ["CutMeasurements", "Measurements", "collision_sentence", "plan_verdict"]
+__all__ = ["CutMeasurements", "Measurements", "collision_sentence", "plan_verdict",
+           "transits_check"]
 
 
 @dataclass(frozen=True)
@@ -77,6 +82,8 @@ class Measurements:
     tracking_error_mm: float | None
     duration_s: float | None
     cuts: tuple[CutMeasurements, ...] = ()
+    #: the transits no clear route was found for, in words (:func:`transits_check`)
+    transits: tuple[str, ...] = ()
 
 
 def _cut_checks(c: CutMeasurements, single: bool) -> list[Check]:
@@ -122,6 +129,14 @@ def _cut_info(c: CutMeasurements, single: bool) -> list[Check]:
     return info
 
 
+def transits_check(failures: tuple[str, ...]) -> Check:
+    """``transits``: how many transits found no route clear of the cell (at most 0); the
+    detail names each, the passes it connects and what is in the way."""
+    return Check("transits", "transits without a clear route (arm, bow, wire, stock, table)",
+                 len(failures), 0, relation="<=", ok=not failures,
+                 detail="\n".join(failures))  # fmt: skip
+
+
 def plan_verdict(m: Measurements, *, singularity_margin: float) -> Verdict:
     """The checks of a plan (see the module doc) from its measurements."""
     single = len(m.cuts) <= 1
@@ -137,6 +152,7 @@ def plan_verdict(m: Measurements, *, singularity_margin: float) -> Verdict:
               None if not m.reach_ok else len(m.collisions), 0, relation="<=",
               ok=m.reach_ok and not m.collisions, detail="\n".join(m.collisions[:8])
               + (f"\nand {len(m.collisions) - 8} more" if len(m.collisions) > 8 else "")),
+        transits_check(m.transits),
         *cut_checks,
         Check.at_most("joint_position", "joint position / limit", m.position_ratio, 1.0,
                       detail="a joint leaves its position range"),

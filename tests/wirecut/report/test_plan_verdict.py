@@ -41,7 +41,7 @@ def _meas(*cuts: CutMeasurements, **kw) -> Measurements:
 
 
 GATING_ONE_CUT = [
-    "reach", "verified", "collisions", "wire_deviation", "planned_wire_deviation",
+    "reach", "verified", "collisions", "transits", "wire_deviation", "planned_wire_deviation",
     "feed_max", "feed_min", "kept_surface", "joint_position", "joint_speed",
     "joint_acceleration", "joint_torque", "singularity",
 ]  # fmt: skip
@@ -80,6 +80,7 @@ def test_an_uncompensated_cut_has_no_kept_surface_check():
         ("singularity", dict(singularity_min=0.019)),
         ("verified", dict(simulated=False)),
         ("collisions", dict(collisions=("link6 hits the stock",))),
+        ("transits", dict(transits=("transit from 'top' to 'side': ... arm hits the stock",))),
     ],
 )
 def test_each_check_fails_alone(check, meas):

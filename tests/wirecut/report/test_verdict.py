@@ -23,18 +23,28 @@ from ruledrobot.wirecut.job.load import load_job
 runner = CliRunner()
 
 #: The demo cut with a home pose that puts the UR5e's arm through the table: the
-#: approach from home and the retract to it cannot be made clear (the planner says so and
-#: keeps the direct moves) — MuJoCo names what hits what, and in which phase.
+#: approach from home and the retract to it cannot be made clear.  The planner fails such
+#: a plan itself (its ``transits`` check, tests/wirecut/motion/test_transit_ompl.py); here
+#: its transits are made to keep the direct moves, as it once did, so that MuJoCo's check
+#: names what hits what, and in which phase.
 COLLIDING = DEMO_JOB.replace(
     "speed_scale = 1.0", "speed_scale = 1.0\nhome = [0.0, 0.5, 0.0, 0.0, 1.57, 0.0]"
 )
+
+
+def _direct(self, qa, qb, notes, what):
+    """A transit planner that keeps the direct move, clear or not."""
+    return [] if np.allclose(qa, qb) else [(np.asarray(qa, float), np.asarray(qb, float))]
 
 
 def _text(result) -> str:
     return " ".join(result.output.split())
 
 
-def test_a_colliding_cut_fails_with_collisions_in_words(tmp_path):
+def test_a_colliding_cut_fails_with_collisions_in_words(tmp_path, monkeypatch):
+    from ruledrobot.wirecut.motion.transit import TransitPlanner
+
+    monkeypatch.setattr(TransitPlanner, "route", _direct)
     job = tmp_path / "job.toml"
     job.write_text(COLLIDING)
     out = tmp_path / "out"
