@@ -266,3 +266,24 @@ def test_ur_control_loop_example_follows_setpoints_from_registers() -> None:
         ctrl.tick()
     assert ctrl.runtime_state == 1  # two moves made: the program ended
     assert _errors(ctrl) == []
+
+
+def test_pose_sub_then_pose_add_gives_the_pose_back() -> None:
+    """UR's manual: pose_add multiplies the rotations p_1.R * p_2.R, pose_sub takes
+    p_to.R * inv(p_from.R): adding back what was subtracted gives the pose."""
+    ctrl = _run(
+        "def prog():\n"
+        "  a = p[0.1, -0.2, 0.3, 0.4, -1.1, 0.7]\n"
+        "  b = p[-0.3, 0.2, 0.5, 1.2, 0.3, -0.5]\n"
+        "  c = pose_add(pose_sub(a, b), b)\n"
+        "  d = 0\n"
+        "  i = 0\n"
+        "  while i < 6:\n"
+        "    d = d + norm(c[i] - a[i])\n"
+        "    i = i + 1\n"
+        "  end\n"
+        "  write_output_float_register(0, d)\n"
+        "end\n"
+    )
+    assert _errors(ctrl) == []
+    assert ctrl.values["output_double_register_0"] < 1e-12

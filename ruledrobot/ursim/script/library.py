@@ -351,13 +351,12 @@ class Library:
     def pose_add(p1: list, p2: list) -> PoseValue:
         """``pose_add(p_1, p_2)``: positions added [m], rotations multiplied (a pose).
 
-        UR's manual: ``p_3.P = p_1.P + p_2.P``, ``p_3.R = p_1.R * p_2.R``.  The emulator computes
-        the rotation matrix ``R(p_2) R(p_1)``: the manual's order only when the rotations commute
-        (about one axis).
+        UR's manual: ``p_3.P = p_1.P + p_2.P``, ``p_3.R = p_1.R * p_2.R`` (so that
+        ``pose_add(pose_sub(a, b), b)`` is ``a``; tested).
         """
         a, b = _matrix(p1, "pose_add"), _matrix(p2, "pose_add")
         T = np.eye(4)
-        T[:3, :3] = b[:3, :3] @ a[:3, :3]
+        T[:3, :3] = a[:3, :3] @ b[:3, :3]
         T[:3, 3] = a[:3, 3] + b[:3, 3]
         return _pose(se3.ur_vector_from_pose(T))
 
