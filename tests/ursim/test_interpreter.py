@@ -287,3 +287,25 @@ def test_pose_sub_then_pose_add_gives_the_pose_back() -> None:
     )
     assert _errors(ctrl) == []
     assert ctrl.values["output_double_register_0"] < 1e-12
+
+
+def test_a_paused_move_resumes_to_its_target_on_play() -> None:
+    """Found in review: after the dashboard's pause (the arm brakes) and play, the program
+    took the braked move for done; a controller resumes the interrupted move."""
+    ctrl = Controller(MODEL)
+    target = (np.array(DEFAULT_Q) + 0.3).tolist()
+    assert ctrl.load_script(f"def p():\n  movej({target}, a=1, v=0.5)\n  textmsg(\"there\")\nend\n")
+    for _ in range(200):
+        ctrl.tick()
+    assert ctrl.pause_program()
+    for _ in range(400):
+        ctrl.tick()
+    stopped = ctrl.backend.state().q.copy()
+    assert np.abs(stopped - target).max() > 0.05  # braked on the way
+    assert ctrl.play()
+    for _ in range(3000):
+        ctrl.tick()
+        if ctrl.runner is None:
+            break
+    np.testing.assert_allclose(ctrl.backend.state().q, target, atol=1e-6)
+    assert "there" in _messages(ctrl)

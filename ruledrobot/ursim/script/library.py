@@ -166,22 +166,30 @@ class Library:
             yield
 
     def flush(self) -> Gen:
-        """Start the pending (blended) moves as one path and wait until it ends."""
+        """Start the pending (blended) moves as one path and wait until it ends.
+
+        A path a pause braked (dashboard ``pause``, then ``play``) is resumed as the
+        controller resumes an interrupted move: from where the arm stopped to the path's
+        last target (its intermediate blend waypoints are not revisited)."""
         if not self.pending:
             return
         moves, self.pending = self.pending, []
-        q = self.c.arm_state().target_q.copy()
-        q0 = q.copy()
-        segs = []
-        for kind, target, pose, v, acc, r in moves:
-            seg = move_segment(self.c.kin, q, kind, target, pose, v, acc, r,
-                               f"{kind}: pose p{target.tolist()} out of reach")  # fmt: skip
-            segs.append(seg)
-            q = seg.q_end
-        motion = PathMotion(q0, segs)
-        self.c.start_motion(motion)
-        while self.c.motion is motion:
-            yield
+        while moves:
+            q = self.c.arm_state().target_q.copy()
+            q0 = q.copy()
+            segs = []
+            for kind, target, pose, v, acc, r in moves:
+                seg = move_segment(self.c.kin, q, kind, target, pose, v, acc, r,
+                                   f"{kind}: pose p{target.tolist()} out of reach")  # fmt: skip
+                segs.append(seg)
+                q = seg.q_end
+            motion = PathMotion(q0, segs)
+            self.c.start_motion(motion)
+            while self.c.motion is motion:
+                yield
+            # braked by a pause before its end: the last move again from where it stopped
+            reached = np.abs(self.c.arm_state().target_q - q).max() < 1e-9
+            moves = [] if reached or self.c.motion is not None else [(*moves[-1][:5], 0.0)]
 
     # ------------------------------------------------------------ math and lists
     sin, cos, tan = staticmethod(math.sin), staticmethod(math.cos), staticmethod(math.tan)
