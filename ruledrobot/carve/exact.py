@@ -31,12 +31,16 @@ from .model import CarveCut
 from .quadric import Fit
 from .segment import Region
 
-__all__ = ["MAX_GAP", "SPACING", "block_face", "exact_cut"]
+__all__ = ["KEEP_DEPTHS", "MAX_GAP", "SPACING", "block_face", "exact_cut", "keep_point"]
 
 SPACING = 0.008
 MAX_GAP = np.radians(60.0)
 #: transversal steps tried past the block on each side of an open cut
 MAX_STEPS = 400
+#: depths [m] behind an open cut's face tried for its kept point, in this order, below
+#: the centroids of the face's KEEP_TRIANGLES largest triangles
+KEEP_DEPTHS = (0.002, 0.005, 0.01, 0.02, 0.0005)
+KEEP_TRIANGLES = 8
 
 
 def block_face(fit: Fit, stock: Box, tolerance: float) -> bool:
@@ -124,6 +128,30 @@ def _open(fit: Fit, region: Region, stock: Box, d0: FloatArray, p0: FloatArray,
     return np.asarray([pts[k] for k in ks]), np.asarray([dirs_at[k] for k in ks])
 
 
+def keep_point(region: Region, query: MeshQuery, stock: Box) -> FloatArray | None:
+    """A point (3,) [m] of the part in the block just behind the region's face: the
+    centroid of one of its largest triangles, :data:`KEEP_DEPTHS` in along the
+    triangle's inward normal (the first inside the part, by ray parity, and at least half
+    that depth from its surface); None when there is none.  A triangle's centroid, not a
+    vertex: a vertex lies on the face's rim, and a point below it on the neighbouring face
+    (a cap fanned from a rim vertex) is on the surface, neither inside nor outside."""
+    tri = query.mesh.triangles[region.faces]
+    n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    area = np.linalg.norm(n, axis=1)
+    c = tri.mean(axis=1)
+    # the largest triangles first; equal ones in coordinate order (not the file's order)
+    r = np.round(c, 7)
+    order = np.lexsort((r[:, 2], r[:, 1], r[:, 0], -np.round(area / area.max(), 6)))
+    pick = order[:KEEP_TRIANGLES]
+    n = n[pick] / np.maximum(area[pick], 1e-300)[:, None]
+    depth = np.asarray(KEEP_DEPTHS)
+    cand = (c[pick][None] - depth[:, None, None] * n[None]).reshape(-1, 3)  # depth-major
+    ok = query.inside(cand) & stock.contains(cand)
+    if ok.any():
+        ok[ok] = query.distance(cand[ok]) >= 0.5 * np.repeat(depth, len(pick))[ok]
+    return cand[int(np.argmax(ok))] if ok.any() else None
+
+
 def exact_cut(fit: Fit, region: Region, stock: Box, query: MeshQuery, prefer: FloatArray,
               name: str, lead: float = 0.02) -> CarveCut | str:  # fmt: skip
     """The cut of a ruled region (module doc), or why there is none (a note)."""
@@ -170,11 +198,8 @@ def exact_cut(fit: Fit, region: Region, stock: Box, query: MeshQuery, prefer: Fl
         pts, D = found
     except ValueError as exc:
         return f"{what}: {exc}"
-    for depth in (0.002, 0.005, 0.01, 0.02, 0.0005):
-        keep = p0 - depth * n0
-        if query.inside(keep[None])[0] and stock.contains(keep):
-            break
-    else:
+    keep = keep_point(region, query, stock)
+    if keep is None:
         return f"{what}: no point of the part found behind the face"
     return CarveCut(name, "exact", Lines.from_point_direction(pts, D), False, keep,
                     f"{what}, open", region.index)  # fmt: skip

@@ -2,9 +2,10 @@
 
 :func:`find_cuts` segments the part (:mod:`.segment`), fits every region
 (:mod:`.quadric`), cuts the ruled ones exactly (:mod:`.exact`; faces of the block need
-no cut), and when any face is left — not ruled, too small to fit, or a cut that would
-gouge the part elsewhere — roughs the part by ``rough_cuts`` loops (:mod:`.rough`) and
-the baseline (the visual hull of as many parallel directions) for comparison.  Open
+no cut), and when any face is left — not ruled, not determined by its vertices, or a
+cut that would gouge the part elsewhere — roughs the part by ``rough_cuts`` loops
+(:mod:`.rough`) and the baseline (the visual hull of as many parallel directions) for
+comparison.  Every region is fitted, whatever its number of triangles.  Open
 cuts come first and closed loops last: a loop that keeps its inside frees the part,
 and every later loop needs the piece clamped again (a setup of its own).
 """
@@ -21,10 +22,10 @@ from .exact import block_face, exact_cut
 from .measure import measure_cut
 from .meshquery import MeshQuery
 from .model import CarveCut, CutMeasure
-from .quadric import fit_region
+from .quadric import Fit, fit_region
 from .readers import PartMesh
 from .rough import SEAMS, Loop, choose_loops, loop_lines
-from .segment import MIN_FACES, Region, segment
+from .segment import Region, segment
 
 __all__ = ["CutPlan", "find_cuts", "prefer_direction"]
 
@@ -65,6 +66,17 @@ def radial_direction(stock: Box) -> FloatArray:
     return c / n if n > 1e-6 else np.array([1.0, 0.0, 0.0])
 
 
+def _unfitted(fit: Fit) -> str:
+    """Why a region's fit gives no cut, in words (``carve.json``'s ``faces``)."""
+    if fit.kind == "curved":
+        return "not ruled (a quadric with no lines on it)"
+    if fit.kind == "undetermined":
+        return (f"its vertices and normals do not determine one surface (another quadric "
+                f"holds them within {fit.residual * 1e3:.3g} mm too: a strip too narrow or "
+                "a fold of a few triangles)")  # fmt: skip
+    return f"not a ruled quadric within tolerance ({fit.residual * 1e3:.3g} mm)"
+
+
 def find_cuts(part: PartMesh, stock: Box, query: MeshQuery, tolerance: float,
               rough_cuts: int, lead: float = 0.02,
               progress=lambda msg: None) -> CutPlan:  # fmt: skip
@@ -76,17 +88,12 @@ def find_cuts(part: PartMesh, stock: Box, query: MeshQuery, tolerance: float,
     notes: list[str] = []
     progress(f"fitting {len(regions)} regions")
     for r in regions:
-        if len(r.faces) < MIN_FACES:
-            faces[r.index] = f"too small to fit ({len(r.faces)} triangles)"
-            continue
         fit = fit_region(r, tolerance)
         if fit.kind == "plane" and block_face(fit, stock, tolerance):
             faces[r.index] = "block face"
             continue
         if fit.kind not in ("plane", "ruled"):
-            faces[r.index] = ("not ruled (a quadric with no lines on it)" if fit.kind == "curved"
-                              else f"not a ruled quadric within tolerance "
-                                   f"({fit.residual * 1e3:.3g} mm)")  # fmt: skip
+            faces[r.index] = _unfitted(fit)
             continue
         got = exact_cut(fit, r, stock, query, prefer, f"face{r.index}", lead)
         if isinstance(got, str):

@@ -42,8 +42,9 @@ FLAT = 1e-3
 class Fit:
     """A fitted region: ``kind`` ``"plane"``, ``"ruled"`` (a ruled quadric) or
     ``"curved"`` (a quadric with no real lines: ellipsoid, paraboloid, two-sheet
-    hyperboloid) or ``"free"`` (no quadric within tolerance); ``A`` (3, 3), ``b`` (3,),
-    ``c`` in metres (base frame), ``residual`` [m] the largest distance of a vertex."""
+    hyperboloid), ``"free"`` (no quadric within tolerance) or ``"undetermined"`` (more
+    than one quadric within it: :func:`fit_region`); ``A`` (3, 3), ``b`` (3,), ``c`` in
+    metres (base frame), ``residual`` [m] the largest distance of a vertex."""
 
     kind: str
     A: FloatArray = field(repr=False)
@@ -132,35 +133,77 @@ def _normal_rows(x: FloatArray, y: FloatArray, z: FloatArray, n: FloatArray) -> 
     return np.moveaxis(rows, 2, 1).reshape(-1, 10)
 
 
+def _quadric(q: FloatArray, c0: FloatArray, s: float) -> tuple[FloatArray, FloatArray, float]:
+    """``A`` (3, 3), ``b`` (3,), ``c`` in metres of the monomial coefficients ``q`` (10,)
+    in coordinates ``x' = (x - c0) / s``."""
+    A_ = np.array([[q[0], q[3], q[4]], [q[3], q[1], q[5]], [q[4], q[5], q[2]]])
+    b_ = q[6:9]
+    A = A_ / s**2
+    b = b_ / s - A @ c0
+    return A, b, float(c0 @ A @ c0 - 2.0 * (b_ / s) @ c0 + q[9])
+
+
+def _within(fit: Fit, region: Region, tolerance: float) -> tuple[bool, float]:
+    """Whether ``fit`` holds the region's vertices within ``tolerance`` [m] with its
+    normals agreeing with theirs (98 % within :data:`NORMAL_ANGLE`); the largest
+    distance [m] of a vertex."""
+    P = region.points
+    res = float(fit.distance(P).max())
+    _, g = fit.value_grad(P)
+    g /= np.maximum(np.linalg.norm(g, axis=1), 1e-300)[:, None]
+    agree = np.abs(np.einsum("ij,ij->i", g, region.normals)) >= np.cos(NORMAL_ANGLE)
+    return bool(res <= tolerance and agree.mean() >= 0.98), res
+
+
+def _apart(one: Fit, other: Fit, region: Region) -> float:
+    """How far apart [m] two fits of a region lie over it: the largest difference of
+    their first-order signed distances (each signed along the region's normals) at its
+    vertices and the points between them (``region.between``)."""
+    x = np.concatenate([region.points, region.between])
+    sd = []
+    for fit in (one, other):
+        _, g = fit.value_grad(region.points)
+        sign = 1.0 if np.median(np.einsum("ij,ij->i", g, region.normals)) >= 0.0 else -1.0
+        q, g = fit.value_grad(x)
+        sd.append(sign * q / np.maximum(np.linalg.norm(g, axis=1), 1e-300))
+    return float(np.abs(sd[0] - sd[1]).max())
+
+
 def fit_region(region: Region, tolerance: float) -> Fit:
-    """The plane or quadric of a region within ``tolerance`` [m] (module doc)."""
+    """The plane or quadric of a region within ``tolerance`` [m] (module doc).
+
+    Whatever its number of triangles: a plane is accepted by its residual alone (a
+    face of two triangles is as much a plane as one of two hundred; every cut is then
+    measured against the whole part, :mod:`.measure`).  A quadric must also be
+    determined by the region where it matters, on the face: when the next best fit
+    (the second smallest singular vector, independent of the best) holds the vertices
+    and normals within the tolerance too, the two must not lie farther apart than the
+    tolerance anywhere on the region's triangles (vertices, edge midpoints,
+    centroids) — else the region (a fold of a few triangles) says too little to choose
+    a surface between its vertices, and the fit is ``"undetermined"`` (``residual``:
+    how far apart the two lie).  A narrow arc of a cylinder is determined there,
+    though its continuation beyond the face is not: that is measured (no gouge)."""
     n, d, res = _plane(region)
     if res <= tolerance:
         return Fit("plane", np.zeros((3, 3)), -0.5 * n, d, res)
     P = region.points
-    if len(P) < 12:
-        return Fit("free", np.zeros((3, 3)), np.zeros(3), 0.0, np.inf)
     c0 = P.mean(axis=0)
     s = float(np.sqrt(((P - c0) ** 2).sum(axis=1).mean()))
     x, y, z = ((P - c0) / s).T
     D = np.stack([x * x, y * y, z * z, 2 * x * y, 2 * x * z, 2 * y * z,
                   2 * x, 2 * y, 2 * z, np.ones_like(x)], axis=1)  # fmt: skip
-    q = np.linalg.svd(np.vstack([D, NORMAL_WEIGHT * _normal_rows(x, y, z, region.normals)]),
-                      full_matrices=False)[2][-1]  # fmt: skip
-    A_ = np.array([[q[0], q[3], q[4]], [q[3], q[1], q[5]], [q[4], q[5], q[2]]])
-    b_ = q[6:9]
-    # back to metres: x' = (x - c0) / s
-    A = A_ / s**2
-    b = b_ / s - A @ c0
-    c = float(c0 @ A @ c0 - 2.0 * (b_ / s) @ c0 + q[9])
+    vt = np.linalg.svd(np.vstack([D, NORMAL_WEIGHT * _normal_rows(x, y, z, region.normals)]),
+                       full_matrices=False)[2]  # fmt: skip
+    A, b, c = _quadric(vt[-1], c0, s)
     fit = Fit("ruled", A, b, c, 0.0)
-    dist = fit.distance(P)
-    _, g = fit.value_grad(P)
-    g /= np.maximum(np.linalg.norm(g, axis=1), 1e-300)[:, None]
-    agree = np.abs(np.einsum("ij,ij->i", g, region.normals)) >= np.cos(NORMAL_ANGLE)
-    res = float(dist.max())
-    if res > tolerance or agree.mean() < 0.98:
+    ok, res = _within(fit, region, tolerance)
+    if not ok:
         return Fit("free", A, b, c, res)
+    other = Fit("ruled", *_quadric(vt[-2], c0, s), 0.0)
+    if _within(other, region, tolerance)[0]:
+        gap = _apart(fit, other, region)
+        if gap > tolerance:
+            return Fit("undetermined", A, b, c, gap)
     ruled = [np.all(np.isfinite(fit.line_directions(p, nn)))
              for p, nn in zip(P[:: max(1, len(P) // 64)], region.normals[:: max(1, len(P) // 64)],
                               strict=True)]  # fmt: skip

@@ -3,8 +3,8 @@
 Two triangles sharing an edge are in one region when their normals differ by less
 than ``sharp`` (radians, default 25 degrees): a column's side is one region, its caps two
 more, a saddle-topped block six.  Each region is then fitted on its own
-(:mod:`.quadric`); a region too small to fit (fewer than ``MIN_FACES`` triangles) is
-left to the roughing cuts.
+(:mod:`.quadric`), whatever its number of triangles (a box exported as 12 triangles is
+six regions of two, six planes).
 """
 
 from __future__ import annotations
@@ -16,9 +16,8 @@ import numpy as np
 from ..geometry.checks import FloatArray
 from .readers import PartMesh
 
-__all__ = ["MIN_FACES", "Region", "face_normals", "segment"]
+__all__ = ["Region", "face_normals", "segment"]
 
-MIN_FACES = 12
 SHARP = np.radians(25.0)
 
 
@@ -26,13 +25,17 @@ SHARP = np.radians(25.0)
 class Region:
     """One smooth piece of the part's surface: ``faces`` (K,) indices into the mesh's
     faces, ``points`` (P, 3) its vertices [m, base frame], ``normals`` (P, 3) their
-    outward unit normals (area-weighted over the region's faces), ``area`` [m^2]."""
+    outward unit normals (area-weighted over the region's faces), ``area`` [m^2],
+    ``between`` (S, 3) its triangles' edge midpoints and centroids [m]."""
 
     index: int
     faces: np.ndarray = field(repr=False)
     points: FloatArray = field(repr=False)
     normals: FloatArray = field(repr=False)
     area: float
+    #: (S, 3) points on its triangles between the vertices: edge midpoints and centroids
+    #: [m] (where a fit through the vertices alone is not pinned, :mod:`.quadric`)
+    between: FloatArray = field(default_factory=lambda: np.zeros((0, 3)), repr=False)
 
     @property
     def centroid(self) -> FloatArray:
@@ -73,6 +76,9 @@ def segment(mesh: PartMesh, sharp: float = SHARP) -> list[Region]:
         vn = np.zeros((len(verts), 3))
         np.add.at(vn, inv, np.repeat(normals[faces] * areas[faces, None], 3, axis=0))
         vn /= np.maximum(np.linalg.norm(vn, axis=1), 1e-300)[:, None]
+        t = mesh.vertices[f[faces]]
+        between = np.concatenate([0.5 * (t + np.roll(t, -1, axis=1)).reshape(-1, 3),
+                                  t.mean(axis=1)])  # fmt: skip
         regions.append(Region(len(regions), faces, mesh.vertices[verts], vn,
-                              float(areas[faces].sum())))  # fmt: skip
+                              float(areas[faces].sum()), between))  # fmt: skip
     return regions

@@ -68,8 +68,10 @@ def print_carve(report: dict[str, Any]) -> None:
         whole.add_row(f"visual hull, {len(b['directions'])} parallel directions",
                       f"{b['carved_volume_l']:.4f}", f"{100 * b['excess']:.2f}", "")  # fmt: skip
     console.print(whole)
+    reasons = print_faces(report["part"].get("faces", {}))
     for note in report["notes"]:
-        console.print(f"note: {note}", highlight=False, markup=False)
+        if note not in reasons:  # a face's reason is printed with the faces
+            console.print(f"note: {note}", highlight=False, markup=False)
     for c in report["checks"]:
         if not c["ok"]:
             value = f" ({c['value_mm']} mm, limit {c['limit_mm']} mm)" if "value_mm" in c else ""
@@ -80,3 +82,34 @@ def print_carve(report: dict[str, Any]) -> None:
     console.print(Text(f"verdict: {'PASS' if ok else 'FAIL'} — "
                        + ("every check holds" if ok else "failed: " + ", ".join(failed)),
                        style="bold green" if ok else "bold red"), highlight=False)  # fmt: skip
+
+
+#: faces left to roughing listed by name (the rest counted; all in carve.json)
+FACES_LISTED = 8
+
+
+def print_faces(faces: dict[str, str]) -> set[str]:
+    """One line of what became of the part's faces (regions) and, for each face left to
+    the roughing loops, why (at most :data:`FACES_LISTED`); the reasons printed."""
+    from ..io.words import counted
+
+    kinds = {"exact": 0, "block face": 0}
+    left: list[tuple[str, str]] = []
+    for k, v in faces.items():
+        if v in kinds:
+            kinds[v] += 1
+        else:
+            left.append((k, v))
+    line = f"faces: {kinds['exact']} cut exactly"
+    if kinds["block face"]:
+        line += f", {counted(kinds['block face'], 'face')} of the block"
+    if left:
+        line += f", {len(left)} left to the roughing loops:"
+    console.print(line, highlight=False, markup=False)
+    for k, v in left[:FACES_LISTED]:
+        text = v if v.startswith(f"region {k}:") else f"region {k}: {v}"
+        console.print(f"  {text}", highlight=False, markup=False)
+    if len(left) > FACES_LISTED:
+        console.print(f"  and {len(left) - FACES_LISTED} more (carve.json, part.faces)",
+                      highlight=False, markup=False)  # fmt: skip
+    return {v for _, v in left}

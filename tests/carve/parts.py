@@ -104,3 +104,49 @@ def write_obj(path, v, f, scale=1.0):
     text += "".join(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in f)
     path.write_text(text)
     return path
+
+
+def box(size=(0.12, 0.1, 0.08), n=1):
+    """The box ``|x_k| <= size_k / 2``, each face an ``n`` x ``n`` grid of squares split
+    in two: ``12 n^2`` triangles (n = 1: the 12 of a CAD export, n = 4: 192)."""
+    h = 0.5 * np.asarray(size)
+    faces = []
+    for axis in range(3):
+        u, v = [k for k in range(3) if k != axis]
+        A, B = np.meshgrid(np.linspace(-h[u], h[u], n + 1), np.linspace(-h[v], h[v], n + 1),
+                           indexing="ij")  # fmt: skip
+        for sign in (-1.0, 1.0):
+            P = np.zeros((*A.shape, 3))
+            P[..., u], P[..., v], P[..., axis] = A, B, sign * h[axis]
+            faces.append(_grid(P))
+    v, f = _weld(np.concatenate(faces))
+
+    def inside(x):
+        return np.all(np.abs(x) < h, axis=1)
+
+    return v, f, inside
+
+
+def prism(radius=0.05, half=0.07, sides=6, rings=2, turn=0.3):
+    """A right prism on the regular ``sides``-gon of circumradius ``radius`` along z,
+    ``|z| <= half``, its side in ``rings - 1`` bands, each end cap fanned from one rim
+    vertex as CAD triangulates a planar face (``sides - 2`` triangles, long slivers
+    for many sides); the first vertex at the angle ``turn`` [rad] from x."""
+    u = np.linspace(0, 2 * np.pi, sides, endpoint=False) + turn
+    z = np.linspace(-half, half, rings)
+    P = np.stack([np.broadcast_to(radius * np.cos(u)[:, None], (sides, rings)),
+                  np.broadcast_to(radius * np.sin(u)[:, None], (sides, rings)),
+                  np.broadcast_to(z, (sides, rings))], -1)  # fmt: skip
+    caps = []
+    for k in (0, -1):
+        ring = P[:, k]
+        caps.append(np.stack([np.broadcast_to(ring[0], ring[1:-1].shape), ring[1:-1], ring[2:]],
+                             axis=1))  # fmt: skip
+    v, f = _weld(np.concatenate([_grid(P, closed_u=True), *caps]))
+    normals = np.stack([np.cos(u + np.pi / sides), np.sin(u + np.pi / sides)], 1)
+    apothem = radius * np.cos(np.pi / sides)
+
+    def inside(x):
+        return (np.all(x[:, :2] @ normals.T < apothem, axis=1)) & (np.abs(x[:, 2]) < half)
+
+    return v, f, inside
