@@ -12,8 +12,31 @@ app = typer.Typer(
     add_completion=False,
     pretty_exceptions_enable=False,
 )
-console = Console(stderr=False, soft_wrap=True)
-err = Console(stderr=True, soft_wrap=True)
+#: columns when the output is not a terminal (a log, a pipe, CI) and COLUMNS is not set:
+#: rich's default of 80 folded a check table's rows into 4-5 lines each (issue 34)
+PLAIN_WIDTH = 100
+
+
+def _width(stream: object) -> int | None:
+    import os
+
+    isatty = getattr(stream, "isatty", None)
+    if "COLUMNS" in os.environ or (isatty is not None and isatty()):
+        return None  # rich's own: the terminal's width, or COLUMNS
+    return PLAIN_WIDTH
+
+
+console = Console(stderr=False, soft_wrap=True, width=_width(__import__("sys").stdout))
+err = Console(stderr=True, soft_wrap=True, width=_width(__import__("sys").stderr))
+
+
+def literal(text: str) -> str:
+    """Help text shown as written: typer renders help as rich markup, where ``[part]``,
+    ``[m]`` or ``[default: ...]`` is a style tag and vanishes ("... and the , , , of a
+    job"); square brackets that would read as tags are escaped."""
+    from rich.markup import escape
+
+    return escape(text)
 
 
 def fail(message: str) -> typer.Exit:
@@ -30,8 +53,11 @@ def print_verdict(verdict, title: str) -> None:
     from rich.text import Text
 
     table = Table(title=title, title_justify="left", show_edge=False, pad_edge=False)
-    for col in ("check", "value", "limit", "ok"):
-        table.add_column(col, justify="right" if col in ("value", "limit") else "left")
+    # the label folds when the screen is narrow; value, limit and ok never do
+    table.add_column("check", justify="left", overflow="fold", ratio=1)
+    for col in ("value", "limit"):
+        table.add_column(col, justify="right", no_wrap=True)
+    table.add_column("ok", justify="left", no_wrap=True)
     for c in verdict.checks:
         mark = (Text("ok", style="green") if c.ok else Text("FAIL", style="bold red")) \
             if c.gating else Text("info", style="dim")
