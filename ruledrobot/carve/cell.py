@@ -10,6 +10,8 @@ A cell file is a job file (docs/wirecut.md) with a ``[part]`` table instead of c
                                  # (UR pose vector: metres, rotation vector in radians)
     tolerance = 0.0005           # m: how far an exact cut may lie from the part's surface
     rough_cuts = 4               # roughing loops where the surface is not ruled (0: none)
+    repair = false               # true: merge vertices within tolerance / 100 and turn
+                                 # facets to agree with their neighbours (noted)
 
     [stock]   ...                # as in a job: the block
     [robot]   ...
@@ -49,20 +51,22 @@ __all__ = ["MESH_SUFFIXES", "Cell", "PartSpec", "load_cell", "parse_cell"]
 
 #: the part files read (:mod:`.readers`)
 MESH_SUFFIXES = (".stl", ".obj", ".ply", ".3dm")
-_PART_FIELDS = ("file", "units", "pose", "tolerance", "rough_cuts")
+_PART_FIELDS = ("file", "units", "pose", "tolerance", "rough_cuts", "repair")
 _SECTIONS = ("part", "stock", "robot", "tool", "cut")
 
 
 @dataclass(frozen=True)
 class PartSpec:
     """The ``[part]`` table: ``file`` (resolved), ``units`` (m, cm, mm, in), ``pose``
-    (4, 4) the part frame in the robot base frame, ``tolerance`` [m], ``rough_cuts``."""
+    (4, 4) the part frame in the robot base frame, ``tolerance`` [m], ``rough_cuts``,
+    ``repair`` (mend the mesh as CAD exported it: :mod:`.repair`)."""
 
     file: Path
     units: str
     pose: FloatArray = field(repr=False)
     tolerance: float = 0.0005
     rough_cuts: int = 4
+    repair: bool = False
 
     @property
     def scale(self) -> float:
@@ -134,9 +138,12 @@ def _part(raw: object, where: str, base_dir: Path | None) -> PartSpec:
     if isinstance(rough, bool) or not isinstance(rough, int) or not 0 <= rough <= 12:
         raise _fail(where, "rough_cuts",
                     f"expected an integer 0 <= rough_cuts <= 12, got {rough!r}")  # fmt: skip
+    repair = raw.get("repair", False)
+    if not isinstance(repair, bool):
+        raise _fail(where, "repair", f"expected true or false, got {repair!r}")
     return PartSpec(file=path, units=units, pose=se3.pose_from_ur_vector(pose_raw),
                     tolerance=_number(raw, "tolerance", where, 0.0005, 0.0),
-                    rough_cuts=int(rough))  # fmt: skip
+                    rough_cuts=int(rough), repair=repair)  # fmt: skip
 
 
 def absolute_paths(tables: dict[str, Any], base_dir: Path | None) -> dict[str, Any]:

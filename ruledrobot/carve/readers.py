@@ -8,9 +8,18 @@ from the file's unit to metres and placed by the part's pose in the robot base f
 
 A part must be a closed 2-manifold: every edge in exactly two triangles.  An open mesh
 (edges of one triangle: holes, a surface and not a solid) or a non-manifold one (edges
-of three or more) is refused, naming the file and how many edges of each kind it has;
-so is one whose triangles disagree in orientation (an edge run the same way by both
-its triangles).  Faces are turned outwards when the whole mesh is inside out.
+of three or more) is refused, naming the file, how many edges of each kind it has and
+on which facets (indices, and where); so is one whose triangles disagree in orientation
+(an edge run the same way by both its triangles), naming the facets turned the other
+way.  ``[part] repair = true`` merges vertices within a hundredth of the tolerance and
+turns those facets first (:mod:`.repair`; what it did is noted).  Faces are turned
+outwards when the whole mesh is inside out.
+
+Before any of that the part's size is compared with the block's: a file in metres
+declared in millimetres makes a part a thousand times too small, which used to be
+refused as "the mesh encloses no volume"; now :func:`check_size` names the sizes and the
+unit that fits (``the part is 0.2 mm across in a 200 mm block: did you mean units =
+"m"?``), and the converse for a part far larger than the block.
 """
 
 from __future__ import annotations
@@ -20,21 +29,31 @@ from pathlib import Path
 
 import numpy as np
 
+from ..geometry.box import Box
 from ..geometry.checks import FloatArray
 from ..geometry.mesh import signed_volume
+from ..io.units import UNIT_NAMES, unit_scale
 from .cell import PartSpec
+from .repair import MERGE_FRACTION, defects_message, mesh_defects, repair_mesh
 
-__all__ = ["PartMesh", "edge_counts", "misoriented_edges", "read_part", "read_triangles"]
+__all__ = ["SIZE_RATIO", "PartMesh", "check_size", "edge_counts", "misoriented_edges",
+           "read_part", "read_triangles"]  # fmt: skip
+
+#: a part this many times smaller across than the block, or five times larger, is taken
+#: for a units mistake when another unit makes it fit the block
+SIZE_RATIO = 20.0
 
 
 @dataclass(frozen=True)
 class PartMesh:
     """The part: ``vertices`` (V, 3) [m] in the robot base frame, ``faces`` (F, 3) int64,
-    counter-clockwise seen from outside; ``source`` the file read."""
+    counter-clockwise seen from outside; ``source`` the file read; ``repairs`` what
+    ``[part] repair = true`` did to the mesh, in words (empty: nothing)."""
 
     vertices: FloatArray = field(repr=False)
     faces: np.ndarray = field(repr=False)
     source: Path | None = None
+    repairs: tuple[str, ...] = ()
 
     @property
     def triangles(self) -> FloatArray:
@@ -144,36 +163,58 @@ def read_triangles(path: Path) -> tuple[FloatArray, np.ndarray, str | None]:
     return v, f[good], units
 
 
-def read_part(spec: PartSpec) -> PartMesh:
-    """The part of a cell (:class:`.cell.PartSpec`): read, checked closed and manifold,
-    in metres and in the robot base frame; ValueError naming the file otherwise."""
+def check_size(vertices: FloatArray, spec: PartSpec, stock: Box, where: str) -> None:
+    """ValueError naming the sizes and the unit that fits when the part, ``vertices``
+    (V, 3) in the file's units read as ``spec.units``, is :data:`SIZE_RATIO` times
+    smaller across than the block ``stock``, or five times larger, and another unit
+    makes it fit the block (its sides against the block's, largest to largest)."""
+    ext = np.sort(np.ptp(vertices, axis=0))[::-1]  # file units, largest first
+    block = np.sort(stock.size)[::-1]  # m
+    across, size = float(ext[0]) * spec.scale, float(block[0])
+    if size / SIZE_RATIO <= across <= 5.0 * size:
+        return
+    fits = [u for u in UNIT_NAMES if np.all(ext * unit_scale(u, "units") <= block * (1 + 1e-9))]
+    best = max(fits, key=lambda u: unit_scale(u, "units"), default=None)
+    if best is None or best == spec.units:
+        return
+    if across < size / SIZE_RATIO and ext[0] * unit_scale(best, "units") < size / SIZE_RATIO:
+        return  # small in every unit that fits: a small part, not a mistake
+    def mm(x: float) -> str:
+        return f"{x * 1e3:,.0f}" if x >= 0.1 else f"{x * 1e3:.3g}"
+
+    raise ValueError(f"{where}: [part] units = {spec.units!r}: the part ({spec.file.name}) is "
+                     f"{mm(across)} mm across in a {mm(size)} mm block: did you mean units = "
+                     f"\"{best}\"?")  # fmt: skip
+
+
+def read_part(spec: PartSpec, stock: Box | None = None, where: str = "cell") -> PartMesh:
+    """The part of a cell (:class:`.cell.PartSpec`): read, its size checked against the
+    block's (``stock``, when given: :func:`check_size`; ``where`` names the cell file),
+    repaired when ``spec.repair`` (:mod:`.repair`), checked closed, manifold and
+    consistently oriented, in metres and in the robot base frame; ValueError naming the
+    file and where its mesh fails otherwise."""
     path = spec.file
     v, f, stated = read_triangles(path)
     units = spec.units
     if stated is not None and stated != units:
         raise ValueError(f"{path}: the model's unit system is {stated}, but [part] units = "
                          f"{units!r} (unit mismatch)")  # fmt: skip
-    boundary, nonmanifold = edge_counts(f)
-    if boundary or nonmanifold:
-        what = []
-        if boundary:
-            what.append(f"{boundary} boundary edge(s) (in one triangle only: the mesh is open)")
-        if nonmanifold:
-            what.append(f"{nonmanifold} non-manifold edge(s) (in three or more triangles)")
-        raise ValueError(f"{path}: not a closed 2-manifold mesh: {' and '.join(what)}; "
-                         "expected a closed solid (repair it in CAD: close its "
-                         "holes)")  # fmt: skip
-    wrong = misoriented_edges(f)
-    if wrong:
-        raise ValueError(f"{path}: the triangles' orientations disagree across {wrong} edge(s) "
-                         "(some faces turned inside out); expected every face counter-"
-                         "clockwise seen from outside (repair the normals in CAD)")  # fmt: skip
+    if stock is not None:
+        check_size(v, spec, stock, where)
+    merge = spec.tolerance * MERGE_FRACTION / spec.scale  # file units
+    repairs: list[str] = []
+    if spec.repair:
+        v, f, repairs = repair_mesh(v, f, merge, units)
+    defects = mesh_defects(v, f, merge)
+    if not defects.ok:
+        raise ValueError(f"{path}: {defects_message(defects, v, f, units, merge, spec.repair)}")
     v = v * spec.scale
     v = v @ spec.pose[:3, :3].T + spec.pose[:3, 3]
-    part = PartMesh(v, f, path)
+    part = PartMesh(v, f, path, tuple(repairs))
     vol = part.volume
     if abs(vol) < 1e-12:
-        raise ValueError(f"{path}: the mesh encloses no volume")
+        raise ValueError(f"{path}: the mesh encloses no volume ({vol * 1e9:.3g} mm^3 in "
+                         f"[part] units = {units!r})")  # fmt: skip
     if vol < 0.0:
-        part = PartMesh(v, f[:, ::-1].copy(), path)
+        part = PartMesh(v, f[:, ::-1].copy(), path, tuple(repairs))
     return part

@@ -90,7 +90,7 @@ def carve(cell_path: str | os.PathLike[str], out: str | os.PathLike[str],
     times: dict[str, float] = {}
     t = time.perf_counter()
     cell = load_cell(cell_path)
-    part = read_part(cell.part)
+    part = read_part(cell.part, cell.stock, cell.where)
     check_fits(part, cell)
     staged = StagedFolder(out)  # refuses a folder of the user's own files at once
     times["read"] = time.perf_counter() - t
@@ -157,8 +157,7 @@ def _report(cell: Cell, part: PartMesh, plan: CutPlan, carved, base, query: Mesh
 
         cq = _MQ(_PM(carved.vertices, carved.faces))
         pv = part.vertices[:: max(1, len(part.vertices) // 20000)]
-        outside = ~cq.inside(pv)
-        spread = float(cq.distance(pv[outside]).max()) if outside.any() else 0.0
+        spread = max(0.0, float(cq.signed(pv).max()))  # outside the carved block
     setups = setups_of(plan.cuts) if plan.cuts else []
     setup_of = {c.name: k + 1 for k, g in enumerate(setups) for c in g}
     tol = cell.part.tolerance
@@ -172,6 +171,7 @@ def _report(cell: Cell, part: PartMesh, plan: CutPlan, carved, base, query: Mesh
         "format": FORMAT,
         "cell": str(cell.source),
         "part": {"file": str(part.source), "units": cell.part.units,
+                 "repair": cell.part.repair, "repaired": list(part.repairs),
                  "triangles": len(part.faces), "regions": len(plan.regions),
                  "faces": {str(k): v for k, v in sorted(plan.faces.items())}},
         "cuts": cuts,
@@ -187,7 +187,8 @@ def _report(cell: Cell, part: PartMesh, plan: CutPlan, carved, base, query: Mesh
             "rough_excess_voxel": round(plan.kept_voxel / vp - 1.0, 5),
             "baseline_excess_voxel": round(plan.baseline_kept_voxel / vp - 1.0, 5)},
         "carved": None if made is None else made.as_dict(),
-        "notes": list(plan.notes) + ([made.note()] if made is not None and made.note() else []),
+        "notes": [f"repaired: {r}" for r in part.repairs] + list(plan.notes)
+                 + ([made.note()] if made is not None and made.note() else []),
         "checks": checks,
         "ok": all(c["ok"] for c in checks),
         "timings_s": {k: round(v, 3) for k, v in times.items()},

@@ -7,14 +7,15 @@ from typing import Any
 
 import typer
 
-from ._common import app, console, err, fail
+from ._common import app, console, err, fail, literal
 
 
 @app.command(epilog="Example:  ruledrobot carve cell.toml --out out/carve   then  ruledrobot "
              "plan out/carve/job.toml --out out/carve-plan   (docs/carve.md)")  # fmt: skip
 def carve(
-    cell: Path = typer.Argument(..., help="Cell file (.toml): [part] file, units, pose, "
-                                "tolerance, and the [stock], [robot], [tool], [cut] of a job."),
+    cell: Path = typer.Argument(..., help=literal(
+        "Cell file (.toml): [part] file, units, pose, tolerance, rough_cuts, repair, and the "
+        "[stock], [robot], [tool], [cut] of a job.")),
     out: Path = typer.Option(Path("out/carve"), "--out", "-o", help="Output folder."),
 ) -> None:
     """Turn a part (a closed STL, OBJ, PLY mesh or a 3DM model) into the ruled cuts that

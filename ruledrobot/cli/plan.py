@@ -6,7 +6,7 @@ from pathlib import Path
 
 import typer
 
-from ._common import app, console, err, fail, print_verdict
+from ._common import app, console, err, fail, literal, print_verdict
 
 
 @app.command(epilog="Example:  ruledrobot simulate out/demo/trajectory.csv --out out/sim --video")
@@ -109,7 +109,7 @@ def plan(
              "     or:  ruledrobot demo --carve")
 def demo(
     out: Path | None = typer.Option(None, "--out", "-o",
-                                    help="Output folder [default: out/demo, out/part]."),
+                                    help=literal("Output folder [default: out/demo, out/part].")),
     part: bool = typer.Option(False, "--part", help="The part demo: three cuts (one all the "
                               "way round), kerf compensated, the wire's heat switched."),
     carve: bool = typer.Option(False, "--carve", help="The carve demo: a hyperboloid column "

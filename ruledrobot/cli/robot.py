@@ -8,7 +8,7 @@ from pathlib import Path
 
 import typer
 
-from ._common import app, console, err, fail, print_verdict
+from ._common import app, console, err, fail, literal, print_verdict
 
 
 def say_program_size(path: Path) -> None:
@@ -47,12 +47,14 @@ def export(
         False, "--allow-long", help="Write a URScript program beyond the safe size (see docs)."
     ),
     tolerance: float | None = typer.Option(
-        None, min=1e-6, help="movel/movep: decimation tolerance at the wire's ends [m] "
-        "(default a quarter of --wire-tolerance)."),
-    blend: float = typer.Option(0.002, min=0.0, help="movel/movep: blend radius [m]."),
+        None, min=1e-6, help=literal(
+            "movel/movep: decimation tolerance at the wire's ends [m] (default a quarter of "
+            "--wire-tolerance).")),
+    blend: float = typer.Option(0.002, min=0.0, help=literal("movel/movep: blend radius [m].")),
     wire_tolerance: float | None = typer.Option(
-        None, min=1e-6, help="movel/movep: the wire's largest distance from the planned "
-        "wire in the stock [m] (default: the plan's [cut] wire_tolerance)."),
+        None, min=1e-6, help=literal(
+            "movel/movep: the wire's largest distance from the planned wire in the stock [m] "
+            "(default: the plan's [cut] wire_tolerance).")),
     force: bool = typer.Option(False, "--force", help="Replace files the export did not "
                                "write (a user's file, a recording) at --out."),
 ) -> None:
@@ -125,8 +127,9 @@ def run(
         "movel/movej program at its speeds, verified before motion)."
     ),
     buffer: float = typer.Option(
-        0.5, min=0.05, max=5.0, help="forward mode: the longest stall of this computer the "
-        "motion rides through unchanged [s]; a longer one stops along the path, heat off."
+        0.5, min=0.05, max=5.0, help=literal(
+            "forward mode: the longest stall of this computer the motion rides through "
+            "unchanged [s]; a longer one stops along the path, heat off.")
     ),
     speed_scale: float = typer.Option(1.0, min=0.01, max=1.0, help="Slow the whole run down."),
     resume: int | None = typer.Option(
@@ -138,9 +141,10 @@ def run(
         False, "--force", help="Run although the controller's kinematics differ from the plan's."
     ),
     wire_tolerance: float | None = typer.Option(
-        None, "--wire-tolerance", min=1e-6, help="The largest distance of the wire from the "
-        "planned wire in the stock [m] (the run's verdict, the path program's check; default: "
-        "the plan's [cut] wire_tolerance)."),
+        None, "--wire-tolerance", min=1e-6, help=literal(
+            "The largest distance of the wire from the planned wire in the stock [m] (the "
+            "run's verdict, the path program's check; default: the plan's [cut] "
+            "wire_tolerance).")),
 ) -> None:
     """Stream a planned trajectory to a UR controller through RTDE (ur_rtde): checks the
     controller (robot model, period, state) and shows the approach move before asking to
@@ -296,9 +300,9 @@ DEFAULT_URSIM_HOST = "127.0.0.1"
 @app.command(epilog="Example:  ruledrobot ursim --host 127.0.0.2 --model ur5e")
 def ursim(
     host: str | None = typer.Option(
-        None, help="Address to listen on [default: 127.0.0.1, or the next free loopback "
-        "address (127.0.0.2, ...) when it is taken]; a given address that is taken is an "
-        "error."),
+        None, help=literal(
+            "Address to listen on [default: 127.0.0.1, or the next free loopback address "
+            "(127.0.0.2, ...) when it is taken]; a given address that is taken is an error.")),
     model: str = typer.Option("ur5e", help="Robot model."),
     programs: Path | None = typer.Option(
         None, help="Folder the dashboard's `load` serves programs from (default: an empty one)."

@@ -81,9 +81,14 @@ def test_bad_cells_name_the_file_table_and_field(tmp_path):
         res, _ = run_carve(cell, tmp_path / f"out{k}")
         assert res.exit_code == 2, res.output
         assert f"c{k}.toml" in res.output and words in res.output
-    # a part larger than the block: metres read as millimetres the other way round
+    # a part larger than the block: millimetres read as centimetres (the unit that fits named)
     cell = write_cell(tmp_path, "egg.stl", AT_CENTRE, units="cm", name="big.toml")
     res, _ = run_carve(cell, tmp_path / "big")
+    assert res.exit_code == 2 and 'did you mean units = "mm"?' in res.output
+    # a part a little too large for its block is a placement or a block, not a unit
+    cell = write_cell(tmp_path, "egg.stl", AT_CENTRE, name="over.toml")
+    cell.write_text(cell.read_text().replace("size = [0.2, 0.2, 0.15]", "size = [0.2, 0.2, 0.08]"))
+    res, _ = run_carve(cell, tmp_path / "over")
     assert res.exit_code == 2 and "does not fit the block" in res.output
 
 
