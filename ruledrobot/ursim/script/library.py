@@ -21,58 +21,22 @@ from __future__ import annotations
 
 import math
 import random
-from collections.abc import Callable, Generator, Iterable
+from collections.abc import Callable, Generator
 from typing import Any
 
 import numpy as np
 
-from ...geometry import se3
 from ...robot.motion.ur_motion import PathMotion
+from . import poses
 from .functions import FUNCTIONS, bind
 from .host import ProgramHost
 from .program import Pose, ScriptRuntimeError, Statement
 from .runner import move_segment, run_io_statement
+from .values import PoseValue, argument_of, pose_of, vector_of
 
 __all__ = ["BLOCKING", "PURE", "Library", "PoseValue", "ScriptRuntimeError"]
 
 Gen = Generator[None, None, Any]
-
-
-class PoseValue(list):
-    """A URScript pose ``p[x, y, z, rx, ry, rz]``: a list of 6 numbers that knows it is a pose."""
-
-    def __repr__(self) -> str:
-        return "p" + super().__repr__()
-
-
-def _arg(v: object) -> object:
-    """A runtime value as the argument checks take it (numbers as float, poses as Pose)."""
-    if isinstance(v, bool) or isinstance(v, str):
-        return v
-    if isinstance(v, (int, float)):
-        return float(v)
-    if isinstance(v, PoseValue):
-        return Pose(tuple(float(x) for x in v))
-    if isinstance(v, list):
-        return [_arg(x) for x in v]
-    return v
-
-
-def _vec(v: object, n: int, what: str) -> np.ndarray:
-    if not isinstance(v, list) or len(v) != n:
-        raise ScriptRuntimeError(f"{what}: expected a list of {n} numbers, got {v!r}")
-    try:
-        return np.asarray(v, dtype=float)
-    except (TypeError, ValueError):
-        raise ScriptRuntimeError(f"{what}: expected numbers, got {v!r}") from None
-
-
-def _pose(v: np.ndarray | Iterable[float]) -> PoseValue:
-    return PoseValue(float(x) for x in v)
-
-
-def _matrix(p: object, what: str) -> np.ndarray:
-    return se3.pose_from_ur_vector(_vec(p, 6, what))
 
 
 _MOVES = ("movej", "movel", "movep")
@@ -99,7 +63,8 @@ class Library:
         for name in BLOCKING:
             ns[f"b_{name}"] = getattr(self.sockets, name, None) or getattr(self, name)
         for name in PURE:
-            ns[f"b_{name}"] = getattr(self.sockets, name, None) or getattr(self, name)
+            ns[f"b_{name}"] = (getattr(self.sockets, name, None) or getattr(poses, name, None)
+                               or getattr(self, name))  # fmt: skip
         return ns
 
     def close(self) -> None:
@@ -114,8 +79,8 @@ class Library:
             if text:
                 args = tuple(a if isinstance(a, str) else Library.to_str(a)
                              for a in args)  # fmt: skip
-            st = Statement(name, [_arg(a) for a in args], {k: _arg(v) for k, v in kwargs.items()},
-                           0, name)  # fmt: skip
+            st = Statement(name, [argument_of(a) for a in args],
+                           {k: argument_of(v) for k, v in kwargs.items()}, 0, name)
             try:
                 st.params = bind(st)
             except ValueError as exc:  # CompileError without a line: the interpreter adds it
@@ -339,80 +304,6 @@ class Library:
         """
         return [bool((int(x) >> i) & 1) for i in range(32)]
 
-    # ------------------------------------------------------------ poses
-    @staticmethod
-    def pose_trans(p_from: list, p_from_to: list) -> PoseValue:
-        """``pose_trans(p_from, p_from_to)``: ``p_from_to`` taken in the frame of ``p_from``.
-
-        The pose of ``T(p_from) T(p_from_to)``: start at the frame ``p_from`` places and move by
-        ``p_from_to`` in it.  A UR pose [m, rad].
-        """
-        T = _matrix(p_from, "pose_trans") @ _matrix(p_from_to, "pose_trans")
-        return _pose(se3.ur_vector_from_pose(T))
-
-    @staticmethod
-    def pose_inv(p: list) -> PoseValue:
-        """``pose_inv(p_from)``: the inverse pose transformation, ``T(p_from)^-1`` [m, rad]."""
-        return _pose(se3.ur_vector_from_pose(se3.inverse(_matrix(p, "pose_inv"))))
-
-    @staticmethod
-    def pose_add(p1: list, p2: list) -> PoseValue:
-        """``pose_add(p_1, p_2)``: positions added [m], rotations multiplied (a pose).
-
-        UR's manual: ``p_3.P = p_1.P + p_2.P``, ``p_3.R = p_1.R * p_2.R`` (so that
-        ``pose_add(pose_sub(a, b), b)`` is ``a``; tested).
-        """
-        a, b = _matrix(p1, "pose_add"), _matrix(p2, "pose_add")
-        T = np.eye(4)
-        T[:3, :3] = a[:3, :3] @ b[:3, :3]
-        T[:3, 3] = a[:3, 3] + b[:3, 3]
-        return _pose(se3.ur_vector_from_pose(T))
-
-    @staticmethod
-    def pose_sub(p_to: list, p_from: list) -> PoseValue:
-        """``pose_sub(p_to, p_from)``: positions subtracted [m], rotation ``R(p_to) R(p_from)^T``.
-
-        On UR's forum it undoes :meth:`pose_add` (``pose_add(pose_sub(p_1, p_2), p_2) == p_1``);
-        with the emulator's :meth:`pose_add` that holds only when the two rotations commute.
-        """
-        a, b = _matrix(p_to, "pose_sub"), _matrix(p_from, "pose_sub")
-        T = np.eye(4)
-        T[:3, :3] = a[:3, :3] @ b[:3, :3].T
-        T[:3, 3] = a[:3, 3] - b[:3, 3]
-        return _pose(se3.ur_vector_from_pose(T))
-
-    @staticmethod
-    def pose_dist(p_from: list, p_to: list) -> float:
-        """``pose_dist(p_from, p_to)``: the distance between two poses.
-
-        UR's controller also weighs the rotation (two poses differing only in orientation are a
-        non-zero distance apart, in no particular unit); the emulator returns the distance of the
-        positions [m], as :meth:`point_dist`.
-        """
-        return float(np.linalg.norm(_vec(p_to, 6, "pose_dist")[:3] - _vec(p_from, 6,
-                                                                          "pose_dist")[:3]))
-
-    @staticmethod
-    def point_dist(p_from: list, p_to: list) -> float:
-        """``point_dist(p_from, p_to)``: the distance between the two poses' positions [m].
-
-        Rotations are not considered.
-        """
-        return Library.pose_dist(p_from, p_to)
-
-    @staticmethod
-    def interpolate_pose(p_from: list, p_to: list, alpha: float) -> PoseValue:
-        """``interpolate_pose(p_from, p_to, alpha)``: the pose a fraction ``alpha`` along.
-
-        The position on the straight line [m], the orientation on the shortest rotation between the
-        two [rad]; ``alpha`` 0 gives ``p_from``, 1 ``p_to``, values outside [0, 1] extrapolate.
-        """
-        A, B = _matrix(p_from, "interpolate_pose"), _matrix(p_to, "interpolate_pose")
-        T = np.eye(4)
-        T[:3, :3] = se3.geodesic(A, B, float(alpha))[:3, :3]
-        T[:3, 3] = A[:3, 3] + float(alpha) * (B[:3, 3] - A[:3, 3])
-        return _pose(se3.ur_vector_from_pose(T))
-
     # ------------------------------------------------------------ the arm
     def get_actual_joint_positions(self) -> list[float]:
         """``get_actual_joint_positions()``: the actual joint positions [rad], base to wrist 3."""
@@ -435,14 +326,14 @@ class Library:
 
         Forward kinematics of the actual joint positions with the active TCP.
         """
-        return _pose(self.c.kin.tcp_vector(self.get_actual_joint_positions()))
+        return pose_of(self.c.kin.tcp_vector(self.get_actual_joint_positions()))
 
     def get_target_tcp_pose(self) -> PoseValue:
         """``get_target_tcp_pose()``: the TCP pose in the base frame [m, rad], target.
 
         Forward kinematics of the target joint positions with the active TCP.
         """
-        return _pose(self.c.kin.tcp_vector(self.get_target_joint_positions()))
+        return pose_of(self.c.kin.tcp_vector(self.get_target_joint_positions()))
 
     def get_forward_kin(self, q: list | None = None, tcp: list | None = None) -> PoseValue:
         """``get_forward_kin(q, tcp)``: the TCP pose in the base frame [m, rad] at joints ``q``.
@@ -450,9 +341,9 @@ class Library:
         ``q`` [rad] defaults to the actual joint positions, ``tcp`` (a pose in the flange frame)
         to the active TCP; the kinematics are the controller's (calibrated when it is).
         """
-        qv = self.get_actual_joint_positions() if q is None else _vec(q, 6, "get_forward_kin")
-        offset = None if tcp is None else _vec(tcp, 6, "get_forward_kin")
-        return _pose(self.c.kin.fk_vector(np.asarray(qv, dtype=float), offset))
+        qv = self.get_actual_joint_positions() if q is None else vector_of(q, 6, "get_forward_kin")
+        offset = None if tcp is None else vector_of(tcp, 6, "get_forward_kin")
+        return pose_of(self.c.kin.fk_vector(np.asarray(qv, dtype=float), offset))
 
     def get_inverse_kin(self, x: list, qnear: list | None = None, maxPositionError: float = 1e-10,
                         maxOrientationError: float = 1e-10, tcp: list | None = None) -> list:
@@ -466,7 +357,8 @@ class Library:
         if tcp is not None:
             raise ScriptRuntimeError("get_inverse_kin(): tcp= is not emulated (set_tcp first)")
         near = self.get_actual_joint_positions() if qnear is None else qnear
-        q = self.c.kin.ik_nearest(_vec(x, 6, "get_inverse_kin"), _vec(near, 6, "get_inverse_kin"))
+        q = self.c.kin.ik_nearest(vector_of(x, 6, "get_inverse_kin"),
+                                  vector_of(near, 6, "get_inverse_kin"))
         if q is None:
             raise ScriptRuntimeError(f"get_inverse_kin(): no solution for p{list(x)}")
         return [float(v) for v in q]
@@ -492,9 +384,9 @@ class Library:
         (nearest ``qnear``, default the actual joint positions); it has no other safety limits.  UR
         also takes joint positions; here any list of 6 is read as a pose.
         """
-        v = _vec(pose, 6, "is_within_safety_limits")
+        v = vector_of(pose, 6, "is_within_safety_limits")
         near = self.get_actual_joint_positions() if qnear is None else qnear
-        return self.c.kin.ik_nearest(v, _vec(near, 6, "is_within_safety_limits")) is not None
+        return self.c.kin.ik_nearest(v, vector_of(near, 6, "is_within_safety_limits")) is not None
 
     # ------------------------------------------------------------ registers and IO reads
     def _reg(self, key: str, i: int, top: int) -> Any:
