@@ -113,8 +113,9 @@ def demo(
     part: bool = typer.Option(False, "--part", help="The part demo: three cuts (one all the "
                               "way round), kerf compensated, the wire's heat switched."),
     carve: bool = typer.Option(False, "--carve", help="The carve demo: a hyperboloid column "
-                               "made from its closed form, carved (ruledrobot carve), each "
-                               "job planned; no video or streaming."),
+                               "made from its closed form and made into programs (ruledrobot "
+                               "make: carved, each setup planned, cut.script, the viewer); no "
+                               "video or streaming."),
     video: bool = typer.Option(True, "--video/--no-video", help="Render video.mp4 too."),
     stream: bool = typer.Option(
         True, "--stream/--no-stream", help="Stream the cut to the embedded RTDE emulator."
@@ -168,35 +169,13 @@ def demo(
 
 
 def _demo_carve(out: Path) -> None:
-    """``demo --carve``: the column's STL and cell into ``out/part``, carved into
-    ``out/carve``, each job planned into ``out/plan`` (``out/planN`` for setup N); the
-    verdicts.  Exit 1 when carve or a plan fails, 2 on bad input."""
-    from ..carve import carve as run_carve
-    from ..carve.demo import write_demo_cell
-    from .carve import print_carve
+    """``demo --carve``: make's demo -- the column's STL and cell written into ``out/part``
+    and made into ``out`` (carve, plan every setup, programs, viewer; docs/make.md).  Exit
+    1 when carve or a setup fails, 2 on bad input."""
+    from ..make.demo import demo_cell
+    from .make import run_make
 
     console.print("[bold]ruledrobot demo --carve[/]: a hyperboloid column from its closed form, "
-                  "carved from the foam block and planned, UR5e")  # fmt: skip
-    try:
-        cell = write_demo_cell(out / "part")
-        console.print(f"wrote {cell} and {cell.parent / 'column.stl'}  (the part and its cell)",
-                      highlight=False, markup=False)  # fmt: skip
-        with console.status("carving") as status:
-            res = run_carve(cell, out / "carve", progress=lambda msg: status.update(msg))
-    except (OSError, ValueError) as exc:
-        raise fail(str(exc)) from None
-    print_carve(res.report)
-    jobs = sorted(p for k, p in res.files.items() if k.startswith("job"))
-    verdicts = []
-    for k, job in enumerate(jobs, start=1):
-        where = out / ("plan" if len(jobs) == 1 else f"plan{k}")
-        console.print(f"[bold]planning {job}[/]", highlight=False)
-        try:
-            _run_plan(job, where)
-            verdicts.append((job, True))
-        except typer.Exit:
-            verdicts.append((job, False))
-    for job, ok in verdicts:
-        console.print(f"{job}: {'PASS' if ok else 'FAIL'}", highlight=False, markup=False)
-    if not res.ok or not all(ok for _, ok in verdicts):
-        raise typer.Exit(code=1)
+                  "carved from the foam block, planned and made into programs (ruledrobot "
+                  "make), UR5e")  # fmt: skip
+    run_make(None, out, prepare=demo_cell)

@@ -38,6 +38,9 @@ def test_demo_carve_carves_the_column_in_one_exact_loop_and_plans_it(tmp_path):
     F = x**2 + z**2 - 0.06**2 * (1 + y**2 / 0.3**2)
     g = 2 * np.sqrt(x**2 + z**2 + (0.06**2 * y / 0.3**2) ** 2)
     assert (np.abs(F) / g)[inside].max() < 5e-4
-    plan = json.loads((out / "plan" / "report.json").read_text())
+    # make's demo (docs/make.md): the setup planned, its program and viewer file
+    plan = json.loads((out / "setup1" / "report.json").read_text())
     assert plan["verdict"]["ok"]
-    assert "carve/job.toml: PASS" in res.output.replace("\\", "/")
+    assert (out / "setup1" / "cut.script").is_file() and (out / "view" / "setup1.html").is_file()
+    assert (out / "part" / "column.stl").is_file()
+    assert "make: PASS — 1 setup" in " ".join(res.output.split())
