@@ -34,6 +34,7 @@ Search (vectorised over rulings; a Python loop over the small candidate grid):
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field, replace
 from typing import Any
 
@@ -88,9 +89,12 @@ class SearchOptions:
             )
 
     def cell(self, model: RobotModel, tool: ToolSpec | BowTool, stock: Box) -> Cell:
-        """The clearance cell of these options (built once per plan and passed down)."""
-        return Cell.of(model, tool, stock, self.table_z, self.margin, self.singular_min,
+        """The clearance cell of these options (built once per plan and passed down): the
+        whole collision model, the arm against itself included, as the transits between the
+        passes judge their ends (one model: a pass may not end where no transit may start)."""
+        cell = Cell.of(model, tool, stock, self.table_z, self.margin, self.singular_min,
                        self.q_start)  # fmt: skip
+        return dataclasses.replace(cell, self_collision=True)
 
 
 def bow_segments(tool: ToolSpec) -> FloatArray:
