@@ -4,7 +4,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: setup demo test lint bench clean
+.PHONY: setup demo test test-fast lint bench clean
 
 $(STAMP): pyproject.toml
 	$(PY) -m venv $(VENV)
@@ -18,10 +18,18 @@ setup: $(STAMP)
 demo: $(STAMP)
 	$(BIN)/ruledrobot demo --out out/demo
 
-## Run the whole test suite (what CI runs).
+## Run the whole test suite (what CI runs): the tests that are not real-time on both
+## cores (pytest-xdist), then the real-time ones (emulator streams) alone, one at a time.
 test: $(STAMP)
 	$(BIN)/ruff check ruledrobot tests scripts
-	$(BIN)/pytest -q
+	$(BIN)/pytest -q -n 2 -m "not realtime"
+	$(BIN)/pytest -q -m realtime
+
+## The edit loop: ruff and the fast tests on both cores (no real-time streams, no slow
+## planning tests): a few minutes less than the whole suite; CI runs `make test`.
+test-fast: $(STAMP)
+	$(BIN)/ruff check ruledrobot tests scripts
+	$(BIN)/pytest -q -n 2 -m "not realtime and not slow"
 
 lint: $(STAMP)
 	$(BIN)/ruff check ruledrobot tests scripts

@@ -23,10 +23,17 @@ REALTIME_DIRS = ("tests/export/", "tests/ursim/")
 REALTIME_TESTS = frozenset({"tests/cli/test_cli.py::test_run_streams_to_the_embedded_emulator"})
 
 
+#: test modules that take long (whole plans, carving, MuJoCo rendering, clusters): marked
+#: ``slow``, left out of ``make test-fast`` (measured with ``pytest --durations``)
+SLOW_MODULES: frozenset[str] = frozenset()
+
+
 def pytest_configure(config: pytest.Config) -> None:
     config.addinivalue_line(
         "markers", "realtime: runs real-time servers; make test runs these after the others, "
         "not in parallel (tests/conftest.py)")  # fmt: skip
+    config.addinivalue_line(
+        "markers", "slow: a long test, left out of make test-fast (tests/conftest.py)")
 
 
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
@@ -35,6 +42,8 @@ def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
         nodeid = item.nodeid.replace("\\", "/")
         if nodeid.startswith(REALTIME_DIRS) or nodeid.split("[")[0] in REALTIME_TESTS:
             item.add_marker(pytest.mark.realtime)
+        if nodeid.split("::")[0] in SLOW_MODULES:
+            item.add_marker(pytest.mark.slow)
 
 
 def random_rotations(rng: np.random.Generator, n: int) -> np.ndarray:

@@ -271,8 +271,9 @@ def say_emulator_clock(emu) -> None:
     at real-time priority."""
     from rich.text import Text
 
-    try:
-        s = emu.stats_summary()
+    try:  # the process-backed emulator calls it stats(), the threaded one stats_summary()
+        get = getattr(emu, "stats_summary", None) or emu.stats
+        s = get()
     except Exception:  # the emulator is gone: nothing to say
         return
     if not s.get("realtime_clock", 0.0):
