@@ -25,7 +25,20 @@ REALTIME_TESTS = frozenset({"tests/cli/test_cli.py::test_run_streams_to_the_embe
 
 #: test modules that take long (whole plans, carving, MuJoCo rendering, clusters): marked
 #: ``slow``, left out of ``make test-fast`` (measured with ``pytest --durations``)
-SLOW_MODULES: frozenset[str] = frozenset()
+SLOW_MODULES: frozenset[str] = frozenset({
+    "tests/batch/test_cli.py", "tests/batch/test_cluster.py", "tests/batch/test_place_dask.py",
+    "tests/carve/test_cad_meshes.py", "tests/carve/test_carved_exact.py",
+    "tests/carve/test_demo_carve.py", "tests/carve/test_developables.py",
+    "tests/carve/test_exact.py", "tests/carve/test_rough_and_input.py",
+    "tests/carve/test_tessellation.py", "tests/cli/test_cli.py", "tests/formats/test_cad.py",
+    "tests/gallery/test_gallery.py", "tests/make/test_make_column.py",
+    "tests/make/test_make_input.py", "tests/make/test_make_parts.py",
+    "tests/place/test_place.py", "tests/place/test_setups.py", "tests/sim/test_playback.py",
+    "tests/sim/test_render.py", "tests/view/test_browser.py", "tests/view/test_video.py",
+    "tests/wirecut/test_calibrated_plan.py", "tests/wirecut/test_killed_plan.py",
+    "tests/wirecut/test_once_plan.py", "tests/wirecut/test_parts.py",
+    "tests/wirecut/test_planner.py", "tests/wirecut/test_robot_base.py",
+})  # fmt: skip
 
 
 def pytest_configure(config: pytest.Config) -> None:

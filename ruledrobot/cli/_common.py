@@ -53,10 +53,10 @@ def print_verdict(verdict, title: str) -> None:
     from rich.text import Text
 
     table = Table(title=title, title_justify="left", show_edge=False, pad_edge=False)
-    # the label folds when the screen is narrow; value, limit and ok never do
-    table.add_column("check", justify="left", overflow="fold", ratio=1)
+    # the label and long values fold when the screen is narrow (rich's own wrapping)
+    table.add_column("check", justify="left", overflow="fold")
     for col in ("value", "limit"):
-        table.add_column(col, justify="right", no_wrap=True)
+        table.add_column(col, justify="right", overflow="fold")
     table.add_column("ok", justify="left", no_wrap=True)
     for c in verdict.checks:
         mark = (Text("ok", style="green") if c.ok else Text("FAIL", style="bold red")) \

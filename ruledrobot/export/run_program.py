@@ -26,7 +26,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..robot.motion.trajectory import Heat, Trajectory
+from ..robot.motion.trajectory import Trajectory
 from ..robot.verdict import Check
 from ..robot.wire.cut import FeedWindow, WireCut
 from .settings import PATH_ACCELERATION, PATH_BLEND
@@ -47,12 +47,8 @@ def run_slice(traj: Trajectory, start: int, speed_scale: float = 1.0) -> Traject
         feeds = tuple(FeedWindow(w.name, w.start, w.stop, w.speed * speed_scale, w.tolerance,
                                  w.held, w.wire_tolerance) for w in cut.feeds)  # fmt: skip
         cut = WireCut(cut.stock, cut.wire_length, feeds)
-    heat = meta.heat
-    if heat is not None:
-        wins = tuple((max(a, start) - start, b - start) for a, b in heat.windows if b > start)
-        heat = Heat(heat.kind, heat.index, heat.value, wins, heat.preheat)
-    t = part.t / float(speed_scale)
-    return Trajectory(t, part.q, part.tcp, meta.replace(cut=cut, heat=heat))
+    t = part.t / float(speed_scale)  # the heat windows: renumbered by Trajectory.sliced
+    return Trajectory(t, part.q, part.tcp, meta.replace(cut=cut))
 
 
 def _move_samples(part: Trajectory, ops: tuple[Op, ...]) -> list[int]:
