@@ -54,10 +54,11 @@ def test_the_wire_lies_on_the_planned_rulings(plan_folder, scene):
     traj = read_trajectory(plan_folder / "trajectory.csv")
     W = pose_from_ur_vector(traj.tcp[tl.sample])  # base = world here (job base is zero)
     mid = tl.wire.mean(axis=1)
-    np.testing.assert_allclose(mid, W[:, :3, 3], atol=1e-9)
+    # the CSV keeps the TCP to about 1e-9 m: agreement to 10 nm, not bit for bit
+    np.testing.assert_allclose(mid, W[:, :3, 3], atol=1e-8)
     axis = tl.wire[:, 1] - tl.wire[:, 0]
     axis /= np.linalg.norm(axis, axis=1, keepdims=True)
-    np.testing.assert_allclose(axis, W[:, :3, 2], atol=1e-9)
+    np.testing.assert_allclose(axis, W[:, :3, 2], atol=1e-8)
     # chord ends during the cut against a dense sampling of surface.stl (0.1 mm spacing)
     mesh = read_stl(plan_folder / "surface.stl")
     tri = mesh.vertices[mesh.faces]
