@@ -31,8 +31,9 @@ from .cut.passes import CutPath, cut_paths, job_search
 from .cut.wire_geometry import distance_from_rulings
 from .cut.wire_pose import SearchOptions
 from .job.spec import Job
-from .motion.assemble import Motion, assemble_motion
+from .motion.assemble import Motion, PassNotTimed, assemble_motion
 from .motion.densify import target_frames
+from .motion.timing import TimingFailure
 from .motion.transit import TransitFailure, TransitNotFound
 
 __all__ = [
@@ -61,8 +62,9 @@ class PlannedMeasures:
 @dataclass(frozen=True, eq=False)
 class Plan:
     """A planned job.  ``motion``/``trajectory``/``measured`` are None when some pass has
-    no feasible wire motion (``reasons`` say why) or a transit between passes has no
-    clear route (``transit_failures`` say which, and what is in the way)."""
+    no feasible wire motion (``reasons`` say why), a transit between passes has no
+    clear route (``transit_failures`` say which, and what is in the way) or the time law
+    found no usable trajectory for a pass (``timing_failures``)."""
 
     job: Job
     model: RobotModel = field(repr=False)  # flange, no tool, the job's base
@@ -82,6 +84,9 @@ class Plan:
     #: the transits no clear route was found for (the plan has no motion then: no move
     #: through the stock, the table or the arm is kept), ``what`` naming the passes
     transit_failures: tuple[TransitFailure, ...] = ()
+    #: the passes the time law found no usable trajectory for (an absurd duration, a
+    #: stalled path speed), in words: the pass, its rulings, what binds there (no motion)
+    timing_failures: tuple[str, ...] = ()
 
     @property
     def reachable(self) -> bool:
@@ -274,6 +279,12 @@ def make_plan(
                                       what=transit_between(job, passes, exc.failure))
         return Plan(job, model, tuple(passes), None, None, None, reasons, notes, timings,
                     bow, data, ref, (failure,))  # fmt: skip
+    except (PassNotTimed, TimingFailure) as exc:  # hours for a loop: a failed plan, not bad input
+        timings["timing_s"] = time.perf_counter() - t1
+        what = (exc.sentence() if isinstance(exc, PassNotTimed) else
+                f"a joint move (approach, transit or retract): {exc}")  # fmt: skip
+        return Plan(job, model, tuple(passes), None, None, None, reasons, notes, timings,
+                    bow, data, ref, timing_failures=(what,))  # fmt: skip
     passes = list(motion.passes)
     timings["timing_s"] = time.perf_counter() - t1
     say("measuring the planned motion")

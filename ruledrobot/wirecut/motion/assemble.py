@@ -37,10 +37,10 @@ from ..cut.wire_geometry import speed_factor
 from ..job.spec import Job
 from .corners import corner_nodes, corner_stop_mask, time_between_corners
 from .densify import densified, pass_deviation, pass_feed_error, uneven_intervals
-from .timing import TimedPath, concatenate, dwell, joint_move
+from .timing import TimedPath, TimingFailure, concatenate, dwell, joint_move
 from .transit import TransitPlanner
 
-__all__ = ["LIFT", "Motion", "assemble_motion"]
+__all__ = ["LIFT", "Motion", "PassNotTimed", "assemble_motion"]
 
 LIFT = 0.1  # m: approach from / retract to this far beyond the lead-in/out pose
 #: rounds of adding rulings where the timed wire leaves the surface or its feed strays,
@@ -93,6 +93,38 @@ class Motion:
     surface: np.ndarray | None = field(default=None, repr=False)
     corner_stop: np.ndarray | None = field(default=None, repr=False)
     wire: WireInStock | None = field(default=None, repr=False)
+
+
+class PassNotTimed(RuntimeError):
+    """The time law found no usable trajectory for a pass (its :class:`TimingFailure` in
+    ``failure``): ``name`` the cut, ``rulings`` (first, last) the pass's rulings (from 0)
+    spanning the stretch where the time goes, of ``count``."""
+
+    def __init__(self, cp: CutPath, failure: TimingFailure) -> None:
+        s = np.asarray(cp.s, dtype=np.float64)
+        s0, s1 = failure.s_range
+        a = int(np.clip(np.searchsorted(s, s0, side="right") - 1, 0, len(s) - 1))
+        b = int(np.clip(np.searchsorted(s, s1, side="left"), a, len(s) - 1))
+        self.name, self.rulings, self.count, self.failure = cp.name, (a, b), len(s), failure
+        super().__init__(self.sentence())
+
+    def sentence(self) -> str:
+        """The pass, the rulings, what the time law found and what binds there."""
+        f, (a, b) = self.failure, self.rulings
+        where = f"rulings {a}-{b} of {self.count}" if b > a else f"ruling {a} of {self.count}"
+        bind = f.binding
+        why = ("" if bind is None else f"; {bind.words()} holds the wire to "
+               f"{1e3 * f.path_speed:.3g} mm/s there")  # fmt: skip
+        if f.reason == "too_long":
+            what = (f"its timed path would last {f.duration:.3g} s ({f.duration / 3600:.3g} h), "
+                    f"{100 * f.share:.0f} % of it over {where}")  # fmt: skip
+        elif f.reason == "stall":
+            what = f"its path speed falls to zero over {where}"
+        elif f.reason == "limits":
+            what = f"its sampled joints still break a limit at {where} after every refinement"
+        else:
+            what = f"no finite path speed at {where}"
+        return f"pass '{self.name}': {what}{why}"
 
 
 def _backed_off(
@@ -231,7 +263,10 @@ def _pass_timing(
         def sf(a: int, b: int, m=m, s=s) -> FloatArray:  # one piece between corners
             return speed_factor(m.flange[a : b + 1], s[a : b + 1], bow, job.stock, near)
 
-        timed = time_between_corners(s, m.q, sf, cut.feed_speed, vel, acc, dt, corners)
+        try:
+            timed = time_between_corners(s, m.q, sf, cut.feed_speed, vel, acc, dt, corners)
+        except TimingFailure as exc:  # no usable time law: the plan fails, named
+            raise PassNotTimed(cp, exc) from None
         if attempt == DENSIFY_ROUNDS:
             break
         wire = measure_wire(job, model, timed.t, timed.q, bow)

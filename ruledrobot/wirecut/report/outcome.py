@@ -16,7 +16,13 @@ from ..motion.feed_limit import feed_limit_reason
 from ..plan import SINGULARITY_MARGIN, Plan, job_reference
 from ..reach.explain import reach_reasons
 from ..verify import Verification
-from .verdict import CutMeasurements, Measurements, plan_verdict, transits_check
+from .verdict import (
+    CutMeasurements,
+    Measurements,
+    plan_verdict,
+    timing_check,
+    transits_check,
+)
 
 __all__ = ["REPORT_FORMAT", "plan_outcome"]
 
@@ -102,13 +108,18 @@ def _cut_sections(plan: Plan, ver: Verification | None) -> tuple[list[dict], lis
 
 def _unreachable(plan: Plan) -> tuple[dict, Verdict]:
     """A plan without motion: some pass is infeasible (``reach`` fails), or every pass is
-    feasible and a transit found no clear route (``reach`` holds, ``transits`` fails)."""
+    feasible and the time law found no usable trajectory for one (``reach`` holds,
+    ``timing`` fails) or a transit found no clear route (``transits`` fails)."""
     reasons = tuple(plan.reasons) + reach_reasons(plan)  # how far, which rule, where to move
-    ok = bool(plan.transit_failures) and all(cp.feasible for cp in plan.passes)
+    ok = (bool(plan.transit_failures) or bool(plan.timing_failures)) and all(
+        cp.feasible for cp in plan.passes)  # fmt: skip
     checks = [Check("reach", "every ruling reachable, clear of stock and table",
                     "yes" if ok else "no", "yes", relation="==", ok=ok,
                     detail="" if ok else "; ".join(reasons))]  # fmt: skip
-    if ok:
+    if ok and plan.timing_failures:  # the time law: before any transit is looked for
+        checks.append(timing_check(plan.timing_failures))
+        reasons += plan.timing_failures
+    elif ok:
         failures = tuple(f.sentence() for f in plan.transit_failures)
         checks.append(transits_check(failures))
         reasons += failures

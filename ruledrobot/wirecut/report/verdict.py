@@ -11,6 +11,10 @@ Gating (the plan is feasible only when all hold; ``docs/verdict.md``):
   route clear of the cell's whole collision model (:mod:`..motion.transit`); one that
   did not is named with the passes it connects and the bodies in the direct move's way,
   and the plan then has no motion at all (no move through them is kept);
+* ``timing`` (only when it fails, the plan then has no motion) — the time law found no
+  usable trajectory for a pass: it would last longer than ``MAX_SAMPLES`` periods (hours
+  for a loop) or its path speed collapses; named with the pass, the rulings where the
+  time goes and the joint limit (or the feed) that binds there (:func:`timing_check`);
 * ``wire_deviation`` — the simulated wire (from the simulated joints) within
   ``[cut] wire_tolerance`` of the target rulings inside the stock;
   ``planned_wire_deviation`` — the same for the planned joints;
@@ -39,7 +43,7 @@ from ...robot.verdict import Check, Verdict
 from ...robot.wire.cut import feed_checks
 
 __all__ = ["CutMeasurements", "Measurements", "collision_sentence", "plan_verdict",
-           "transits_check"]
+           "timing_check", "transits_check"]
 
 
 @dataclass(frozen=True)
@@ -133,6 +137,15 @@ def transits_check(failures: tuple[str, ...]) -> Check:
     """``transits``: how many transits found no route clear of the cell (at most 0); the
     detail names each, the passes it connects and what is in the way."""
     return Check("transits", "transits without a clear route (arm, bow, wire, stock, table)",
+                 len(failures), 0, relation="<=", ok=not failures,
+                 detail="\n".join(failures))  # fmt: skip
+
+
+def timing_check(failures: tuple[str, ...]) -> Check:
+    """``timing``: how many passes the time law found no usable trajectory for (at most
+    0): an absurd duration (hours for a loop), a path speed that collapses; the detail
+    names each pass, the rulings where the time goes and the limit that binds there."""
+    return Check("timing", "motions without a usable time law (hours long, stalled)",
                  len(failures), 0, relation="<=", ok=not failures,
                  detail="\n".join(failures))  # fmt: skip
 

@@ -23,6 +23,7 @@ from ruledrobot.wirecut.motion.timing import (
     FEED_TOL,
     RATIO_TOL,
     TimedPath,
+    TimingFailure,
     concatenate,
     joint_move,
     time_path,
@@ -163,8 +164,9 @@ def test_limits_that_cannot_be_met_raise(monkeypatch):
         return tp, sig[:1], sig[1:2]
 
     monkeypatch.setattr(timing.time_law, "_timed_from_law", always_over)
-    with pytest.raises(ValueError, match=r"exceeds the limits after 6 rounds.*between s ="):
+    with pytest.raises(TimingFailure, match=r"exceeds the limits after 6 rounds.*between s =") as e:
         time_path(s, q, sf, 0.05, VL, AL, DT)
+    assert e.value.reason == "limits"  # a failed plan (the timing check), not bad input
 
 
 def test_a_path_speed_that_collapses_names_the_place(monkeypatch):
@@ -177,8 +179,10 @@ def test_a_path_speed_that_collapses_names_the_place(monkeypatch):
         return np.where(mid, 0.0, x)
 
     monkeypatch.setattr(timing.solvers, "_x_upper", zero_in_the_middle)
-    with pytest.raises(ValueError, match=r"collapses to zero between s = 0\.4.*binding"):
+    with pytest.raises(TimingFailure, match=r"collapses to zero between s = 0\.4.*binding") as e:
         time_path(s, q, sf, 0.05, VL, AL, DT, solver="reachability")
+    assert e.value.reason == "stall" and e.value.duration == math.inf
+    assert 0.39 < e.value.s_range[0] < e.value.s_range[1] < 0.7  # the zeroed stretch (in σ)
 
 
 # --------------------------------------------------------------------------- feed

@@ -26,9 +26,12 @@ Method of :func:`time_path` (details and measurements in ``docs/timing.md``):
      ``sf_σ σ̇ ≤ feed_speed`` are both *path-velocity* bounds, folded into one upper
      bound ``x ≤ x_hi`` handed to toppra as the ``xbound`` of a canonical linear
      constraint (the mechanism ``JointVelocityConstraint`` itself uses), where
-     ``sf_σ = speed_factor·ds/dσ``. The speed factor at a grid point is the largest
-     sample value of the gaps it touches, so the bound also holds between grid
-     points (x and the speed factor are both piecewise linear there);
+     ``sf_σ = speed_factor(s(σ))·s'(σ)`` with ``s(σ)`` the monotone C¹ (PCHIP)
+     interpolation of the samples, so that ``sf_σ`` is continuous (a piecewise linear
+     ``s(σ)`` made it jump at every kink of the joint path, and the bound with it).
+     A grid point's bound is the largest ``sf_σ`` over the stages it touches, so it
+     also holds between grid points (x is linear there); stages over which ``sf_σ``
+     changes by more than ``FEED_SMOOTH`` are split;
    - joint acceleration ``|q'_j u + q''_j x| ≤ safety·a_j``: toppra's
      ``JointAccelerationConstraint`` with *interpolation* discretisation (the
      constraint of stage i is imposed at both ends of the stage; collocation alone
@@ -51,7 +54,9 @@ Method of :func:`time_path` (details and measurements in ``docs/timing.md``):
    Where a true limit is broken — between grid points, where the constraints are
    not imposed — the stages around those samples are split in four and the path is
    solved again (``REFINE_ROUNDS`` times), then the limits are tightened everywhere,
-   and after ``MAX_TRIES`` rounds :class:`ValueError` is raised.
+   and after ``MAX_TRIES`` rounds :class:`TimingFailure` is raised — as when the path
+   speed collapses or the law would last more than ``MAX_SAMPLES`` periods: a
+   :class:`ValueError` with where the time goes and what binds (``diagnose``).
 
 ``safety`` scales the joint limits only. The feed bound is not scaled: a constant
 feed equal to ``feed_speed`` is the goal of the cut.
@@ -61,12 +66,13 @@ and limits), ``result`` (:class:`TimedPath`), ``inputs`` (the argument checks ev
 timing function shares), ``report`` (the finite-difference verification),
 ``problem`` (grid and constraint rows), ``solvers`` (toppra and the reachability
 fallback), ``sampling``, ``time_law`` (:func:`time_path`), ``moves``
-(:func:`joint_move`, :func:`concatenate`).
+(:func:`joint_move`, :func:`concatenate`), ``diagnose`` (:class:`TimingFailure`).
 """
 
 from __future__ import annotations
 
 from ....robot.motion.rates import trajectory_limits_report
+from .diagnose import Binding, TimingFailure
 from .moves import concatenate, dwell, joint_move
 from .result import TimedPath
 from .time_law import time_path
@@ -78,7 +84,9 @@ __all__ = [
     "FEED_TOL",
     "MAX_SAMPLES",
     "RATIO_TOL",
+    "Binding",
     "TimedPath",
+    "TimingFailure",
     "concatenate",
     "dwell",
     "joint_move",

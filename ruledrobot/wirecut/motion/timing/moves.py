@@ -10,6 +10,7 @@ from numpy.typing import ArrayLike
 
 from ....geometry.checks import as_number, as_shaped
 from ....robot.motion.rates import trajectory_limits_report
+from .diagnose import Binding, TimingFailure
 from .inputs import as_factor, as_rate_limits
 from .result import TimedPath
 from .tolerances import CONTINUITY_TOL, MAX_SAMPLES, FloatArray
@@ -68,8 +69,16 @@ def joint_move(
     T = 2.0 * Ta + (1.0 - V * Ta) / V
     n = max(1, math.ceil(T / dt - 1e-9))
     if n + 1 > MAX_SAMPLES:
-        raise ValueError(
-            f"joint_move: the move lasts {T:.6g} s = {n + 1} samples, more than MAX_SAMPLES"
+        cruise = V < math.sqrt(a_s / 2.0)  # the velocity limit binds, else the acceleration
+        lim = vlim if cruise else alim
+        j = int(np.argmin(np.where(moving, lim / np.maximum(D, 1e-300), np.inf)))
+        b = Binding("velocity" if cruise else "acceleration", j + 1, V * V, V, float(D[j]))
+        raise TimingFailure(
+            f"joint_move: the move lasts {T:.6g} s = {n + 1} samples, more than MAX_SAMPLES "
+            f"= {MAX_SAMPLES}; joint {j + 1} sets it: {float(D[j]):.3g} rad to go at its "
+            f"{b.kind} limit {float(lim[j]):.3g} rad/s{'' if cruise else '²'}",
+            reason="too_long", duration=T, s_range=(0.0, 1.0), share=1.0, binding=b,
+            path_speed=V,
         )
     k = T / (n * dt)
     t = np.arange(n + 1) * dt

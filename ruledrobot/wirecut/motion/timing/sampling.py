@@ -16,6 +16,11 @@ from .tolerances import FEED_HOLD_TOL, FEED_TOL, MAX_SAMPLES, RATIO_MAX, FloatAr
 # --------------------------------------------------------------------------- sampling
 
 
+class _TooLongError(ValueError):
+    """Internal: the law lasts more than ``MAX_SAMPLES`` periods (the caller diagnoses
+    it, :func:`.diagnose.too_long`)."""
+
+
 def _sample_law(
     grid: FloatArray, x: FloatArray, dt: float, what: str
 ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
@@ -34,7 +39,7 @@ def _sample_law(
     T = float(tau[-1])
     n = max(1, math.ceil(T / dt - 1e-9))
     if n + 1 > MAX_SAMPLES:
-        raise ValueError(
+        raise _TooLongError(
             f"{what}: the timed path lasts {T:.6g} s = {n + 1} samples at dt = {dt} s, more "
             f"than MAX_SAMPLES = {MAX_SAMPLES}; split the path or raise the feed/limits"
         )

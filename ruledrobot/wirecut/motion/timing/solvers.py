@@ -9,6 +9,7 @@ from typing import Any
 
 import numpy as np
 
+from .diagnose import TimingFailure, binding_at
 from .problem import _Problem, _stage_rows, _static_bound, _x_upper
 from .tolerances import FloatArray
 
@@ -117,26 +118,6 @@ def _toppra_controllable(
     return np.maximum(K[:, 1], 0.0)
 
 
-def _binding(prob: _Problem, i: int, vlim: FloatArray, alim: FloatArray) -> str:
-    """Name the tightest bound on the path speed at grid point i (for error messages)."""
-    cands: list[tuple[float, str]] = []
-    with np.errstate(divide="ignore"):
-        xv = (vlim / np.abs(prob.d1[i])) ** 2
-    j = int(np.argmin(xv))
-    cands.append((float(xv[j]), f"joint {j + 1} velocity"))
-    cands.append((float(prob.x_feed[i]), "feed"))
-    st = min(i, prob.grid.shape[0] - 2)
-    c, w, x_only = _stage_rows(prob, alim)
-    xa = min(float(_static_bound(c[st : st + 1], w[st : st + 1], prob.deltas[st : st + 1])[0]),
-             float(x_only[st]))  # fmt: skip
-    cands.append((xa, "joint acceleration"))
-    x, name = min(cands)
-    g = int(np.clip(np.searchsorted(prob.sigma, prob.grid[i], side="right") - 1, 0,
-                    prob.sigma.shape[0] - 2))  # fmt: skip
-    ds_dsigma = (prob.s_w[g + 1] - prob.s_w[g]) / (prob.sigma[g + 1] - prob.sigma[g])
-    return f"{name} (ds/dt <= {math.sqrt(x) * ds_dsigma:.3g} there)"
-
-
 def _solve(
     prob: _Problem,
     vlim: FloatArray,
@@ -167,8 +148,11 @@ def _solve(
         x[-1] = 0.0
     if not np.isfinite(x).all():
         i = int(np.flatnonzero(~np.isfinite(x))[0])
-        raise ValueError(
-            f"time_path: no finite path speed at s = {prob.s_at(prob.grid[i]):.6g}; "
-            f"binding constraint: {_binding(prob, i, vlim, alim)}"
+        s_i = float(prob.s_at(prob.grid[i : i + 1])[0])
+        b = binding_at(prob, i, vlim, alim)
+        raise TimingFailure(
+            f"time_path: no finite path speed at s = {s_i:.6g}; binding constraint: "
+            f"{b.words()} (ds/dt <= {b.ds_dt:.3g} there)",
+            reason="no_speed", duration=float("nan"), s_range=(s_i, s_i), binding=b,
         )
     return x, method

@@ -8,12 +8,13 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ....geometry.checks import as_number, as_shaped, check_increasing
+from .diagnose import TimingFailure, too_long
 from .inputs import as_factor, as_rate_limits
-from .problem import _prepare, _Problem
+from .problem import _prepare
 from .result import TimedPath
-from .sampling import _sample_law, _timed_from_law
-from .solvers import _binding, _solve, _StalledError
-from .tolerances import FEED_TOL, MAX_TRIES, REFINE_ROUNDS, FloatArray
+from .sampling import _sample_law, _timed_from_law, _TooLongError
+from .solvers import _solve, _StalledError
+from .tolerances import FEED_TOL, MAX_SAMPLES, MAX_TRIES, REFINE_ROUNDS
 
 # --------------------------------------------------------------------------- public
 
@@ -61,8 +62,11 @@ def time_path(
         ``<= 1 + RATIO_TOL`` (feed ``<= 1 + FEED_TOL``).
 
     Raises:
-        ValueError: bad input (the message names the argument and index), or no
-            trajectory within the limits (the message names the constraint and where).
+        TimingFailure: (a ValueError) no usable trajectory — the path speed collapses to
+            zero, the timed path would last more than ``MAX_SAMPLES`` periods, or the
+            sampled output still breaks a limit after every round; its fields and message
+            say where (the caller's ``s``) and what binds (:mod:`.diagnose`).
+        ValueError: bad input (the message names the argument and index).
     """
     s_arr = as_shaped(s, "s", (None,))
     N = s_arr.shape[0]
@@ -93,15 +97,19 @@ def time_path(
         x, method = _solve(prob, v_k, a_k, start_at_rest, end_at_rest, use_toppra=use_toppra)
         try:
             law = _sample_law(prob.grid, x, dt, "time_path")
-        except _StalledError as exc:
+        except _StalledError:
             if method != "toppra":
-                raise _stall_error(prob, exc.stage, v_k, a_k) from None
+                raise too_long(prob, x, v_k, a_k, dt, MAX_SAMPLES, stalled=True) from None
             x, method = _solve(prob, v_k, a_k, start_at_rest, end_at_rest, use_toppra=False)
-            method = f"reachability (fallback: toppra profile stalls at stage {exc.stage})"
+            method = "reachability (fallback: toppra profile stalls)"
             try:
                 law = _sample_law(prob.grid, x, dt, "time_path")
-            except _StalledError as exc2:
-                raise _stall_error(prob, exc2.stage, v_k, a_k) from None
+            except _StalledError:
+                raise too_long(prob, x, v_k, a_k, dt, MAX_SAMPLES, stalled=True) from None
+            except _TooLongError:
+                raise too_long(prob, x, v_k, a_k, dt, MAX_SAMPLES) from None
+        except _TooLongError:
+            raise too_long(prob, x, v_k, a_k, dt, MAX_SAMPLES) from None
         tp, lo, hi = _timed_from_law(prob, *law, dt, vlim, alim, method)
         if lo.size == 0:
             if attempt:
@@ -116,18 +124,12 @@ def time_path(
                 prob.feed_scale *= 0.995 / tp.max_feed_ratio
                 prob.set_grid(prob.grid)
     assert tp is not None
-    raise ValueError(
+    s0, s1 = (float(v) for v in prob.s_at(np.array([lo[0], hi[0]])))
+    raise TimingFailure(
         f"time_path: sampled output still exceeds the limits after {MAX_TRIES} rounds "
         f"(joint speed ratio {tp.max_speed_ratio:.4f}, acceleration ratio "
         f"{tp.max_acc_ratio:.4f}, feed ratio {tp.max_feed_ratio:.4f}), first between "
-        f"s = {prob.s_at(lo[0]):.6g} and {prob.s_at(hi[0]):.6g}; the path bends faster "
-        f"there than dt = {dt} s resolves — resample it more densely or smooth it"
-    )
-
-
-def _stall_error(prob: _Problem, i: int, vlim: FloatArray, alim: FloatArray) -> ValueError:
-    return ValueError(
-        f"time_path: the path speed collapses to zero between s = "
-        f"{prob.s_at(prob.grid[i]):.6g} and {prob.s_at(prob.grid[i + 1]):.6g}"
-        f"; binding constraint: {_binding(prob, i, vlim, alim)}"
+        f"s = {s0:.6g} and {s1:.6g}; the path bends faster "
+        f"there than dt = {dt} s resolves — resample it more densely or smooth it",
+        reason="limits", duration=tp.duration, s_range=(s0, s1),
     )

@@ -24,6 +24,11 @@ FEED_HOLD_TOL = 0.01
 CONTINUITY_TOL = 1e-9
 #: Most samples a timed path may have (1 h 6 min at 500 Hz; ~300 MB of q, qd, qdd).
 MAX_SAMPLES = 2_000_000
+#: Largest relative change of the wire's speed per unit σ within one solver stage: a
+#: stage over which it changes more is split (into ``FEED_SPLIT`` parts at most), so
+#: that the feed bounds of neighbouring nodes differ by about this much at most.
+FEED_SMOOTH = 0.0025
+FEED_SPLIT = 64
 #: Fewest solver stages; sparse inputs have their gaps split evenly up to this.
 MIN_STAGES = 200
 #: Verification rounds of :func:`time_path`: the first ``REFINE_ROUNDS`` split the
