@@ -20,7 +20,7 @@ import math
 import socket
 import struct
 import threading
-from collections.abc import Generator
+from collections.abc import Callable, Generator
 from typing import Any
 
 from ..ports.tcp import try_realtime_priority
@@ -142,6 +142,19 @@ class ScriptSockets:
     def _ticks(self, timeout: float) -> int:
         return max(0, math.ceil(float(timeout) / self.period - 1e-9))
 
+    def _wait(self, socket_name: str, timeout: float, take: Callable[[_Conn], bytes | None]
+              ) -> Generator[None, None, bytes | None]:  # fmt: skip
+        """What ``take`` finds in the socket's buffer, waiting up to ``timeout`` s of
+        controller time (whole periods); None on a timeout or a closed socket."""
+        c = self.conns.get(str(socket_name))
+        for k in range(self._ticks(timeout) + 1):
+            data = take(c) if c is not None else None
+            if data is not None or c is None or c.closed:
+                return data
+            if k < self._ticks(timeout):
+                yield
+        return None
+
     # ------------------------------------------------------------ open, close, send
     def socket_open(self, address: str, port: int, socket_name: str = "socket_0") -> Gen:
         """Connect (waiting in controller time); True when connected."""
@@ -188,17 +201,10 @@ class ScriptSockets:
         n = int(number)
         if n < 1 or n > 30:
             raise ScriptRuntimeError(f"socket_read_binary_integer(): number must be 1..30, got {n}")
-        c = self.conns.get(str(socket_name))
-        ticks = self._ticks(timeout)
-        k = 0
-        while True:
-            data = c.take(4 * n) if c is not None else None
-            if data is not None:
-                return [n, *struct.unpack(f">{n}i", data)]
-            if k >= ticks or c is None or c.closed:
-                return [0] + [-1] * n
-            k += 1
-            yield
+        data = yield from self._wait(socket_name, timeout, lambda conn: conn.take(4 * n))
+        if data is None:
+            return [0] + [-1] * n
+        return [n, *struct.unpack(f">{n}i", data)]
 
     def socket_read_ascii_float(self, number: int, socket_name: str = "socket_0",
                                 timeout: float = 2.0) -> Gen:  # fmt: skip
@@ -223,17 +229,10 @@ class ScriptSockets:
 
     def socket_read_line(self, socket_name: str = "socket_0", timeout: float = 2.0) -> Gen:
         """One line without its newline; ``""`` on a timeout."""
-        c = self.conns.get(str(socket_name))
-        ticks = self._ticks(timeout)
-        k = 0
-        while True:
-            data = c.take_until(b"\n") if c is not None else None
-            if data is not None:
-                return data.decode("latin-1").rstrip("\r\n")
-            if k >= ticks or c is None or c.closed:
-                return ""
-            k += 1
-            yield
+        data = yield from self._wait(socket_name, timeout, lambda conn: conn.take_until(b"\n"))
+        if data is None:
+            return ""
+        return data.decode("latin-1").rstrip("\r\n")
 
     def socket_read_string(self, socket_name: str = "socket_0", prefix: str = "",
                            suffix: str = "", timeout: float = 2.0) -> Gen:  # fmt: skip
