@@ -20,6 +20,7 @@ import numpy as np
 
 from ..io.atomic import atomic_write_text
 from ..io.lines import save_lines
+from ..io.toml_text import toml_table
 from .model import CarveCut
 
 __all__ = ["SPACING", "setups_of", "toml_text", "write_jobs"]
@@ -28,44 +29,21 @@ __all__ = ["SPACING", "setups_of", "toml_text", "write_jobs"]
 SPACING = 0.003
 
 
-def _value(v: Any) -> str:
-    if isinstance(v, bool):
-        return "true" if v else "false"
-    if isinstance(v, (int, np.integer)):
-        return str(int(v))
-    if isinstance(v, (float, np.floating)):
-        r = repr(round(float(v), 12) + 0.0)
-        return r if "." in r or "e" in r or "inf" in r or "nan" in r else r + ".0"
-    if isinstance(v, str):
-        return '"' + v.replace("\\", "\\\\").replace('"', '\\"') + '"'
-    if isinstance(v, np.ndarray):
-        v = v.tolist()
-    if isinstance(v, (list, tuple)):
-        return "[" + ", ".join(_value(x) for x in v) + "]"
-    if isinstance(v, dict):
-        return "{ " + ", ".join(f"{k} = {_value(x)}" for k, x in v.items()) + " }"
-    raise ValueError(f"cannot write {type(v).__name__} to TOML")
-
-
-def _table(name: str, table: dict[str, Any], header: str = "[{}]") -> list[str]:
-    return [header.format(name), *(f"{k} = {_value(v)}" for k, v in table.items()), ""]
-
-
 def toml_text(tables: dict[str, Any], cuts: list[tuple[CarveCut, str]], title: str) -> str:
     """A job file: the cell's tables and ``cuts`` as ``(cut, lines file name)``."""
     out = [f"# {title}", "# written by ruledrobot carve; plan it with: ruledrobot plan job.toml "
            "--out DIR", ""]  # fmt: skip
     for name in ("stock", "robot", "tool"):
         if name in tables:
-            out += _table(name, tables[name])
+            out += toml_table(name, tables[name])
     defaults = dict(tables.get("cut", {}))
     for cut, file in cuts:
         entry: dict[str, Any] = {"name": cut.name,
                                  "keep": cut.keep if isinstance(cut.keep, str)
                                  else np.asarray(cut.keep).tolist(), **defaults}  # fmt: skip
         out.append(f"# {cut.kind}: {cut.what}")
-        out += _table("cut", entry, "[[{}]]")
-        out += _table("cut.surface", {"file": file, "spacing": SPACING})
+        out += toml_table("cut", entry, "[[{}]]")
+        out += toml_table("cut.surface", {"file": file, "spacing": SPACING})
     return "\n".join(out)
 
 

@@ -39,6 +39,21 @@ def literal(text: str) -> str:
     return escape(text)
 
 
+def numbers(text: str | None, option: str, n: int | None = None) -> list[float] | None:
+    """``"a,b,c"`` -> floats (exactly ``n`` when given), or None for None; a ValueError
+    names the option."""
+    if text is None:
+        return None
+    try:
+        values = [float(v) for v in text.replace(" ", "").split(",")]
+    except ValueError:
+        values = []
+    if not values or (n is not None and len(values) != n):
+        count = f"{n} " if n is not None else ""
+        raise ValueError(f"{option}: expected {count}comma-separated numbers, got {text!r}")
+    return values
+
+
 def fail(message: str) -> typer.Exit:
     """Print a bad-input error literally (no markup: ``[cut]`` stays) and exit 2."""
     from rich.text import Text

@@ -9,7 +9,7 @@ from typing import Any, NamedTuple
 
 import typer
 
-from ._common import app, console, err, fail
+from ._common import app, console, err, fail, numbers
 
 _IN_GCODE = "Input: G-code"
 _IN_WING = "Input: airfoil panel"
@@ -20,19 +20,6 @@ _IN = "Input"
 _OUT_GCODE = "Output: G-code"
 _OUT_CAD = "Output: DXF and 3DM"
 _OUT = "Output"
-
-
-def _numbers(text: str | None, n: int, option: str) -> list[float] | None:
-    """``"a,b,c"`` -> n floats, or None; a ValueError names the option."""
-    if text is None:
-        return None
-    try:
-        values = [float(v) for v in text.replace(" ", "").split(",")]
-    except ValueError:
-        values = []
-    if len(values) != n:
-        raise ValueError(f"{option}: expected {n} comma-separated numbers, got {text!r}")
-    return values
 
 
 class _Opt(NamedTuple):
@@ -105,8 +92,8 @@ _WRITE = (
 
 # Values the command line gives in another form than the reader or writer takes.
 _READ_AS = {"tip": str, "layers": lambda layers: list(layers) or None}
-_WRITE_AS = {"frame": lambda text: _numbers(text, 6, "--out-frame"),
-             "faces": lambda text: _numbers(text, 2, "--out-faces")}
+_WRITE_AS = {"frame": lambda text: numbers(text, "--out-frame", 6),
+             "faces": lambda text: numbers(text, "--out-faces", 2)}
 
 
 def _given(table: tuple[_Opt, ...], values: dict[str, Any], prefix: str,

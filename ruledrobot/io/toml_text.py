@@ -1,0 +1,42 @@
+"""Writing TOML text: the values and tables of the job files the project writes.
+
+A minimal writer (no third-party dependency: tomli-w is an extra of the batch planner)
+for the flat tables of a job file — numbers, strings, booleans, lists and inline
+tables.  Floats always carry a ``.`` or an exponent (so that TOML reads them back as
+floats), rounded to 12 decimals; numpy scalars and arrays are written as numbers and
+lists.  Used by carve's jobs and the kerf ladder's.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+__all__ = ["toml_table", "toml_value"]
+
+
+def toml_value(v: Any) -> str:
+    """``v`` as a TOML value (module doc); ValueError for a type TOML cannot hold here."""
+    if isinstance(v, (bool, np.bool_)):
+        return "true" if v else "false"
+    if isinstance(v, (int, np.integer)):
+        return str(int(v))
+    if isinstance(v, (float, np.floating)):
+        r = repr(round(float(v), 12) + 0.0)
+        return r if "." in r or "e" in r or "inf" in r or "nan" in r else r + ".0"
+    if isinstance(v, str):
+        return '"' + v.replace("\\", "\\\\").replace('"', '\\"') + '"'
+    if isinstance(v, np.ndarray):
+        v = v.tolist()
+    if isinstance(v, (list, tuple)):
+        return "[" + ", ".join(toml_value(x) for x in v) + "]"
+    if isinstance(v, dict):
+        return "{ " + ", ".join(f"{k} = {toml_value(x)}" for k, x in v.items()) + " }"
+    raise ValueError(f"cannot write {type(v).__name__} to TOML")
+
+
+def toml_table(name: str, table: dict[str, Any], header: str = "[{}]") -> list[str]:
+    """The lines of the table ``name`` (``header`` ``"[[{}]]"`` for an array entry), one
+    ``key = value`` each, and a blank line."""
+    return [header.format(name), *(f"{k} = {toml_value(v)}" for k, v in table.items()), ""]
