@@ -16,8 +16,9 @@ is ``e_i / (1 - h_ii)`` (``h`` the hat matrix's diagonal).
 Good enough (docs/kerf.md, "Calibration"): every constant determined by the design; the
 RMS residual <= :data:`RMS_LIMIT`; every row predicted from the others within
 :data:`HELD_OUT_LIMIT`; each constant's standard error <= :data:`RELATIVE_LIMIT` of its
-value (the threshold's: of the smallest heat above it in the fit, since a threshold near
-zero is no worse known for being small); the constants physical.
+value (the threshold's: of the mean heat above it in the rows fitted, ``mean(p) - p0``,
+the relative error it puts into the melt term ``k (p - p0) / v``; a threshold near zero
+is no worse known for being small); the constants physical.
 
 ``max_speed`` is bracketed, not fitted: a cut that went through bounds it from below by its
 ``v / (p - p0)``, a failed one from above; the largest ratio that cut is written, and only
@@ -185,10 +186,10 @@ def fit_kerf(m: Measured) -> KerfFit:
     r2 = 1.0 - float(resid @ resid) / tss if tss > 0.0 else float("nan")
     with np.errstate(divide="ignore"):
         loo = np.where(lev < 1.0 - 1e-9, resid / (1.0 - lev), np.inf)
-    p_low = float(np.min(p)) - p0
+    p_mean = float(np.mean(p)) - p0
     consts = (Constant("kerf_base", w0, float(np.sqrt(cov[0, 0])), "m", w0),
               Constant("kerf_gain", k, float(np.sqrt(cov[1, 1])), "m^2/s per W/m", k),
-              Constant("power_threshold", p0, sig_p0, "W/m", p_low))  # fmt: skip
+              Constant("power_threshold", p0, sig_p0, "W/m", p_mean))  # fmt: skip
     physical = k > 0.0 and w0 > 0.0 and p0 > -2.0 * sig_p0
     why_not = []
     if k <= 0.0:
@@ -225,7 +226,7 @@ def fit_kerf(m: Measured) -> KerfFit:
     for c in consts:
         checks.append(Check.at_most(
             f"{c.name}_uncertainty", f"standard error of {c.name}"
-            + (" (of the least heat above it)" if c.name == "power_threshold" else ""),
+            + (" (of the mean heat above it)" if c.name == "power_threshold" else ""),
             100.0 * c.relative, 100.0 * RELATIVE_LIMIT, "%",
             f"{c.name} = {c.value:.4g} +- {c.sigma:.2g} {c.unit}: cut more speeds or powers "
             "farther apart, or measure each slot more times"))  # fmt: skip

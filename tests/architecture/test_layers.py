@@ -28,11 +28,14 @@ ALLOWED: dict[str, set[str]] = {
     "batch": {"geometry", "io", "place", "robot", "wirecut"},
     # from a part to its cuts: the planner's top-level names only (tests/carve/test_layer.py)
     "carve": {"geometry", "io", "robot", "subdivision", "wirecut"},
+    # calibrating the kerf model: the ladder's jobs (the planner's top-level names only,
+    # tests/kerf/test_ladder.py) and the fit of what was measured
+    "kerf": {"geometry", "io", "robot", "wirecut"},
     # from a part to programs: carve, plan (the planner's top-level names), export, view
     "make": {"carve", "export", "io", "robot", "view", "wirecut"},
     "cli": {
-        "algorithms", "batch", "carve", "export", "gallery", "geometry", "io", "make", "place",
-        "protocol", "robot", "sim", "subdivision", "ursim", "view", "wirecut",
+        "algorithms", "batch", "carve", "export", "gallery", "geometry", "io", "kerf", "make",
+        "place", "protocol", "robot", "sim", "subdivision", "ursim", "view", "wirecut",
     },
     # the package root re-exports the light lower layers only (``rr.Lines``, ``rr.refine``)
     "": {"algorithms", "geometry", "io", "subdivision"},
