@@ -34,7 +34,7 @@ from typing import Any
 import numpy as np
 
 from ..geometry import se3
-from ..geometry.lines import Lines, plucker_from_point_direction
+from ..geometry.lines import Lines
 from ..io.atomic import atomic_write_text
 from ..io.lines import save_lines
 from ..io.outdir import StagedFolder
@@ -194,13 +194,17 @@ def write_ladder(job_file: str | os.PathLike[str], out: str | os.PathLike[str],
     size = job.stock.size
     n = v.size * p.size
     if spacing is None:
-        spacing = min(SPACING_MAX, np.floor(size[across] / (n + 1) * 1e3) * 1e-3)
-    if spacing < SPACING_MIN or (n + 1) * spacing > size[across] + 1e-12:
-        raise ValueError(f"{where}: [stock] size: {n} cuts {spacing * 1e3:g} mm apart (at "
-                         f"least {SPACING_MIN * 1e3:g} mm, so that kerfs do not merge and "
-                         f"slices stand) need {(n + 1) * spacing * 1e3:g} mm along the "
-                         f"block's {_AXES[across]}; it is {size[across] * 1e3:g} mm: "
-                         "fewer speeds or powers, or a longer block")  # fmt: skip
+        spacing = float(np.clip(np.floor(size[across] / (n + 1) * 1e3) * 1e-3, SPACING_MIN,
+                                SPACING_MAX))  # fmt: skip
+    if spacing < SPACING_MIN:
+        raise ValueError(f"--spacing: {spacing * 1e3:g} mm; expected at least "
+                         f"{SPACING_MIN * 1e3:g} mm, so that kerfs do not merge and the "
+                         "slices stand")  # fmt: skip
+    if (n + 1) * spacing > size[across] + 1e-12:
+        raise ValueError(f"{where}: [stock] size: {n} cuts {spacing * 1e3:g} mm apart need "
+                         f"{(n + 1) * spacing * 1e3:g} mm along the block's {_AXES[across]}; "
+                         f"it is {size[across] * 1e3:g} mm: fewer speeds or powers, a "
+                         "smaller --spacing or a longer block")  # fmt: skip
     offsets = (np.arange(n) - 0.5 * (n - 1)) * spacing
     cuts = tuple(LadderCut(f"cut{k + 1}_{v[k % v.size] * 1e3:g}mm_s", f"power{k // v.size + 1}",
                            float(v[k % v.size]), float(p[k // v.size]), float(offsets[k]))
@@ -236,8 +240,7 @@ def write_ladder(job_file: str | os.PathLike[str], out: str | os.PathLike[str],
                 base = c + cut.offset * R[:, across]
                 h = 0.5 * size[up] + 0.001  # from just above the block to just below
                 pts = base + np.outer(np.linspace(h, -h, RULINGS), e_up)
-                lines = Lines(plucker_from_point_direction(pts, np.tile(R[:, wire],
-                                                                        (RULINGS, 1))))
+                lines = Lines.from_point_direction(pts, np.tile(R[:, wire], (RULINGS, 1)))
                 save_lines(folder / f"{cut.name}.json", lines)
                 text += toml_table("cut", {"name": cut.name, "feed_speed": cut.speed,
                                            **fields}, "[[{}]]")  # fmt: skip
