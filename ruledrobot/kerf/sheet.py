@@ -58,8 +58,8 @@ def sheet_text(ladder: Any, job_file: Path) -> str:
         "gauges), each across the slot, square to its faces:",
         "",
         "- three on the top face, at a quarter, half and three quarters of the slot's "
-        f"length along {wa} (not within 20 mm of the block's edges, where the wire enters "
-        "hotter),",
+        f"length along {wa} (not within 20 mm of the block's edges: the wire's ends, in "
+        "the air, run at another temperature than its middle in the foam),",
         "- one at mid-height on each of the two end faces where the slot comes out.",
         "",
         "Write their mean in `kerf_mm` (mm, two decimals). When the readings of a slot "
