@@ -14,6 +14,7 @@ import numpy as np
 
 from ..geometry import se3
 from ..geometry.checks import FloatArray
+from ..geometry.rotations import angle_between
 from ..io.atomic import atomic_open, atomic_write_json
 from ..robot.arm.model import RobotModel
 from ..robot.motion.rates import RATIO_MAX
@@ -92,8 +93,7 @@ class PlaybackResult:
 
     def tcp_orientation_error(self) -> FloatArray:
         """(M,) rotation angle between simulated and reference TCP frames [rad]."""
-        R = np.einsum("nji,njk->nik", self.tcp_ref[:, :3, :3], self.tcp[:, :3, :3])
-        return np.linalg.norm(se3.rotvec_from_matrix(R), axis=-1)
+        return angle_between(self.tcp_ref, self.tcp)
 
     def verdict(self) -> Verdict:
         """The playback's checks: collisions, joint positions, speeds and torques of the
