@@ -31,9 +31,8 @@ import numpy as np
 from ..geometry._arrays import FloatArray
 from ..geometry.box import Box
 from ..geometry.interp import interp_linear
-from ..geometry.se3 import transform_points
 from ..robot.motion.trajectory import CUTTING_PHASES
-from ..robot.wire.in_stock import chord_fractions, wire_in_stock
+from ..robot.wire.in_stock import chord_fractions, flange_wire_ends, wire_in_stock
 
 __all__ = ["CutAnnotator", "phase_labels"]
 
@@ -112,8 +111,7 @@ class CutAnnotator:
                                   0.5 * length], axis=1)  # fmt: skip
         # feed at every sample (forward kinematics of the samples), then at the frames
         flange = dataclasses.replace(scene.robot, tool=np.eye(4)).fk(q)
-        w = np.stack([scene.tool.wire_start, scene.tool.wire_end])
-        all_ends = transform_points(flange, w)
+        all_ends = flange_wire_ends(flange, scene.tool)
         feed = wire_in_stock(t, all_ends, self.stock).feed
         k = np.clip(np.searchsorted(t, times - 1e-9), 0, t.size - 1)
         self.feed = feed[k]

@@ -40,6 +40,7 @@ from numpy.typing import ArrayLike
 from ...geometry.box import Box
 from ...geometry.ranges import runs_of
 from .._checks import FloatArray
+from ..tool import BowTool
 
 __all__ = [
     "TOUCH",
@@ -47,6 +48,7 @@ __all__ = [
     "across_speeds",
     "chord_fractions",
     "feed_chord",
+    "flange_wire_ends",
     "largest_line_distance",
     "wire_ends",
     "wire_gap",
@@ -81,6 +83,15 @@ def wire_ends(tcp: ArrayLike, wire_length: float) -> FloatArray:
     half = 0.5 * float(wire_length) * T[..., :3, 2]
     p = T[..., :3, 3]
     return np.stack([p - half, p + half], axis=-2)
+
+
+def flange_wire_ends(flange: ArrayLike, bow: BowTool) -> FloatArray:
+    """Wire ends (M, 2, 3) of flange poses (M, 4, 4) that carry ``bow``: :func:`wire_ends`
+    of the wire frames ``flange @ W`` (:meth:`~ruledrobot.robot.tool.BowTool.wire_frame`),
+    i.e. the bow's ``wire_start`` and ``wire_end`` carried by each flange pose.  The one
+    derivation of the wire from the arm (the planner, the playback's contacts and video,
+    the viewer); the ends are in the flange poses' frame (base or world)."""
+    return wire_ends(np.asarray(flange, dtype=np.float64) @ bow.wire_frame(), bow.wire_length)
 
 
 def chord_fractions(

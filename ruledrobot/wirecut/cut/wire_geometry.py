@@ -29,7 +29,12 @@ from ...geometry import se3
 from ...geometry.box import Box
 from ...geometry.checks import FloatArray
 from ...robot.tool import BowTool
-from ...robot.wire.in_stock import across_speeds, feed_chord, largest_line_distance, wire_ends
+from ...robot.wire.in_stock import (
+    across_speeds,
+    feed_chord,
+    flange_wire_ends,
+    largest_line_distance,
+)
 from ..job.spec import ToolSpec
 
 __all__ = [
@@ -164,7 +169,7 @@ def speed_factor(
     job's spec or the bow built from it.
     """
     bow = BowTool.of(tool)
-    ends = wire_ends(np.asarray(flange, dtype=np.float64) @ bow.wire_frame(), bow.wire_length)
+    ends = flange_wire_ends(flange, bow)
     f = feed_chord(ends, stock, near)
     if len(ends) < 2:
         return np.zeros(len(ends))

@@ -30,7 +30,7 @@ from ...robot.arm.model import RobotModel
 from ...robot.arm.nearest import nearest_ik
 from ...robot.motion.trajectory import HEATED_PHASES
 from ...robot.tool import BowTool
-from ...robot.wire.in_stock import WireInStock, wire_ends, wire_gap, wire_in_stock
+from ...robot.wire.in_stock import WireInStock, flange_wire_ends, wire_gap, wire_in_stock
 from ..cut.clearance import Cell
 from ..cut.passes import CutPath
 from ..cut.wire_geometry import speed_factor
@@ -208,7 +208,7 @@ def feed_param(
     step0 = np.maximum(step0, 1e-9)  # strictly increasing, also where the wire holds still
     s0 = np.r_[0.0, np.cumsum(step0)]
     bow = BowTool.of(job.tool if bow is None else bow)
-    ends = wire_ends(cp.motion.flange @ bow.wire_frame(), bow.wire_length)
+    ends = flange_wire_ends(cp.motion.flange, bow)
     step = np.empty_like(step0)
     cuts = [0, *(int(c) for c in corner_nodes(F, 0.5 * job.tool.wire_length)), len(F) - 1]
     for a, b in pairwise(cuts):  # between corners: differences never reach across one
@@ -231,7 +231,7 @@ def measure_wire(
     times ``t`` (M,) (``model``: the planner's, flange without tool, base frame; ``bow``:
     the job's, when the caller built it)."""
     bow = BowTool.of(job.tool if bow is None else bow)
-    ends = wire_ends(model.fk(q) @ bow.wire_frame(), bow.wire_length)
+    ends = flange_wire_ends(model.fk(q), bow)
     return wire_in_stock(t, ends, job.stock)
 
 
