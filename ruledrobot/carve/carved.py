@@ -213,7 +213,7 @@ def _grid_kept(cut: CarveCut, stock: Box, resolution: float):
     from ..subdivision import subdivide
     from ..wirecut import part_sdf, stock_mesh
 
-    grown = Box(stock.centre, stock.size + 2 * GRID_REACH * resolution, stock.rotation)
+    grown = stock.grown(GRID_REACH * resolution)
     fine = subdivide(cut.lines, scheme="four_point", steps=STEPS, closed=cut.closed)
     passes = (SurfacePass(cut.name, ruling_frames(fine, stock.centre), cut.closed),)
     job = _Job((_Cut(cut.name, cut.keep),), grown)

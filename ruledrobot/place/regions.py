@@ -249,8 +249,7 @@ def transforms(job: Job, xyz: FloatArray, move: str, turn: Turn = AS_CLAMPED) ->
 def moved_job(job: Job, T: FloatArray) -> Job:
     """The job with its block moved by T (4, 4): the stock, every cut's surface pose and
     keep point (in memory; :mod:`.job_file` writes it)."""
-    st = job.stock
-    stock = Box(T[:3, :3] @ st.centre + T[:3, 3], st.size, T[:3, :3] @ st.rotation)
+    stock = job.stock.moved(T)
     cuts = []
     for cut in job.cuts:
         keep = cut.keep

@@ -57,13 +57,6 @@ def phase_labels(phases: Any, n: int) -> np.ndarray | None:
     return labels
 
 
-def _stock_in_world(scene: Any) -> Box:
-    base = np.asarray(scene.robot.base)
-    R, p = base[:3, :3], base[:3, 3]
-    s = scene.stock
-    return Box(centre=R @ s.centre + p, size=s.size, rotation=R @ s.rotation)
-
-
 class CutAnnotator:
     """Annotated frames of a motion (see the module doc); a context manager.
 
@@ -79,7 +72,7 @@ class CutAnnotator:
         mj = self.mj = renderer._mj
         scene = renderer.scene
         model = renderer.model
-        self.stock = _stock_in_world(scene)
+        self.stock: Box = scene.stock.moved(scene.robot.base)  # in the world frame
         # wire ends at the frames, from MuJoCo's sites
         s0 = mj.mj_name2id(model, mj.mjtObj.mjOBJ_SITE, "wire_start")
         s1 = mj.mj_name2id(model, mj.mjtObj.mjOBJ_SITE, "wire_end")

@@ -212,8 +212,7 @@ def build_scene(
     ids = np.array([g.geom_id for g in geoms], dtype=int)
     base = np.asarray(robot.base)
     R, p = base[:3, :3], base[:3, 3]
-    stock = Box(centre=R @ job.stock.centre + p, size=job.stock.size,
-                rotation=R @ job.stock.rotation)  # fmt: skip
+    stock = job.stock.moved(base)
 
     rulings = np.zeros((0, 2, 3))
     if folder.rulings is not None:

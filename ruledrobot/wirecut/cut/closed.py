@@ -108,7 +108,7 @@ def _slit(frame: FloatArray, direction: FloatArray, stock: Box, lead: float,
     slit's outer end, so that the wire's angular velocity, like its velocity, is
     continuous where the slit meets the loop (a jump there jumps the joint rates and the
     feed with them)."""
-    grown = Box(stock.centre, stock.size + 2.0 * lead, stock.rotation)
+    grown = stock.grown(lead)
     o, z = frame[:3, 3], frame[:3, 2]
     dist = _clear_distance(grown, o, z, direction)
     n = max(2, int(np.ceil(dist / SLIT_STEP)) + 1)

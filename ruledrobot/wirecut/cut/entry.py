@@ -99,7 +99,7 @@ def _move(ends: FloatArray, step: FloatArray, stock: Box) -> FloatArray:
     if not (h > 0.0).any():
         raise ValueError("the profile's end rulings coincide: no direction to enter along")
     u = step / np.where(h > 0.0, h, 1.0)[:, None]  # an end that does not move stays
-    grown = Box(stock.centre, stock.size + 2.0 * CLEAR, stock.rotation)
+    grown = stock.grown(CLEAR)
     k = np.arange(1, MAX_RULINGS + 1)
     s = np.cumsum(GROWTH ** (k - 1))  # in units of the end step
     pts = ends[None] + s[:, None, None] * h[None, :, None] * u[None]

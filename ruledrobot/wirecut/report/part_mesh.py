@@ -71,7 +71,7 @@ def _surface_samples(
     midpoints of the whole cut (an arc's own centroid can lie near the arc)."""
     whole = len(passes) == 1
     arcs = []
-    grown = Box(stock.centre, stock.size + 0.004, stock.rotation)
+    grown = stock.grown(0.002)
     for cp in passes:
         S = cp.target_frames
         if cp.closed:
