@@ -185,8 +185,10 @@ def path_steps(
     blend: float = PATH_BLEND,
     min_dwell: float = 0.05,
 ) -> tuple[PathStep, ...]:
-    """The steps of a path program playing the plan's samples — TCP ``tcp`` (M, 6), joints
-    ``q`` (M, 6) at times ``t`` (M,) — as planned: nothing of the plan's motion is merged.
+    """The steps of a path program playing the plan's samples.
+
+    TCP ``tcp`` (M, 6), joints ``q`` (M, 6) at times ``t`` (M,) — as planned: nothing of the
+    plan's motion is merged.
 
     * every sample of ``boundaries`` (phase starts and ends, the wire entering and leaving
       the stock) and every heat switch (``heat`` (M,) bool) is a waypoint, so no move

@@ -63,8 +63,9 @@ class Box:
 
     @property
     def corners(self) -> FloatArray:
-        """The 8 corners (8, 3) in world coordinates [m]; corner ``4i + 2j + k`` lies at
-        ``(i, j, k)`` of the box axes' (low, high) halves."""
+        """The 8 corners (8, 3) in world coordinates [m].
+
+        Corner ``4i + 2j + k`` lies at ``(i, j, k)`` of the box axes' (low, high) halves."""
         return self.centre + (_UNIT_CORNERS * self.size) @ self.rotation.T
 
     @property
@@ -73,9 +74,10 @@ class Box:
         return self.corners[_EDGES]
 
     def moved(self, T: ArrayLike) -> Box:
-        """The box carried by the rigid motion ``T`` (4, 4): centre ``R c + p``, axes
-        ``R rotation``, the same size (a block placed elsewhere, the stock of a job
-        file seen from the world frame of a robot base ``T``)."""
+        """The box carried by the rigid motion ``T`` (4, 4).
+
+        Centre ``R c + p``, axes ``R rotation``, the same size (a block placed elsewhere, the
+        stock of a job file seen from the world frame of a robot base ``T``)."""
         T = as_float_array(T, "T")
         if T.shape != (4, 4):
             raise ValueError(f"T: expected a pose (4, 4), got shape {T.shape}")

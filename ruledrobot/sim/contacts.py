@@ -42,8 +42,10 @@ class Collision:
     depth: float
 
     def as_dict(self) -> dict[str, Any]:
-        """The event for a report: ``start_s``, ``end_s`` [s], the geom and body names, and
-        ``max_depth_mm`` the deepest penetration [mm]."""
+        """The event for a report.
+
+        ``start_s``, ``end_s`` [s], the geom and body names, and ``max_depth_mm`` the deepest
+        penetration [mm]."""
         return {
             "start_s": self.start,
             "end_s": self.end,

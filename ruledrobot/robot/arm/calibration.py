@@ -219,9 +219,9 @@ class Calibration:
         return np.stack([self.theta_offset, self.a, self.d, self.alpha], axis=1)
 
     def deltas(self) -> FloatArray:
-        """(6, 4) effective minus nominal ``[theta_offset, a, d, alpha]`` (angles not
-        wrapped): what a controller's ``calibration.conf`` calls ``delta_theta`` ...
-        ``delta_alpha``."""
+        """(6, 4) effective minus nominal ``[theta_offset, a, d, alpha]`` (angles not wrapped).
+
+        What a controller's ``calibration.conf`` calls ``delta_theta`` ... ``delta_alpha``."""
         m = _nominal_model(self.model)
         return self.dh() - np.stack([m.theta_offset, m.a, m.d, m.alpha], axis=1)
 

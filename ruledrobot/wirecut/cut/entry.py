@@ -60,9 +60,10 @@ MAX_RULINGS = 60
 
 @dataclass(frozen=True)
 class ProfileEntry:
-    """The profile's rulings with their moves: ``lines`` (N + before + after),
-    ``before`` rulings of the entry move ahead of the profile's first and ``after`` of
-    the exit move past its last."""
+    """The profile's rulings with their moves.
+
+    ``lines`` (N + before + after), ``before`` rulings of the entry move ahead of the profile's
+    first and ``after`` of the exit move past its last."""
 
     lines: Lines
     before: int

@@ -51,10 +51,11 @@ __all__ = [
 
 
 def wire_frame(tool: ToolSpec | BowTool) -> FloatArray:
-    """The wire frame W (4, 4) in the flange frame (see the module doc): origin at the
-    wire midpoint, z along the wire, x the bow's depth direction
-    (:meth:`ruledrobot.robot.tool.BowTool.wire_frame`); ``tool`` the job's spec or the
-    bow built from it."""
+    """The wire frame W (4, 4) in the flange frame (see the module doc).
+
+    Origin at the wire midpoint, z along the wire, x the bow's depth direction
+    (:meth:`ruledrobot.robot.tool.BowTool.wire_frame`); ``tool`` the job's spec or the bow
+    built from it."""
     return BowTool.of(tool).wire_frame()
 
 
@@ -117,9 +118,10 @@ def world_referenced(F: FloatArray) -> FloatArray:
 def slide_bounds(
     c0: FloatArray, c1: FloatArray, hit: np.ndarray, tool: ToolSpec
 ) -> tuple[FloatArray, FloatArray, np.ndarray]:
-    """Slides ``lo <= s <= hi`` (M,) for which the wire covers each chord with the
-    clearance; ``(-inf, inf)`` where the ruling misses the stock.  ``ok`` is False
-    where the chord is longer than the wire allows."""
+    """Slides ``lo <= s <= hi`` (M,) for which the wire covers each chord with the clearance.
+
+    ``(-inf, inf)`` where the ruling misses the stock. ``ok`` is False where the chord is
+    longer than the wire allows."""
     half = 0.5 * tool.wire_length - tool.clearance
     lo = np.where(hit, c1 - half, -np.inf)
     hi = np.where(hit, c0 + half, np.inf)
@@ -142,8 +144,9 @@ def _rz_tz(psi: FloatArray, s: FloatArray, reverse: FloatArray | bool) -> FloatA
 def wire_poses(
     frames: ArrayLike, roll: ArrayLike, slide: ArrayLike, reverse: ArrayLike | bool = False
 ) -> FloatArray:
-    """Wire poses ``G = F Rz(roll) Tz(slide) [Rx(pi)]``: frames (M, 4, 4), roll and
-    slide broadcast to (..., M) -> (..., M, 4, 4)."""
+    """Wire poses ``G = F Rz(roll) Tz(slide) [Rx(pi)]``.
+
+    Frames (M, 4, 4), roll and slide broadcast to (..., M) -> (..., M, 4, 4)."""
     F = np.asarray(frames, dtype=np.float64)
     psi, s = np.broadcast_arrays(np.asarray(roll, float), np.asarray(slide, float))
     return F @ _rz_tz(psi, s, reverse)

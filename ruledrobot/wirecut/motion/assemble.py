@@ -184,12 +184,14 @@ def _across(p: FloatArray, o: FloatArray, z: FloatArray) -> FloatArray:
 def feed_param(
     job: Job, cp: CutPath, feed_speed: float, bow: BowTool | None = None
 ) -> tuple[FloatArray, float]:
-    """(M,) the path parameter the feed is held in, and ``near`` (m): the distance [m]
-    travelled across the wire by the part of it nearest the block — the chord's ends
-    inside it — as the speed factor measures it (:func:`~..cut.wire_geometry.speed_factor`, the
-    one model); ``near``: how far out of the block the time law bounds that part's
-    speed: :data:`FEED_NEAR`, or farther so that the bound reaches three rulings beyond
-    every entry and exit and the wire moves at the feed for :data:`SETTLE_S` before it.
+    """(M,) the path parameter the feed is held in, and ``near`` (m).
+
+    The distance [m] travelled across the wire by the part of it nearest the block — the
+    chord's ends inside it — as the speed factor measures it
+    (:func:`~..cut.wire_geometry.speed_factor`, the one model); ``near``: how far out of the
+    block the time law bounds that part's speed: :data:`FEED_NEAR`, or farther so that the
+    bound reaches three rulings beyond every entry and exit and the wire moves at the feed for
+    :data:`SETTLE_S` before it.
 
     First the frame origins' travel across the wire ``s0``; then each interval's length
     is the mean speed factor at its ends (per unit of ``s0``) times its ``s0`` length,

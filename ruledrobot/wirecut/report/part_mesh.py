@@ -246,8 +246,9 @@ def _grid_step(world: FloatArray, shape: tuple[int, ...]) -> float | None:
 def part_mesh(
     job: Job, passes: tuple[CutPath, ...], resolution: float = RESOLUTION
 ) -> Mesh | None:
-    """The part's closed triangle mesh in the base frame [m] (module doc); None when no
-    cut names its kept side or nothing of the stock is kept."""
+    """The part's closed triangle mesh in the base frame [m] (module doc).
+
+    None when no cut names its kept side or nothing of the stock is kept."""
     if all(c.keep is None for c in job.cuts):
         return None
     return stock_mesh(job.stock, resolution,
