@@ -39,10 +39,12 @@ PLAN_OPTIONS = {"simulate": True, "video": False}
 
 @dataclass(frozen=True)
 class CodeIdentity:
-    """The code that plans: ``version`` of ruledrobot, ``sources`` the SHA-256 of the
-    ``.py`` files of :data:`PLANNING_CODE` (relative path and bytes, sorted), ``commit``
-    the git commit of the checkout it runs from (None when it is not one).  ``id`` is
-    what jobs are hashed with and what every worker must match."""
+    """The code that plans.
+
+    ``version`` of ruledrobot, ``sources`` the SHA-256 of the ``.py`` files of
+    :data:`PLANNING_CODE` (relative path and bytes, sorted), ``commit`` the git commit of the
+    checkout it runs from (None when it is not one). ``id`` is what jobs are hashed with and
+    what every worker must match."""
 
     version: str
     sources: str
@@ -54,8 +56,9 @@ class CodeIdentity:
         return f"{self.version}+{self.sources[:16]}"
 
     def as_dict(self) -> dict[str, str | None]:
-        """The identity as a JSON-ready dict: ``id``, ``version``, ``sources_sha256``,
-        ``commit``."""
+        """The identity as a JSON-ready dict.
+
+        ``id``, ``version``, ``sources_sha256``, ``commit``."""
         return {"id": self.id, "version": self.version, "sources_sha256": self.sources,
                 "commit": self.commit}  # fmt: skip
 
@@ -99,9 +102,11 @@ def code_identity() -> CodeIdentity:
 
 @dataclass(frozen=True)
 class InputFile:
-    """An input file a job names: ``named`` as written in the job, ``path`` where it is
-    on this machine (absolute, normalised), ``sha256`` of its bytes (None: cannot be
-    read), ``data`` the bytes when they were kept (:func:`read_content`)."""
+    """An input file a job names.
+
+    ``named`` as written in the job, ``path`` where it is on this machine (absolute,
+    normalised), ``sha256`` of its bytes (None: cannot be read), ``data`` the bytes when they
+    were kept (:func:`read_content`)."""
 
     named: str
     path: Path
@@ -111,9 +116,11 @@ class InputFile:
 
 @dataclass(frozen=True)
 class JobContent:
-    """A job read for planning: ``text`` the effective job's bytes (None when the job
-    file cannot be read or is not valid TOML: ``error`` says why, a bad input found
-    without planning), its input files, and ``digest``, the content hash."""
+    """A job read for planning.
+
+    ``text`` the effective job's bytes (None when the job file cannot be read or is not valid
+    TOML: ``error`` says why, a bad input found without planning), its input files, and
+    ``digest``, the content hash."""
 
     entry: JobEntry
     text: bytes | None
@@ -128,9 +135,10 @@ class JobContent:
 
 
 def resolve_input(named: str, job_path: Path) -> Path:
-    """Where an input file named ``named`` by the job file at ``job_path`` (absolute)
-    is: relative paths from the job's folder, normalised
-    (:func:`ruledrobot.io.paths.input_path`, the one rule of every format)."""
+    """Where an input file named ``named`` by the job file at ``job_path`` (absolute) is.
+
+    Relative paths from the job's folder, normalised (:func:`ruledrobot.io.paths.input_path`,
+    the one rule of every format)."""
     return input_path(named, job_path.parent)
 
 

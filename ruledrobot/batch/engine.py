@@ -63,8 +63,10 @@ def _distributed():
 
 
 def default_workers() -> int:
-    """Worker processes for this machine: its usable cores, fewer when the available
-    memory cannot give each :data:`WORKER_MEMORY`; at least one."""
+    """Worker processes for this machine.
+
+    Its usable cores, fewer when the available memory cannot give each :data:`WORKER_MEMORY`;
+    at least one."""
     try:
         cores = len(os.sched_getaffinity(0))
     except AttributeError:  # pragma: no cover - not Linux
@@ -86,9 +88,10 @@ WORKER_MALLOC = {"MALLOC_TRIM_THRESHOLD_": 256 << 20, "MALLOC_MMAP_THRESHOLD_": 
 
 
 def local_cluster(workers: int, quiet: bool = True):
-    """A ``LocalCluster`` for planning: ``workers`` single-threaded processes on
-    loopback (with :data:`WORKER_MALLOC`), a job whose worker died reported at once
-    (the batch retries it), no dashboard."""
+    """A ``LocalCluster`` for planning.
+
+    ``workers`` single-threaded processes on loopback (with :data:`WORKER_MALLOC`), a job whose
+    worker died reported at once (the batch retries it), no dashboard."""
     distributed = _distributed()
     import dask
 
@@ -102,10 +105,11 @@ def local_cluster(workers: int, quiet: bool = True):
 
 
 class Engine:
-    """A Dask client for the batch: use as a context manager (closes the client, and the
-    local cluster it started).  ``workers``: processes of the local cluster (default
-    :func:`default_workers`); ``scheduler``: address of a running scheduler instead;
-    ``timeout``: seconds to reach it."""
+    """A Dask client for the batch.
+
+    Use as a context manager (closes the client, and the local cluster it started).
+    ``workers``: processes of the local cluster (default :func:`default_workers`);
+    ``scheduler``: address of a running scheduler instead; ``timeout``: seconds to reach it."""
 
     def __init__(self, workers: int | None = None, scheduler: str | None = None,
                  timeout: float = 10.0, quiet: bool = True) -> None:  # fmt: skip
@@ -172,15 +176,18 @@ class Engine:
         return sum(self.client.nthreads().values())
 
     def slots(self, threads: int | None = None) -> int:
-        """Jobs to keep in flight: one per worker thread, at least 1 (a job then waits
-        for the first worker of a cluster that has none yet)."""
+        """Jobs to keep in flight.
+
+        One per worker thread, at least 1 (a job then waits for the first worker of a cluster
+        that has none yet)."""
         return max(1, self.threads() if threads is None else threads)
 
     def heal(self, threads: int) -> None:
-        """Local cluster: start workers in place of lost ones.  A nanny restarts a dead
-        worker; one that stayed away longer than ``distributed.deploy.lost-worker-timeout``
-        (15 s: a slow start on a loaded machine) is dropped by the cluster for good, and
-        ``scale`` starts it again."""
+        """Local cluster: start workers in place of lost ones.
+
+        A nanny restarts a dead worker; one that stayed away longer than
+        ``distributed.deploy.lost-worker-timeout`` (15 s: a slow start on a loaded machine) is
+        dropped by the cluster for good, and ``scale`` starts it again."""
         if self.cluster is not None and threads < self.workers:
             try:
                 self.cluster.scale(self.workers)
@@ -195,8 +202,10 @@ class Engine:
             return None
 
     def describe(self) -> dict[str, Any]:
-        """How the batch runs: ``kind`` local or cluster, scheduler address, workers,
-        threads, the scheduler's allowed failures."""
+        """How the batch runs.
+
+        ``kind`` local or cluster, scheduler address, workers, threads, the scheduler's allowed
+        failures."""
         info = self.client.scheduler_info()
         workers = info.get("workers", {})
         return {
@@ -210,8 +219,9 @@ class Engine:
 
     @property
     def client_retries(self) -> int:
-        """How often the batch dispatches a job again after its worker died: once when
-        the scheduler does not retry (``allowed_failures=0``), else never."""
+        """How often the batch dispatches a job again after its worker died.
+
+        Once when the scheduler does not retry (``allowed_failures=0``), else never."""
         return 1 if self.allowed_failures == 0 else 0
 
     def submit(self, fn: Callable[..., Any], arg: Any, key: str):

@@ -78,8 +78,10 @@ class JobEntry:
 
     @property
     def label(self) -> str:
-        """The job file's path; ``<job list>#<name>`` for a job changed by overrides (no
-        file holds its text: the output folder's ``job.toml`` does)."""
+        """The job file's path.
+
+        ``<job list>#<name>`` for a job changed by overrides (no file holds its text: the
+        output folder's ``job.toml`` does)."""
         if not self.overrides:
             return str(self.path)
         return f"{self.job_list}#{self.name}"
@@ -211,10 +213,11 @@ def _from_path(path: Path, where: str) -> list[JobEntry]:
 
 
 def find_jobs(args: Sequence[str | Path], exclude: Path | None = None) -> tuple[JobEntry, ...]:
-    """The jobs named by ``args`` (job files, globs, job lists), in order; see the module
-    doc.  Globs on the command line match nothing under ``exclude`` (the batch's output
-    folder).  BatchInputError when an argument names nothing, a list is unreadable, no
-    job is found, or two jobs would share an output folder."""
+    """The jobs named by ``args`` (job files, globs, job lists), in order; see the module doc.
+
+    Globs on the command line match nothing under ``exclude`` (the batch's output folder).
+    BatchInputError when an argument names nothing, a list is unreadable, no job is found, or
+    two jobs would share an output folder."""
     entries: list[JobEntry] = []
     for arg in args:
         text = str(arg)

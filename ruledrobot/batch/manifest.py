@@ -106,8 +106,9 @@ class JobRecord:
         return self.status in ("infeasible", "bad_input", "crashed")
 
     def as_dict(self) -> dict[str, Any]:
-        """The record as a JSON-ready dict: its fields (tuples as lists) plus ``worst_check``
-        and ``worst_margin``."""
+        """The record as a JSON-ready dict.
+
+        Its fields (tuples as lists) plus ``worst_check`` and ``worst_margin``."""
         d = asdict(self)
         d["failed_checks"] = list(self.failed_checks)
         d["files"] = list(self.files)
@@ -116,8 +117,10 @@ class JobRecord:
 
     @classmethod
     def from_dict(cls, d: dict[str, Any]) -> JobRecord:
-        """The record of a dict written by :meth:`as_dict`; keys that are not fields (the
-        derived ``worst_check`` / ``worst_margin``, or unknown ones) are ignored."""
+        """The record of a dict written by :meth:`as_dict`.
+
+        Keys that are not fields (the derived ``worst_check`` / ``worst_margin``, or unknown
+        ones) are ignored."""
         known = {f.name for f in fields(cls)}
         kw = {k: v for k, v in d.items() if k in known}
         kw["failed_checks"] = tuple(kw.get("failed_checks") or ())
@@ -144,9 +147,10 @@ def figures_of(report: dict[str, Any]) -> tuple[dict[str, Any], dict[str, float]
 
 
 def resumable(record: JobRecord | None, digest: str, out: Path) -> bool:
-    """Whether a rerun may keep ``record`` for a job whose content hash is ``digest``:
-    same hash, a final status, and (planned jobs) the folder's completion marker and
-    every file the record lists still there (sizes and checksums are not re-read)."""
+    """Whether a rerun may keep ``record`` for a job whose content hash is ``digest``.
+
+    Same hash, a final status, and (planned jobs) the folder's completion marker and every file
+    the record lists still there (sizes and checksums are not re-read)."""
     if record is None or record.hash != digest or record.status not in FINAL:
         return False
     if record.status == "bad_input":
@@ -157,7 +161,8 @@ def resumable(record: JobRecord | None, digest: str, out: Path) -> bool:
 
 
 def load_records(out: Path) -> dict[str, JobRecord]:
-    """The records of an earlier run in ``out`` by job name (none: no ``batch.json``);
+    """The records of an earlier run in ``out`` by job name (none: no ``batch.json``).
+
     BatchInputError when ``batch.json`` is there but is not a batch manifest."""
     path = out / BATCH_JSON
     if not path.exists():
@@ -198,8 +203,9 @@ def _csv_text(records: list[JobRecord]) -> str:
 
 def write_manifest(out: Path, records: list[JobRecord], earlier: list[JobRecord],
                    run: dict[str, Any]) -> Path:  # fmt: skip
-    """Write ``batch.json`` and ``batch.csv`` into ``out`` (each atomically): ``records``
-    the jobs of this run in order, ``earlier`` records of jobs of earlier runs that
+    """Write ``batch.json`` and ``batch.csv`` into ``out`` (each atomically).
+
+    ``records`` the jobs of this run in order, ``earlier`` records of jobs of earlier runs that
     this one does not name (their folders are still there), ``run`` how and when."""
     counts = {s: sum(r.status == s for r in records) for s in STATUSES}
     doc = {

@@ -20,8 +20,10 @@ def _clock(seconds: float | None) -> str:
 
 
 def job_line(r: JobRecord) -> str:
-    """One line about a job's result: name, status and why (failing checks, the bad
-    input's message, the crash's last line), the plan's seconds."""
+    """One line about a job's result.
+
+    Name, status and why (failing checks, the bad input's message, the crash's last line), the
+    plan's seconds."""
     lines = r.message.strip().splitlines()
     why = {"feasible": "", "infeasible": ", ".join(r.failed_checks),
            "bad_input": lines[0] if lines else "", "crashed": lines[-1] if lines else "",
@@ -31,8 +33,9 @@ def job_line(r: JobRecord) -> str:
 
 
 class BatchBar:
-    """Progress of a batch on ``console`` (a rich Console): call it with every
-    :class:`~.run.BatchProgress`; :meth:`stop` when the batch ends."""
+    """Progress of a batch on ``console`` (a rich Console).
+
+    Call it with every :class:`~.run.BatchProgress`; :meth:`stop` when the batch ends."""
 
     def __init__(self, console: Any = None) -> None:
         self.console = console

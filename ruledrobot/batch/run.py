@@ -48,11 +48,12 @@ NO_WORKER_S = 120.0
 
 @dataclass(frozen=True)
 class BatchProgress:
-    """Where a batch stands: ``total`` jobs, ``kept`` (earlier results kept),
-    ``to_plan`` (planned by this run), of which ``done`` have a result (``failed``:
-    infeasible, bad input or crashed) and ``running`` are on workers; ``elapsed_s``
-    since the run started; ``last`` the record that just came back; ``workers`` the
-    worker threads the scheduler has (None: not started)."""
+    """Where a batch stands.
+
+    ``total`` jobs, ``kept`` (earlier results kept), ``to_plan`` (planned by this run), of
+    which ``done`` have a result (``failed``: infeasible, bad input or crashed) and ``running``
+    are on workers; ``elapsed_s`` since the run started; ``last`` the record that just came
+    back; ``workers`` the worker threads the scheduler has (None: not started)."""
 
     total: int
     kept: int
@@ -78,9 +79,11 @@ class BatchProgress:
 
 @dataclass(frozen=True)
 class BatchResult:
-    """What :func:`run_batch` did: the records of the batch's jobs in order, how many it
-    planned and kept, whether Ctrl-C stopped it, the engine it ran on, and why it
-    stopped early if it did (``error``: the local cluster lost its workers)."""
+    """What :func:`run_batch` did.
+
+    The records of the batch's jobs in order, how many it planned and kept, whether Ctrl-C
+    stopped it, the engine it ran on, and why it stopped early if it did (``error``: the local
+    cluster lost its workers)."""
 
     out: Path
     records: tuple[JobRecord, ...]

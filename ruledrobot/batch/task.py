@@ -51,11 +51,12 @@ KILL_LOG = "RULEDROBOT_BATCH_TEST_KILL_LOG"
 
 @dataclass(frozen=True)
 class JobTask:
-    """What a worker needs to plan one job: ``label`` the path the reports name,
-    ``job_path`` the job file's absolute path on the client (its folder resolves
-    relative paths) and ``named_path`` that path as the client names it, ``text`` the
-    effective job's bytes, ``inputs`` ``(absolute client path, bytes)`` of every input
-    file that exists, ``code`` the client's code id."""
+    """What a worker needs to plan one job.
+
+    ``label`` the path the reports name, ``job_path`` the job file's absolute path on the
+    client (its folder resolves relative paths) and ``named_path`` that path as the client
+    names it, ``text`` the effective job's bytes, ``inputs`` ``(absolute client path, bytes)``
+    of every input file that exists, ``code`` the client's code id."""
 
     name: str
     label: str
@@ -68,11 +69,12 @@ class JobTask:
 
 @dataclass(frozen=True)
 class TaskResult:
-    """A job's result: ``status`` feasible, infeasible, bad_input or crashed;
-    ``message`` the verdict's summary, the bad input's message or the traceback;
-    ``files`` ``(relative path, bytes)`` of the plan folder without its manifest, and
-    ``info`` what that manifest said beside the files (kind, feasible, verdict);
-    ``plan_s`` seconds the worker took; ``worker`` ``host:pid``."""
+    """A job's result.
+
+    ``status`` feasible, infeasible, bad_input or crashed; ``message`` the verdict's summary,
+    the bad input's message or the traceback; ``files`` ``(relative path, bytes)`` of the plan
+    folder without its manifest, and ``info`` what that manifest said beside the files (kind,
+    feasible, verdict); ``plan_s`` seconds the worker took; ``worker`` ``host:pid``."""
 
     name: str
     status: str

@@ -61,8 +61,10 @@ GRID_REACH = 4
 
 @dataclass(frozen=True)
 class SurfacePass:
-    """What the part model reads of a pass: its ``name``, ``target_frames`` (M, 4, 4)
-    (z along each ruling), ``closed``, ``extended`` (frames added at its ends: none)."""
+    """What the part model reads of a pass.
+
+    Its ``name``, ``target_frames`` (M, 4, 4) (z along each ruling), ``closed``, ``extended``
+    (frames added at its ends: none)."""
 
     name: str
     target_frames: FloatArray = field(repr=False)
@@ -97,11 +99,13 @@ def ruling_frames(lines: Lines, centre: FloatArray) -> FloatArray:
 
 @dataclass(frozen=True)
 class Carved:
-    """The carved block: ``mesh`` (closed, outward, base frame, m; None when nothing is
-    kept), ``method`` ``"boolean"`` (every cut a solid), ``"boolean+grid"`` (the cuts in
-    ``grid`` meshed on the grid, each with why its surface is no solid) or ``"grid"``
-    (the whole block on the grid: ``why``), ``solid_triangles`` the cuts' solids'
-    triangles, ``planes`` the half-spaces intersected, ``resolution`` the grid's step [m]."""
+    """The carved block.
+
+    ``mesh`` (closed, outward, base frame, m; None when nothing is kept), ``method``
+    ``"boolean"`` (every cut a solid), ``"boolean+grid"`` (the cuts in ``grid`` meshed on the
+    grid, each with why its surface is no solid) or ``"grid"`` (the whole block on the grid:
+    ``why``), ``solid_triangles`` the cuts' solids' triangles, ``planes`` the half-spaces
+    intersected, ``resolution`` the grid's step [m]."""
 
     mesh: Mesh | None
     method: str
@@ -213,7 +217,7 @@ def _grid_kept(cut: CarveCut, stock: Box, resolution: float):
     from ..subdivision import subdivide
     from ..wirecut import part_sdf, stock_mesh
 
-    grown = Box(stock.centre, stock.size + 2 * GRID_REACH * resolution, stock.rotation)
+    grown = stock.grown(GRID_REACH * resolution)
     fine = subdivide(cut.lines, scheme="four_point", steps=STEPS, closed=cut.closed)
     passes = (SurfacePass(cut.name, ruling_frames(fine, stock.centre), cut.closed),)
     job = _Job((_Cut(cut.name, cut.keep),), grown)

@@ -57,9 +57,11 @@ _SECTIONS = ("part", "stock", "robot", "tool", "cut")
 
 @dataclass(frozen=True)
 class PartSpec:
-    """The ``[part]`` table: ``file`` (resolved), ``units`` (m, cm, mm, in), ``pose``
-    (4, 4) the part frame in the robot base frame, ``tolerance`` [m], ``rough_cuts``,
-    ``repair`` (mend the mesh as CAD exported it: :mod:`.repair`)."""
+    """The ``[part]`` table.
+
+    ``file`` (resolved), ``units`` (m, cm, mm, in), ``pose`` (4, 4) the part frame in the robot
+    base frame, ``tolerance`` [m], ``rough_cuts``, ``repair`` (mend the mesh as CAD exported
+    it: :mod:`.repair`)."""
 
     file: Path
     units: str
@@ -76,9 +78,11 @@ class PartSpec:
 
 @dataclass(frozen=True)
 class Cell:
-    """A parsed cell file: the part, the block (:class:`~ruledrobot.geometry.box.Box`, base
-    frame), and the job tables as the user wrote them (``tables``: ``stock``, ``robot``,
-    ``tool``, ``cut``; checked), for the jobs carve writes.  ``source``: the cell file."""
+    """A parsed cell file.
+
+    The part, the block (:class:`~ruledrobot.geometry.box.Box`, base frame), and the job tables
+    as the user wrote them (``tables``: ``stock``, ``robot``, ``tool``, ``cut``; checked), for
+    the jobs carve writes. ``source``: the cell file."""
 
     part: PartSpec
     stock: Box
@@ -157,8 +161,9 @@ def absolute_paths(tables: dict[str, Any], base_dir: Path | None) -> dict[str, A
 
 
 def parse_cell(doc: dict, where: str = "cell", base_dir: Path | None = None) -> Cell:
-    """Check a cell file's document (see the module doc); ValueError naming the file, the
-    table and the field."""
+    """Check a cell file's document (see the module doc).
+
+    ValueError naming the file, the table and the field."""
     from ..wirecut import parse_job
 
     extra = sorted(set(doc) - set(_SECTIONS))

@@ -46,8 +46,9 @@ approach_speed = 0.6
 
 def column_mesh(a: float = 0.06, c: float = 0.3, length: float = 0.2, around: int = 64,
                 along: int = 12) -> tuple[FloatArray, FloatArray]:  # fmt: skip
-    """The capped column (module doc) as ``(vertices (V, 3) m, faces (F, 3))``: closed,
-    faces turned outwards; ``around`` points per ring, ``along`` rings."""
+    """The capped column (module doc) as ``(vertices (V, 3) m, faces (F, 3))``.
+
+    Closed, faces turned outwards; ``around`` points per ring, ``along`` rings."""
     u = np.linspace(0.0, 2.0 * np.pi, around, endpoint=False)
     y = np.linspace(-0.5 * length, 0.5 * length, along)
     r = a * np.sqrt(1.0 + y**2 / c**2)

@@ -129,12 +129,13 @@ def _open(fit: Fit, region: Region, stock: Box, d0: FloatArray, p0: FloatArray,
 
 
 def keep_point(region: Region, query: MeshQuery, stock: Box) -> FloatArray | None:
-    """A point (3,) [m] of the part in the block just behind the region's face: the
-    centroid of one of its largest triangles, :data:`KEEP_DEPTHS` in along the
-    triangle's inward normal (the first inside the part, by ray parity, and at least half
-    that depth from its surface); None when there is none.  A triangle's centroid, not a
-    vertex: a vertex lies on the face's rim, and a point below it on the neighbouring face
-    (a cap fanned from a rim vertex) is on the surface, neither inside nor outside."""
+    """A point (3,) [m] of the part in the block just behind the region's face.
+
+    The centroid of one of its largest triangles, :data:`KEEP_DEPTHS` in along the triangle's
+    inward normal (the first inside the part, by ray parity, and at least half that depth from
+    its surface); None when there is none. A triangle's centroid, not a vertex: a vertex lies
+    on the face's rim, and a point below it on the neighbouring face (a cap fanned from a rim
+    vertex) is on the surface, neither inside nor outside."""
     tri = query.mesh.triangles[region.faces]
     n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
     area = np.linalg.norm(n, axis=1)

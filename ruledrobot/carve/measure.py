@@ -46,8 +46,9 @@ def chord_samples(lines: Lines, stock: Box, step: float = STEP) -> tuple[FloatAr
 
 
 def surface_distance(points: FloatArray, lines: Lines, closed: bool) -> FloatArray:
-    """(N,) distance [m] from ``points`` (N, 3) to the ruled surface of ``lines``: to the
-    plane through the nearest ruling and the foot on its nearer neighbour."""
+    """(N,) distance [m] from ``points`` (N, 3) to the ruled surface of ``lines``.
+
+    To the plane through the nearest ruling and the foot on its nearer neighbour."""
     p, d = lines.point, lines.direction
     rel = points[:, None, :] - p[None]
     along = np.einsum("nki,ki->nk", rel, d)
@@ -73,8 +74,9 @@ def surface_distance(points: FloatArray, lines: Lines, closed: bool) -> FloatArr
 
 def measure_cut(cut: CarveCut, stock: Box, query: MeshQuery, tolerance: float,
                 region: Region | None = None) -> CutMeasure:  # fmt: skip
-    """The measures of one cut (module doc); ``ok``: no gouge, and for an exact cut the
-    face within ``tolerance`` of the cut."""
+    """The measures of one cut (module doc).
+
+    ``ok``: no gouge, and for an exact cut the face within ``tolerance`` of the cut."""
     pts, owner = chord_samples(cut.lines, stock)
     if not len(pts):
         return CutMeasure(0.0, np.inf, np.inf, np.nan, False)

@@ -170,9 +170,10 @@ def _oriented_distance2(p: FloatArray, box: FloatArray) -> FloatArray:
 
 @dataclass(frozen=True)
 class MeshQuery:
-    """Exact distance, closest points and inside tests against a closed mesh (module
-    doc).  Built once per mesh (median splits: ``log2(F / LEAF)`` sorts of the F
-    triangles); the queries take batches of points."""
+    """Exact distance, closest points and inside tests against a closed mesh (module doc).
+
+    Built once per mesh (median splits: ``log2(F / LEAF)`` sorts of the F triangles); the
+    queries take batches of points."""
 
     mesh: PartMesh
 
@@ -235,8 +236,10 @@ class MeshQuery:
         return n, vn, en, edge
 
     def nearest(self, points: FloatArray) -> tuple[FloatArray, np.ndarray, FloatArray]:
-        """For points (N, 3) [m]: the distance (N,) [m] to the mesh, the index (N,) of the
-        nearest triangle, and the closest point (N, 3) on it; exact (module doc)."""
+        """For points (N, 3) [m].
+
+        The distance (N,) [m] to the mesh, the index (N,) of the nearest triangle, and the
+        closest point (N, 3) on it; exact (module doc)."""
         p = np.asarray(points, dtype=np.float64).reshape(-1, 3)
         n = len(p)
         tri, leaves = self._tri, self._leaves
@@ -280,8 +283,10 @@ class MeshQuery:
         return self.nearest(points)[0]
 
     def signed(self, points: FloatArray) -> FloatArray:
-        """(N,) exact signed distance [m] from ``points`` (N, 3): negative inside the
-        closed mesh (the closest feature's pseudo-normal, module doc); 0 on it."""
+        """(N,) exact signed distance [m] from ``points`` (N, 3).
+
+        Negative inside the closed mesh (the closest feature's pseudo-normal, module doc); 0 on
+        it."""
         p = np.asarray(points, dtype=np.float64).reshape(-1, 3)
         d, ti, _ = self.nearest(p)
         t = self._tri[ti]

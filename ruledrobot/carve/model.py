@@ -14,11 +14,12 @@ __all__ = ["CarveCut", "CutMeasure"]
 
 @dataclass(frozen=True)
 class CarveCut:
-    """One cut: ``lines`` its rulings (base frame, m), ``closed`` a loop round the part,
-    ``keep`` the part's side (``"inside"`` or a point (3,) of the part), ``kind``
-    ``"exact"`` (the rulings of a ruled face of the part) or ``"rough"`` (a loop that
-    stands off the part), ``what`` in words (``"region 1: ruled quadric"``),
-    ``region`` the face it cuts (exact cuts) or None."""
+    """One cut.
+
+    ``lines`` its rulings (base frame, m), ``closed`` a loop round the part, ``keep`` the
+    part's side (``"inside"`` or a point (3,) of the part), ``kind`` ``"exact"`` (the rulings
+    of a ruled face of the part) or ``"rough"`` (a loop that stands off the part), ``what`` in
+    words (``"region 1: ruled quadric"``), ``region`` the face it cuts (exact cuts) or None."""
 
     name: str
     kind: str
@@ -31,11 +32,13 @@ class CarveCut:
 
 @dataclass(frozen=True)
 class CutMeasure:
-    """A cut measured against the part (metres): ``gouge`` the deepest ruling point
-    inside the part beyond the tolerance (0: none), ``closest`` the nearest any
-    ruling point in the block comes to the part, ``farthest`` (rough) the largest of
-    the rulings' nearest approaches to the part, ``deviation`` (exact) the largest
-    distance from the face's vertices to the cut's surface, ``ok`` the cut's checks."""
+    """A cut measured against the part (metres).
+
+    ``gouge`` the deepest ruling point inside the part beyond the tolerance (0: none),
+    ``closest`` the nearest any ruling point in the block comes to the part, ``farthest``
+    (rough) the largest of the rulings' nearest approaches to the part, ``deviation`` (exact)
+    the largest distance from the face's vertices to the cut's surface, ``ok`` the cut's
+    checks."""
 
     gouge: float
     closest: float

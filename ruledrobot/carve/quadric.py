@@ -40,11 +40,13 @@ FLAT = 1e-3
 
 @dataclass(frozen=True)
 class Fit:
-    """A fitted region: ``kind`` ``"plane"``, ``"ruled"`` (a ruled quadric) or
-    ``"curved"`` (a quadric with no real lines: ellipsoid, paraboloid, two-sheet
-    hyperboloid), ``"free"`` (no quadric within tolerance) or ``"undetermined"`` (more
-    than one quadric within it: :func:`fit_region`); ``A`` (3, 3), ``b`` (3,), ``c`` in
-    metres (base frame), ``residual`` [m] the largest distance of a vertex."""
+    """A fitted region.
+
+    ``kind`` ``"plane"``, ``"ruled"`` (a ruled quadric) or ``"curved"`` (a quadric with no real
+    lines: ellipsoid, paraboloid, two-sheet hyperboloid), ``"free"`` (no quadric within
+    tolerance) or ``"undetermined"`` (more than one quadric within it: :func:`fit_region`);
+    ``A`` (3, 3), ``b`` (3,), ``c`` in metres (base frame), ``residual`` [m] the largest
+    distance of a vertex."""
 
     kind: str
     A: FloatArray = field(repr=False)

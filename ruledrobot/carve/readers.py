@@ -46,9 +46,11 @@ SIZE_RATIO = 20.0
 
 @dataclass(frozen=True)
 class PartMesh:
-    """The part: ``vertices`` (V, 3) [m] in the robot base frame, ``faces`` (F, 3) int64,
-    counter-clockwise seen from outside; ``source`` the file read; ``repairs`` what
-    ``[part] repair = true`` did to the mesh, in words (empty: nothing)."""
+    """The part.
+
+    ``vertices`` (V, 3) [m] in the robot base frame, ``faces`` (F, 3) int64, counter-clockwise
+    seen from outside; ``source`` the file read; ``repairs`` what ``[part] repair = true`` did
+    to the mesh, in words (empty: nothing)."""
 
     vertices: FloatArray = field(repr=False)
     faces: np.ndarray = field(repr=False)
@@ -188,11 +190,12 @@ def check_size(vertices: FloatArray, spec: PartSpec, stock: Box, where: str) -> 
 
 
 def read_part(spec: PartSpec, stock: Box | None = None, where: str = "cell") -> PartMesh:
-    """The part of a cell (:class:`.cell.PartSpec`): read, its size checked against the
-    block's (``stock``, when given: :func:`check_size`; ``where`` names the cell file),
-    repaired when ``spec.repair`` (:mod:`.repair`), checked closed, manifold and
-    consistently oriented, in metres and in the robot base frame; ValueError naming the
-    file and where its mesh fails otherwise."""
+    """The part of a cell (:class:`.cell.PartSpec`).
+
+    Read, its size checked against the block's (``stock``, when given: :func:`check_size`;
+    ``where`` names the cell file), repaired when ``spec.repair`` (:mod:`.repair`), checked
+    closed, manifold and consistently oriented, in metres and in the robot base frame;
+    ValueError naming the file and where its mesh fails otherwise."""
     path = spec.file
     v, f, stated = read_triangles(path)
     units = spec.units

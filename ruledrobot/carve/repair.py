@@ -39,13 +39,14 @@ NAMED = 12
 
 @dataclass(frozen=True)
 class MeshDefects:
-    """What is wrong with a mesh: ``boundary`` (K,) the facets with an edge in no other
-    facet (``boundary_edges`` such edges), ``nonmanifold`` the facets with an edge in three
-    or more (``nonmanifold_edges``), ``flipped`` the facets turned the other way from
-    their neighbours (the smaller side in their piece), ``disagree`` how many edges two
-    facets run the same way, ``near`` how many vertices lie within the merge distance of
-    another (counted when the mesh is open), ``non_orientable`` whether a piece has no
-    consistent orientation."""
+    """What is wrong with a mesh.
+
+    ``boundary`` (K,) the facets with an edge in no other facet (``boundary_edges`` such
+    edges), ``nonmanifold`` the facets with an edge in three or more (``nonmanifold_edges``),
+    ``flipped`` the facets turned the other way from their neighbours (the smaller side in
+    their piece), ``disagree`` how many edges two facets run the same way, ``near`` how many
+    vertices lie within the merge distance of another (counted when the mesh is open),
+    ``non_orientable`` whether a piece has no consistent orientation."""
 
     boundary: np.ndarray = field(repr=False)
     nonmanifold: np.ndarray = field(repr=False)
@@ -73,8 +74,10 @@ def _edges(faces: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 
 def near_vertex_labels(vertices: FloatArray, distance: float) -> np.ndarray:
-    """(V,) for each vertex the first vertex of its cluster: vertices joined when they lie
-    within ``distance`` (file units) of one another (chains joined too)."""
+    """(V,) for each vertex the first vertex of its cluster.
+
+    Vertices joined when they lie within ``distance`` (file units) of one another (chains
+    joined too)."""
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
     from scipy.spatial import cKDTree
@@ -141,8 +144,9 @@ def facet_orientation(faces: np.ndarray) -> tuple[np.ndarray, bool]:
 
 
 def mesh_defects(vertices: FloatArray, faces: np.ndarray, merge: float) -> MeshDefects:
-    """What is wrong with a mesh (:class:`MeshDefects`); ``merge`` the distance (file
-    units) within which two vertices count as near."""
+    """What is wrong with a mesh (:class:`MeshDefects`).
+
+    ``merge`` the distance (file units) within which two vertices count as near."""
     _, which, counts = _edges(faces)
     per_facet = counts[which].reshape(3, -1)
     boundary = np.flatnonzero(np.any(per_facet == 1, axis=0))
@@ -216,9 +220,10 @@ def defects_message(defects: MeshDefects, vertices: FloatArray, faces: np.ndarra
 
 def repair_mesh(vertices: FloatArray, faces: np.ndarray, merge: float,
                 units: str) -> tuple[FloatArray, np.ndarray, list[str]]:  # fmt: skip
-    """The mesh repaired (module doc) and what was done, in words (empty: nothing was
-    wrong); ``merge`` in file units.  Vertices (V', 3) are the clusters' first vertices,
-    faces (F', 3) renumbered."""
+    """The mesh repaired (module doc) and what was done, in words (empty: nothing was wrong).
+
+    ``merge`` in file units. Vertices (V', 3) are the clusters' first vertices, faces (F', 3)
+    renumbered."""
     notes: list[str] = []
     labels = near_vertex_labels(vertices, merge)
     moved = int(np.sum(labels != np.arange(len(vertices))))

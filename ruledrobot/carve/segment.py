@@ -23,10 +23,11 @@ SHARP = np.radians(25.0)
 
 @dataclass(frozen=True)
 class Region:
-    """One smooth piece of the part's surface: ``faces`` (K,) indices into the mesh's
-    faces, ``points`` (P, 3) its vertices [m, base frame], ``normals`` (P, 3) their
-    outward unit normals (area-weighted over the region's faces), ``area`` [m^2],
-    ``between`` (S, 3) its triangles' edge midpoints and centroids [m]."""
+    """One smooth piece of the part's surface.
+
+    ``faces`` (K,) indices into the mesh's faces, ``points`` (P, 3) its vertices [m, base
+    frame], ``normals`` (P, 3) their outward unit normals (area-weighted over the region's
+    faces), ``area`` [m^2], ``between`` (S, 3) its triangles' edge midpoints and centroids [m]."""
 
     index: int
     faces: np.ndarray = field(repr=False)

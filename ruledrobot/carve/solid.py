@@ -70,10 +70,12 @@ class NotASolid(ValueError):
 
 @dataclass(frozen=True)
 class CutSolid:
-    """A cut's kept side in the block's frame: ``kind`` ``"plane"`` (``normal`` (3,) and
-    ``offset`` [m]: the points with ``normal . x >= offset``), or ``"tube"`` / ``"slab"``
-    (``vertices`` (V, 3) [m], ``faces`` (F, 3): closed, outward); ``subtract`` when the
-    solid is the waste (a loop keeping its outside); ``rulings`` after refinement."""
+    """A cut's kept side in the block's frame.
+
+    ``kind`` ``"plane"`` (``normal`` (3,) and ``offset`` [m]: the points with ``normal . x >=
+    offset``), or ``"tube"`` / ``"slab"`` (``vertices`` (V, 3) [m], ``faces`` (F, 3): closed,
+    outward); ``subtract`` when the solid is the waste (a loop keeping its outside);
+    ``rulings`` after refinement."""
 
     kind: str
     normal: FloatArray | None = None
@@ -101,8 +103,9 @@ def _basis(a: FloatArray) -> tuple[FloatArray, FloatArray]:
 
 
 def nearest_points(p: FloatArray, d: FloatArray) -> FloatArray:
-    """Each line's point (N, 3) nearest the origin (the block's centre): lines through
-    ``p`` (N, 3) along unit ``d`` (N, 3)."""
+    """Each line's point (N, 3) nearest the origin (the block's centre).
+
+    Lines through ``p`` (N, 3) along unit ``d`` (N, 3)."""
     return p - np.einsum("ij,ij->i", p, d)[:, None] * d
 
 
@@ -196,8 +199,9 @@ def _monotone_angles(P: FloatArray, centre: FloatArray, e1: FloatArray, e2: Floa
 
 
 def tube(p: FloatArray, d: FloatArray, half: FloatArray, eps: float = EPS) -> CutSolid:
-    """The closed loop of rulings ``p``, ``d`` (N, 3) [block frame] as a capped tube
-    (module doc); NotASolid when its sections are not star-shaped."""
+    """The closed loop of rulings ``p``, ``d`` (N, 3) [block frame] as a capped tube (module doc).
+
+    NotASolid when its sections are not star-shaped."""
     a = _unit(d.sum(axis=0))
     along = d @ a
     if along.min() < MIN_ALONG_AXIS:
@@ -375,9 +379,11 @@ def slab(p: FloatArray, d: FloatArray, keep: FloatArray, half: FloatArray, eps: 
 
 def kept_solid(p: FloatArray, d: FloatArray, closed: bool, keep: str | FloatArray,
                half: FloatArray, eps: float = EPS) -> CutSolid:  # fmt: skip
-    """A cut's kept side (module doc): rulings through ``p`` (N, 3) along unit ``d``
-    (N, 3), ``keep`` ``"inside"``/``"outside"`` (a loop) or a point (3,), all in the
-    block's frame, ``half`` (3,) the block's half-sizes [m].  NotASolid says why not."""
+    """A cut's kept side (module doc).
+
+    Rulings through ``p`` (N, 3) along unit ``d`` (N, 3), ``keep`` ``"inside"``/``"outside"``
+    (a loop) or a point (3,), all in the block's frame, ``half`` (3,) the block's half-sizes
+    [m]. NotASolid says why not."""
     reach = float(np.linalg.norm(half)) + MARGIN
     d = d * np.r_[1.0, np.cumprod(np.where(np.einsum("ij,ij->i", d[1:], d[:-1]) < 0.0, -1.0,
                                             1.0))][:, None]  # oriented alike  # fmt: skip
@@ -403,8 +409,9 @@ def kept_solid(p: FloatArray, d: FloatArray, closed: bool, keep: str | FloatArra
 
 
 def to_manifold(vertices: FloatArray, faces: np.ndarray) -> Any:
-    """A ``manifold3d.Manifold`` of a closed, outward mesh (V, 3) [m], (F, 3); NotASolid
-    when manifold3d refuses it (its status) or finds no volume."""
+    """A ``manifold3d.Manifold`` of a closed, outward mesh (V, 3) [m], (F, 3).
+
+    NotASolid when manifold3d refuses it (its status) or finds no volume."""
     import manifold3d as m3d
 
     mesh = m3d.Mesh64(vert_properties=np.ascontiguousarray(vertices, dtype=np.float64),

@@ -20,16 +20,20 @@ def make(
         "and the [stock], [robot], [tool], [cut] of a job.")),
     out: Path = typer.Option(Path("out/make"), "--out", "-o", help="Output folder."),
 ) -> None:
-    """Make a part: carve it from the block, plan every setup (verified in MuJoCo), write
-    each setup's program (cut.script), trajectory and viewer file, and say what to do by
-    hand between setups.  Exits 0 when every setup passes, 1 when one fails (which, and
-    why; no program is left), 2 on bad input (the file and field named)."""
+    """Make a part.
+
+    Carve it from the block, plan every setup (verified in MuJoCo), write each setup's program
+    (cut.script), trajectory and viewer file, and say what to do by hand between setups. Exits
+    0 when every setup passes, 1 when one fails (which, and why; no program is left), 2 on bad
+    input (the file and field named)."""
     run_make(cell, out)
 
 
 def run_make(cell: Path | None, out: Path, prepare: Callable[[Path], Path] | None = None) -> None:
-    """Run make with progress bars, print what it found; exit 1 when a setup fails, 2 on
-    bad input (``prepare``: the demo's cell, written into the folder)."""
+    """Run make with progress bars, print what it found.
+
+    Exit 1 when a setup fails, 2 on bad input (``prepare``: the demo's cell, written into the
+    folder)."""
     from ..make import make as do_make
     from ..make.progress import MakeBars
 

@@ -91,8 +91,10 @@ def plan(
     view: bool = typer.Option(False, "--view", help="Then show it in the browser viewer "
                               "(ruledrobot view OUT, on 127.0.0.1:8080; Ctrl-C stops)."),
 ) -> None:
-    """Plan a hot-wire cut: refine, choose the wire motion, time it, verify it in MuJoCo,
-    write the trajectory.  Exits with status 1 (and the reasons) when infeasible."""
+    """Plan a hot-wire cut.
+
+    Refine, choose the wire motion, time it, verify it in MuJoCo, write the trajectory. Exits
+    with status 1 (and the reasons) when infeasible."""
     from .view import show
 
     try:

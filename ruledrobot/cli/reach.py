@@ -24,10 +24,11 @@ def reach(
                                "the planner's, and more spread over the chord's freedom "
                                "(each cell keeps its best)."),
 ) -> None:
-    """Map where the arm can hold the wire: for every ruling of every pass and every roll
-    about the wire, the margin or why not (out of reach, joint limit, singularity, which
-    collision).  Writes reach.png (one panel per cut, the planner's path drawn on it) and
-    reach.json.  Exits 1 when some pass has no feasible path."""
+    """Map where the arm can hold the wire.
+
+    For every ruling of every pass and every roll about the wire, the margin or why not (out of
+    reach, joint limit, singularity, which collision). Writes reach.png (one panel per cut, the
+    planner's path drawn on it) and reach.json.  Exits 1 when some pass has no feasible path."""
     from ..wirecut.job.load import load_job
     from ..wirecut.reach.report import summary_lines, write_reach
 

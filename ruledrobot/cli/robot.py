@@ -101,8 +101,9 @@ def export(
 
 
 class RunModeName(str, Enum):
-    """How ``run`` drives the robot (``--mode``): ``forward``, ``servoj`` (or its other
-    name ``stream``) or ``path``."""
+    """How ``run`` drives the robot (``--mode``).
+
+    ``forward``, ``servoj`` (or its other name ``stream``) or ``path``."""
     forward = "forward"
     servoj = "servoj"
     stream = "stream"
@@ -146,13 +147,14 @@ def run(
             "run's verdict, the path program's check; default: the plan's [cut] "
             "wire_tolerance).")),
 ) -> None:
-    """Stream a planned trajectory to a UR controller through RTDE (ur_rtde): checks the
-    controller (robot model, period, state) and shows the approach move before asking to
-    start; monitors the motion, stops safely, says where and how to resume; records the
-    actual trajectory (<name>.run-NNN.csv) and measures it: the run's verdict (the feed and
+    """Stream a planned trajectory to a UR controller through RTDE (ur_rtde).
+
+    Checks the controller (robot model, period, state) and shows the approach move before
+    asking to start; monitors the motion, stops safely, says where and how to resume; records
+    the actual trajectory (<name>.run-NNN.csv) and measures it: the run's verdict (the feed and
     the wire in the block, samples skipped in the foam) is printed and written into the
-    recording's sidecar.  Exit 0 completed and every check holds, 1 refused, stopped or a
-    check of the executed cut failed, 2 bad input."""
+    recording's sidecar. Exit 0 completed and every check holds, 1 refused, stopped or a check
+    of the executed cut failed, 2 bad input."""
     import sys
 
     if not (yes or dry_run or sys.stdin.isatty()):
@@ -266,9 +268,10 @@ def stream(trajectory: Path, host: str | None, *, yes: bool = False, **options):
 
 
 def say_emulator_clock(emu) -> None:
-    """After a run on the embedded emulator: its clock in one line (on time, or how many
-    periods it ran late to catch up after its host stalled), and when it could not run
-    at real-time priority."""
+    """After a run on the embedded emulator.
+
+    Its clock in one line (on time, or how many periods it ran late to catch up after its host
+    stalled), and when it could not run at real-time priority."""
     from rich.text import Text
 
     try:  # the process-backed emulator calls it stats(), the threaded one stats_summary()

@@ -10,8 +10,9 @@ from ._common import app, console, fail
 
 
 def show(folder: Path, export: Path | None = None, **options) -> None:
-    """Serve the viewer of a plan folder until Ctrl-C, or write its static export; exit 2
-    on a folder that is not a plan folder, a refused address or a missing viewer extra."""
+    """Serve the viewer of a plan folder until Ctrl-C, or write its static export.
+
+    Exit 2 on a folder that is not a plan folder, a refused address or a missing viewer extra."""
     from ..view import ViewerUnavailable, export_html, serve
 
     try:
@@ -42,7 +43,9 @@ def view(
     duration: float | None = typer.Option(None, min=0.0, help="Stop after this many seconds "
                                           "(default: run until Ctrl-C)."),
 ) -> None:
-    """Show a plan folder in the browser: the arm, bow and wire moving through the stock,
-    the cut surface, the rulings, a timeline to play and scrub, phase and live figures,
-    collisions and near misses, the table of checks.  Never plans anything."""
+    """Show a plan folder in the browser.
+
+    The arm, bow and wire moving through the stock, the cut surface, the rulings, a timeline to
+    play and scrub, phase and live figures, collisions and near misses, the table of checks.
+    Never plans anything."""
     show(folder, export, host=host, port=port, allow_remote=allow_remote, duration=duration)

@@ -17,6 +17,7 @@ from itertools import pairwise
 import numpy as np
 
 from ..geometry.ranges import runs_of
+from ..geometry.rotations import angle_between, rotation_angle
 from ..geometry.se3 import pose_from_rotvec, rotvec_from_matrix
 from .settings import PATH_BLEND
 
@@ -46,7 +47,7 @@ def _segment_errors(p: np.ndarray, R: np.ndarray, i: int, j: int) -> tuple[np.nd
     rel = rotvec_from_matrix(Ri.T @ Rj)
     interp = Ri @ _rot(s[:, None] * rel[None, :])  # (n, 3, 3)
     err = np.einsum("nji,njk->nik", interp, R[i + 1 : j])  # interp^T R_k
-    ang = np.linalg.norm(rotvec_from_matrix(err), axis=-1)
+    ang = rotation_angle(err)
     return pos, ang
 
 
@@ -184,8 +185,10 @@ def path_steps(
     blend: float = PATH_BLEND,
     min_dwell: float = 0.05,
 ) -> tuple[PathStep, ...]:
-    """The steps of a path program playing the plan's samples — TCP ``tcp`` (M, 6), joints
-    ``q`` (M, 6) at times ``t`` (M,) — as planned: nothing of the plan's motion is merged.
+    """The steps of a path program playing the plan's samples.
+
+    TCP ``tcp`` (M, 6), joints ``q`` (M, 6) at times ``t`` (M,) — as planned: nothing of the
+    plan's motion is merged.
 
     * every sample of ``boundaries`` (phase starts and ends, the wire entering and leaving
       the stock) and every heat switch (``heat`` (M,) bool) is a waypoint, so no move
@@ -221,7 +224,7 @@ def path_steps(
     dt = np.diff(t)
     seg_len = np.linalg.norm(np.diff(p, axis=0), axis=1)
     speed = seg_len / dt
-    turn = np.linalg.norm(rotvec_from_matrix(np.einsum("nji,njk->nik", R[:-1], R[1:])), axis=-1)
+    turn = angle_between(R[:-1], R[1:])
     still = (speed < STILL_SPEED) & (turn / dt < STILL_TURN)
     jspeed = np.zeros(M - 1) if q is None else np.abs(np.diff(q, axis=0)).max(axis=1) / dt
     dwells = {a: b for a, b in runs_of(still) if t[b] - t[a] >= min_dwell}
@@ -252,7 +255,7 @@ def path_steps(
         secs = float(t[j] - t[i])
         hot = bool(on[i])
         L = float(arc[j] - arc[i])
-        rot = float(np.linalg.norm(rotvec_from_matrix(R[i].T @ R[j])))
+        rot = float(angle_between(R[i], R[j]))
         if dwells.get(i) == j or (L < 1e-6 and rot < 1e-6):
             steps.append(PathStep("dwell", i, j, secs, heat=hot))
         elif tight[i]:

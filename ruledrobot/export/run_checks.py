@@ -40,8 +40,10 @@ _VERSION_RE = re.compile(r"(\d+)\.(\d+)\.(\d+)(?:\.(\d+))?")
 
 @dataclass(frozen=True)
 class ControllerInfo:
-    """What the dashboard said: ``model_reply`` (``"UR5"``), ``version_reply``
-    (``"URSoftware 5.11.1.108318 (...)"``), ``version`` (major, minor, bugfix)."""
+    """What the dashboard said.
+
+    ``model_reply`` (``"UR5"``), ``version_reply`` (``"URSoftware 5.11.1.108318 (...)"``),
+    ``version`` (major, minor, bugfix)."""
 
     host: str
     model_reply: str

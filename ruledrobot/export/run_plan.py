@@ -95,10 +95,12 @@ _INSIDE: weakref.WeakKeyDictionary[Trajectory, np.ndarray] = weakref.WeakKeyDict
 
 
 def inside_mask(traj: Trajectory) -> np.ndarray:
-    """(M,) bool, read-only: the wire is in the block at sample k — from the one model of
-    the wire against the block (:meth:`Trajectory.wire_in_stock`) when the metadata names
-    its cut (``meta.cut``), else from the sidecar's ``in_stock`` ranges.  Computed once
-    per trajectory (a trajectory is immutable; ~1 s for a long cut)."""
+    """(M,) bool, read-only.
+
+    The wire is in the block at sample k — from the one model of the wire against the block
+    (:meth:`Trajectory.wire_in_stock`) when the metadata names its cut (``meta.cut``), else
+    from the sidecar's ``in_stock`` ranges. Computed once per trajectory (a trajectory is
+    immutable; ~1 s for a long cut)."""
     mask = _INSIDE.get(traj)
     if mask is None:
         wis = traj.wire_in_stock()
@@ -118,11 +120,12 @@ def _in_stock_run(inside: np.ndarray, k: int) -> tuple[int, int] | None:
 
 
 def entry_sample(traj: Trajectory, a: int, inside: np.ndarray | None = None) -> int:
-    """The sample a replay of the in-stock run starting at ``a`` starts from: the start
-    of the latest lead-in phase that begins before ``a`` with the wire outside the block
-    from there to ``a`` (the model's and the phases' edges need not coincide), else
-    ``a - 1`` (the last sample before the wire entered the block), at least 0.
-    ``inside``: :func:`inside_mask` of ``traj`` (computed when not given)."""
+    """The sample a replay of the in-stock run starting at ``a`` starts from.
+
+    The start of the latest lead-in phase that begins before ``a`` with the wire outside the
+    block from there to ``a`` (the model's and the phases' edges need not coincide), else ``a -
+    1`` (the last sample before the wire entered the block), at least 0. ``inside``:
+    :func:`inside_mask` of ``traj`` (computed when not given)."""
     inside = inside_mask(traj) if inside is None else inside
     best = None
     for p in traj.meta.phases:
@@ -263,8 +266,9 @@ class StopPlace:
 
 
 def stop_place(traj: Trajectory, k: int, inside: np.ndarray | None = None) -> StopPlace:
-    """Where sample ``k`` is; ``inside``: :func:`inside_mask` of ``traj`` (computed when
-    not given)."""
+    """Where sample ``k`` is.
+
+    ``inside``: :func:`inside_mask` of ``traj`` (computed when not given)."""
     k = int(min(max(k, 0), traj.n - 1))
     inside = inside_mask(traj) if inside is None else inside
     return StopPlace(k, float(traj.t[k]), traj.phase_at(k), bool(inside[k]))
@@ -274,8 +278,9 @@ _RUN_RE = re.compile(r"\.run-(\d{3,})$")
 
 
 def recording_path_for(path: str | os.PathLike[str]) -> Path:
-    """``cut.csv`` -> the first free ``cut.run-001.csv``, ``cut.run-002.csv``, ... beside it
-    (free: neither the CSV nor its sidecar exists).  The CSV is created empty at once
+    """``cut.csv`` -> the first free ``cut.run-001.csv``, ``cut.run-002.csv``, ...
+
+    beside it (free: neither the CSV nor its sidecar exists).  The CSV is created empty at once
     (exclusively), so two runs never choose the same name."""
     p = Path(path)
     stem = _RUN_RE.sub("", p.stem)

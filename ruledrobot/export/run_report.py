@@ -13,8 +13,10 @@ __all__ = ["RunProgress", "resume_command"]
 
 
 class RunProgress:
-    """A rich progress bar: the phase (``*``: the wire inside the stock), the sample,
-    the trajectory time; started on the first :meth:`update` (after the confirmation)."""
+    """A rich progress bar.
+
+    The phase (``*``: the wire inside the stock), the sample, the trajectory time; started on
+    the first :meth:`update` (after the confirmation)."""
 
     def __init__(self, traj: Trajectory, console: Any = None) -> None:
         self.traj = traj
@@ -24,8 +26,9 @@ class RunProgress:
         self._inside = inside_mask(traj)
 
     def update(self, k: int, n: int) -> None:
-        """Show sample ``k`` of ``n`` (clipped to ``n``), its phase and trajectory time [s];
-        the first call starts the bar.
+        """Show sample ``k`` of ``n`` (clipped to ``n``), its phase and trajectory time [s].
+
+        The first call starts the bar.
         """
         from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 

@@ -20,10 +20,12 @@ __all__ = ["ControllerError", "RunMode", "RunPlan", "RunResult"]
 
 
 class RunMode(str, Enum):
-    """How the motion is sent: forwarded ahead of time to a program that plays it on the
-    controller's clock (:mod:`.forward`, the default), one servoJ per controller period
-    streamed on this computer's clock, or the plan's path program (UR moves at the plan's
-    speeds, verified before motion: :mod:`.run_program`)."""
+    """How the motion is sent.
+
+    Forwarded ahead of time to a program that plays it on the controller's clock
+    (:mod:`.forward`, the default), one servoJ per controller period streamed on this
+    computer's clock, or the plan's path program (UR moves at the plan's speeds, verified
+    before motion: :mod:`.run_program`)."""
 
     forward = "forward"
     servoj = "servoj"
@@ -140,8 +142,9 @@ class RunResult:
 
     @property
     def ok(self) -> bool:
-        """Completed (or a dry run) with every check before motion and of the executed
-        cut holding: what exit code 0 means."""
+        """Completed (or a dry run) with every check before motion and of the executed cut holding.
+
+        What exit code 0 means."""
         return (self.completed and (self.verdict is None or self.verdict.ok)
                 and (self.run_verdict is None or self.run_verdict.ok))  # fmt: skip
 

@@ -83,9 +83,10 @@ MAX_LATENCY = 0.1
 
 def align_recording(plan_q: np.ndarray, rec_q: np.ndarray, tags: np.ndarray,
                     window: int) -> np.ndarray:  # fmt: skip
-    """(R,) the plan sample (row of ``plan_q``) of every recorded sample: its tag where the
-    live match made one (``tags`` >= 0), else the nearest plan sample in joint space
-    from a quarter ``window`` behind the last match to ``window`` ahead of it (the
+    """(R,) the plan sample (row of ``plan_q``) of every recorded sample.
+
+    Its tag where the live match made one (``tags`` >= 0), else the nearest plan sample in
+    joint space from a quarter ``window`` behind the last match to ``window`` ahead of it (the
     live match's rule, :meth:`~.run_session.Session.check_deviation`); 0 before any."""
     out = np.asarray(tags, dtype=np.int64).copy()
     last, high = 0, 0
@@ -106,9 +107,10 @@ def _runs_in(index: np.ndarray, start: int, stop: int) -> tuple[tuple[int, int],
 
 
 def recording_cut(cut: WireCut, plan_index: np.ndarray, speed_scale: float = 1.0) -> WireCut:
-    """The trajectory's cut for the recorded samples: each feed window (and its held
-    ranges) carried over to the recorded samples whose plan sample ``plan_index`` (R,)
-    lies in it, the set speed times ``speed_scale``."""
+    """The trajectory's cut for the recorded samples.
+
+    Each feed window (and its held ranges) carried over to the recorded samples whose plan
+    sample ``plan_index`` (R,) lies in it, the set speed times ``speed_scale``."""
     feeds = []
     for w in cut.feeds:
         held = tuple(r for a, b in w.held for r in _runs_in(plan_index, a, b))
@@ -240,18 +242,19 @@ def measure_run(
     hot: np.ndarray | None = None,
     entry_in_block: float | None = None,
 ) -> RunMeasures:
-    """The run's verdict and measures (module doc).  ``traj``: the plan; ``rec``: the
-    recording (None when nothing was recorded); ``plan_index`` (R,): the plan sample of
-    each recorded sample (:func:`align_recording` mapped to input samples);
-    ``skipped_ranges``: the skipped samples as half-open plan-sample ranges;
+    """The run's verdict and measures (module doc).
+
+    ``traj``: the plan; ``rec``: the recording (None when nothing was recorded); ``plan_index``
+    (R,): the plan sample of each recorded sample (:func:`align_recording` mapped to input
+    samples); ``skipped_ranges``: the skipped samples as half-open plan-sample ranges;
     ``wire_tolerance`` (m): the wire deviation's limit, default the plan's
-    (:func:`~.urscript.plan_wire_tolerance`: the strictest of its cuts'); ``hot`` (R,):
-    the heat on at each recorded sample, as the controller's outputs said (None: not
-    recorded), for the hot dwell; ``entry_in_block``: the pre-heat [s] of a run that
-    entered the trajectory from rest with the wire in the block (a resume that continues
-    in the kerf), None otherwise — its **resume mark** is allowed: the ramp from rest to
-    the feed (at most :data:`RESUME_RAMP` s) is left out of ``feed_min`` and the pre-heat
-    added to the hot dwell's limit, both said in the checks' details."""
+    (:func:`~.urscript.plan_wire_tolerance`: the strictest of its cuts'); ``hot`` (R,): the
+    heat on at each recorded sample, as the controller's outputs said (None: not recorded), for
+    the hot dwell; ``entry_in_block``: the pre-heat [s] of a run that entered the trajectory
+    from rest with the wire in the block (a resume that continues in the kerf), None otherwise
+    — its **resume mark** is allowed: the ramp from rest to the feed (at most
+    :data:`RESUME_RAMP` s) is left out of ``feed_min`` and the pre-heat added to the hot
+    dwell's limit, both said in the checks' details."""
     wire_tolerance = plan_wire_tolerance(traj, wire_tolerance)
     checks = [
         Check("motion", "the motion ran to the end", status, "completed", "", "==",

@@ -29,7 +29,8 @@ def wrap_angle(x: ArrayLike) -> FloatArray:
 
 
 def wrap_near(x: ArrayLike, ref: ArrayLike) -> FloatArray:
-    """The representatives ``x + 2 pi k`` nearest ``ref`` (broadcasting): ``ref +
-    wrap_angle(x - ref)``, so the result lies in ``(ref - pi, ref + pi]``."""
+    """The representatives ``x + 2 pi k`` nearest ``ref`` (broadcasting).
+
+    ``ref + wrap_angle(x - ref)``, so the result lies in ``(ref - pi, ref + pi]``."""
     ref = np.asarray(ref, dtype=np.float64)
     return ref + wrap_angle(np.asarray(x, dtype=np.float64) - ref)

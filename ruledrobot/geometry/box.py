@@ -63,14 +63,32 @@ class Box:
 
     @property
     def corners(self) -> FloatArray:
-        """The 8 corners (8, 3) in world coordinates [m]; corner ``4i + 2j + k`` lies at
-        ``(i, j, k)`` of the box axes' (low, high) halves."""
+        """The 8 corners (8, 3) in world coordinates [m].
+
+        Corner ``4i + 2j + k`` lies at ``(i, j, k)`` of the box axes' (low, high) halves."""
         return self.centre + (_UNIT_CORNERS * self.size) @ self.rotation.T
 
     @property
     def edges(self) -> FloatArray:
         """The 12 edges (12, 2, 3) as pairs of corners in world coordinates [m]."""
         return self.corners[_EDGES]
+
+    def moved(self, T: ArrayLike) -> Box:
+        """The box carried by the rigid motion ``T`` (4, 4).
+
+        Centre ``R c + p``, axes ``R rotation``, the same size (a block placed elsewhere, the
+        stock of a job file seen from the world frame of a robot base ``T``)."""
+        T = as_float_array(T, "T")
+        if T.shape != (4, 4):
+            raise ValueError(f"T: expected a pose (4, 4), got shape {T.shape}")
+        R, p = T[:3, :3], T[:3, 3]
+        return Box(R @ self.centre + p, self.size, R @ self.rotation)
+
+    def grown(self, margin: float) -> Box:
+        """The box grown by ``margin`` [m] on every side (edge lengths ``size + 2 margin``;
+        a negative margin shrinks it, refused when an edge would vanish): the same box
+        as :meth:`contains` and :meth:`clip_lines` test with ``margin``."""
+        return Box(self.centre, self.size + 2.0 * float(margin), self.rotation)
 
     def to_box(self, points: ArrayLike) -> FloatArray:
         """World points (..., 3) in box coordinates."""

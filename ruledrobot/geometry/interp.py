@@ -38,8 +38,9 @@ def interp_linear(x: ArrayLike, xp: ArrayLike, fp: ArrayLike) -> FloatArray:
 def interp_hermite(
     x: ArrayLike, xp: ArrayLike, fp: ArrayLike, dfp: ArrayLike
 ) -> tuple[FloatArray, FloatArray]:
-    """Cubic Hermite interpolation of values ``fp`` and slopes ``dfp`` (N, J) at ``x`` (M,):
-    values and slopes (M, J).  C1, exact on the samples."""
+    """Cubic Hermite interpolation of values ``fp`` and slopes ``dfp`` (N, J) at ``x`` (M,).
+
+    Values and slopes (M, J). C1, exact on the samples."""
     x = np.asarray(x, dtype=np.float64)
     xp = np.asarray(xp, dtype=np.float64)
     fp = np.asarray(fp, dtype=np.float64)

@@ -220,8 +220,9 @@ def neighbour_gaps(plucker: ArrayLike, closed: bool = False) -> FloatArray:
 
 
 def coincident_neighbours(plucker: ArrayLike, closed: bool = False) -> np.ndarray:
-    """Indices i (K,) whose line coincides with line i+1 (mod N when ``closed``):
-    gap below ``COINCIDENT_REL`` x the median gap or below ``COINCIDENT_ABS``."""
+    """Indices i (K,) whose line coincides with line i+1 (mod N when ``closed``).
+
+    Gap below ``COINCIDENT_REL`` x the median gap or below ``COINCIDENT_ABS``."""
     gap = neighbour_gaps(plucker, closed)
     if gap.size == 0:
         return np.zeros(0, dtype=int)

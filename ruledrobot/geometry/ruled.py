@@ -172,8 +172,10 @@ class RuledSurface:
     def striction_points(
         self, at_intersection: Literal["average", "intersection"] = "average"
     ) -> FloatArray:
-        """Discrete striction points (N, 3): midpoints of the feet of the common
-        normals with both neighbours (paper section 2.4); see the module doc."""
+        """Discrete striction points (N, 3).
+
+        Midpoints of the feet of the common normals with both neighbours (paper section 2.4);
+        see the module doc."""
         cn = self.common_normals()
         n = len(self.lines)
         plus = np.empty((n, 3))  # foot on ruling i of the normal with ruling i+1
@@ -210,10 +212,11 @@ class RuledSurface:
         return self.lines.direction.copy()
 
     def distribution_parameters(self) -> FloatArray:
-        """Discrete distribution parameter per pair: pitch ``a/alpha`` (m/rad) of the
-        screw about the common normal taking ruling i to ruling i+1 (the paper's
-        limit definition).  0 at torsal pairs; inf at parallel (cylindrical) ones;
-        NaN for identical rulings."""
+        """Discrete distribution parameter per pair.
+
+        Pitch ``a/alpha`` (m/rad) of the screw about the common normal taking ruling i to
+        ruling i+1 (the paper's limit definition). 0 at torsal pairs; inf at parallel
+        (cylindrical) ones; NaN for identical rulings."""
         cn = self.common_normals()
         with np.errstate(divide="ignore", invalid="ignore"):
             return np.where(cn.parallel & (cn.distance <= self.tol), np.nan, cn.distance / cn.angle)
@@ -229,10 +232,11 @@ class RuledSurface:
     # -- frames -----------------------------------------------------------------
 
     def sannia_frames(self) -> FloatArray:
-        """Discrete Sannia frames (N, 4, 4) at the striction points (paper Eq. 8):
-        ``e1 = l``, ``e2`` = unit part of ``l_{i+1} - l_{i-1}`` normal to ``l_i``
-        (one-sided at open ends), ``e3 = e1 x e2``.  Where the spherical image
-        stalls (cylindrical rulings) ``e3`` is taken along the common normal."""
+        """Discrete Sannia frames (N, 4, 4) at the striction points (paper Eq. 8).
+
+        ``e1 = l``, ``e2`` = unit part of ``l_{i+1} - l_{i-1}`` normal to ``l_i`` (one-sided at
+        open ends), ``e3 = e1 x e2``. Where the spherical image stalls (cylindrical rulings)
+        ``e3`` is taken along the common normal."""
         l = self.lines.direction
         n = len(l)
         if self.closed:

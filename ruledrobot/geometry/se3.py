@@ -320,10 +320,11 @@ def kernel_loaded() -> bool:
 
 
 def uses_kernel(n: int) -> bool:
-    """Whether a geodesic of ``n`` pairs runs in the compiled kernel: when it is loaded
-    (then at every size: it takes ~1 us for one pair where numpy takes ~200 us), or when
-    ``n > NUMPY_PAIRS`` (which loads it).  The kernel's results are the numpy path's bit
-    for bit, so the choice changes the time only; a process that computes only small
+    """Whether a geodesic of ``n`` pairs runs in the compiled kernel.
+
+    When it is loaded (then at every size: it takes ~1 us for one pair where numpy takes ~200
+    us), or when ``n > NUMPY_PAIRS`` (which loads it). The kernel's results are the numpy
+    path's bit for bit, so the choice changes the time only; a process that computes only small
     batches (the emulator's clock thread) never waits a second for numba."""
     return _kernel is not None or n > NUMPY_PAIRS
 

@@ -442,9 +442,11 @@ def surface_point(name: str, u: ArrayLike, v: ArrayLike, **params: Any) -> Float
 
 
 def cylindroid(u: ArrayLike, c: float = 0.5) -> Lines:
-    """Cylindroid (Plücker conoid) rulings at ``u`` (N,) rad: through ``(0, 0, c sin 2u)``
-    along ``(cos u, sin u, 0)``.  The rulings through the double line ``|z| <= c`` of
-    the z axis; ruling ``u + pi`` is ruling ``u`` reversed (closed with a flip)."""
+    """Cylindroid (Plücker conoid) rulings at ``u`` (N,) rad.
+
+    Through ``(0, 0, c sin 2u)`` along ``(cos u, sin u, 0)``. The rulings through the double
+    line ``|z| <= c`` of the z axis; ruling ``u + pi`` is ruling ``u`` reversed (closed with a
+    flip)."""
     return SURFACES["cylindroid"](u, c=c)
 
 
@@ -460,8 +462,9 @@ def hyperboloid(u: ArrayLike, a: float = 1.0, c: float = 1.0) -> Lines:
 
 
 def helicoid(u: ArrayLike, pitch: float = 0.2) -> Lines:
-    """Right helicoid rulings at ``u`` (N,) rad: through ``(0, 0, pitch u)`` along
-    ``(cos u, sin u, 0)``; ``pitch`` in m/rad."""
+    """Right helicoid rulings at ``u`` (N,) rad.
+
+    Through ``(0, 0, pitch u)`` along ``(cos u, sin u, 0)``; ``pitch`` in m/rad."""
     return SURFACES["helicoid"](u, pitch=pitch)
 
 
@@ -471,8 +474,10 @@ def helical_surface(
     direction: ArrayLike = (0.0, 1.0, 1.0),
     pitch: float = 0.2,
 ) -> Lines:
-    """General helical ruled surface: the line through ``point`` (3,) along ``direction``
-    (3,) moved by :func:`helical_motion` ``(u, pitch)`` for each ``u`` (N,) rad."""
+    """General helical ruled surface.
+
+    The line through ``point`` (3,) along ``direction`` (3,) moved by :func:`helical_motion`
+    ``(u, pitch)`` for each ``u`` (N,) rad."""
     return SURFACES["helical_surface"](u, point=point, direction=direction, pitch=pitch)
 
 
@@ -483,21 +488,27 @@ def helical_developable(u: ArrayLike, radius: float = 1.0, pitch: float = 0.3) -
 
 
 def conoid(u: ArrayLike, height: float = 0.5, waves: int = 3) -> Lines:
-    """Right conoid at ``u`` (N,) rad: through ``(0, 0, height sin(waves u))`` along
-    ``(cos u, sin u, 0)``; directrix the z axis, director plane z = 0."""
+    """Right conoid at ``u`` (N,) rad.
+
+    Through ``(0, 0, height sin(waves u))`` along ``(cos u, sin u, 0)``; directrix the z axis,
+    director plane z = 0."""
     return SURFACES["conoid"](u, height=height, waves=waves)
 
 
 def mobius_band(u: ArrayLike, radius: float = 1.0) -> Lines:
-    """Möbius band rulings at ``u`` (N,) rad: through ``(R cos u, R sin u, 0)`` along
-    ``(cos(u/2) cos u, cos(u/2) sin u, sin(u/2))``; ruling ``u + 2 pi`` is ruling ``u``
-    reversed, so ``u = 2 pi k / N`` (k < N) is a sequence closed with a flip."""
+    """Möbius band rulings at ``u`` (N,) rad.
+
+    Through ``(R cos u, R sin u, 0)`` along ``(cos(u/2) cos u, cos(u/2) sin u, sin(u/2))``;
+    ruling ``u + 2 pi`` is ruling ``u`` reversed, so ``u = 2 pi k / N`` (k < N) is a sequence
+    closed with a flip."""
     return SURFACES["mobius_band"](u, radius=radius)
 
 
 def helical_motion(phi: ArrayLike, pitch: float) -> FloatArray:
-    """Helical motions (..., 4, 4): rotation by ``phi`` (...) rad about the z axis and
-    translation ``pitch * phi`` (m) along it.  A one-parameter subgroup of SE(3)."""
+    """Helical motions (..., 4, 4).
+
+    Rotation by ``phi`` (...) rad about the z axis and translation ``pitch * phi`` (m) along
+    it. A one-parameter subgroup of SE(3)."""
     phi = as_float_array(phi, "phi")
     pitch = _finite(pitch, "pitch")
     c, s = np.cos(phi), np.sin(phi)

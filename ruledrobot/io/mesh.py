@@ -32,8 +32,10 @@ _STL_FACET = np.dtype([("normal", "<f4", (3,)), ("vertices", "<f4", (3, 3)), ("a
 
 
 class StlMesh(NamedTuple):
-    """A mesh read from STL: shared ``vertices`` (V, 3) (identical float32
-    coordinates merged), ``faces`` (F, 3) int64, stored facet ``normals`` (F, 3)."""
+    """A mesh read from STL.
+
+    Shared ``vertices`` (V, 3) (identical float32 coordinates merged), ``faces`` (F, 3) int64,
+    stored facet ``normals`` (F, 3)."""
 
     vertices: FloatArray
     faces: IntArray

@@ -25,9 +25,10 @@ FILE_KINDS = {
 
 
 def input_path(named: str | os.PathLike[str], base_dir: str | os.PathLike[str] | None) -> Path:
-    """The file ``named`` by a file whose folder is ``base_dir``: an absolute path as it
-    is, a relative one from ``base_dir`` (the working folder when None), normalised
-    (``a/./b`` and ``a/x/../b`` read ``a/b``; ``~`` is the user's home)."""
+    """The file ``named`` by a file whose folder is ``base_dir``.
+
+    An absolute path as it is, a relative one from ``base_dir`` (the working folder when None),
+    normalised (``a/./b`` and ``a/x/../b`` read ``a/b``; ``~`` is the user's home)."""
     p = Path(named).expanduser()
     if not p.is_absolute() and base_dir is not None:
         p = Path(base_dir) / p

@@ -20,7 +20,8 @@ UNIT_NAMES = tuple(_SCALE)
 
 
 def unit_name(value: object, where: str) -> str:
-    """The canonical name (``m``, ``cm``, ``mm``, ``in``) of a unit given by a user;
+    """The canonical name (``m``, ``cm``, ``mm``, ``in``) of a unit given by a user.
+
     ValueError naming ``where`` otherwise."""
     if isinstance(value, str):
         key = value.strip().lower()

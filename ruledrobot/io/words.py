@@ -14,9 +14,10 @@ __all__ = ["counted", "index_ranges", "mm"]
 
 
 def index_ranges(mask: ArrayLike, labels: ArrayLike | None = None) -> str:
-    """The True entries of a boolean ``mask`` (N,) as compact ranges of their indices —
-    ``"3-17, 40"`` — or of ``labels[i]`` (N,) (e.g. the ruling numbers of sampled
-    rulings: runs of consecutive samples joined); ``""`` when none."""
+    """The True entries of a boolean ``mask`` (N,) as compact ranges of their indices.
+
+    ``"3-17, 40"`` — or of ``labels[i]`` (N,) (e.g. the ruling numbers of sampled rulings: runs
+    of consecutive samples joined); ``""`` when none."""
     k = np.flatnonzero(np.asarray(mask, dtype=bool))
     if k.size == 0:
         return ""

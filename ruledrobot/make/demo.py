@@ -18,6 +18,7 @@ DEMO_PART = "part"
 
 
 def demo_cell(folder: Path) -> Path:
-    """Write the demo column and its cell into ``folder/part``; the cell file (the
-    ``prepare`` of :func:`ruledrobot.make.make`)."""
+    """Write the demo column and its cell into ``folder/part``.
+
+    The cell file (the ``prepare`` of :func:`ruledrobot.make.make`)."""
     return write_demo_cell(Path(folder) / DEMO_PART)

@@ -17,8 +17,10 @@ __all__ = ["MakeBars"]
 
 
 class MakeBars:
-    """Progress of a make run on ``console`` (a rich Console): call it with every
-    :class:`~.steps.Step`; use as a context manager (the bars stop on leaving)."""
+    """Progress of a make run on ``console`` (a rich Console).
+
+    Call it with every :class:`~.steps.Step`; use as a context manager (the bars stop on
+    leaving)."""
 
     def __init__(self, console: Any = None) -> None:
         from rich.progress import (

@@ -87,9 +87,10 @@ def _run(setup: Setup, program: str | None) -> str:
 
 def hand_steps(setups: list[Setup], cell: Cell, programs: dict[int, str | None] | None = None,
                blocked: str = "") -> list[str]:  # fmt: skip
-    """What the operator does before each setup (one paragraph per setup); ``programs``:
-    each setup's program file name, None when it has none (default ``cut.script``);
-    ``blocked``: why there is nothing to run (a failed make), said instead."""
+    """What the operator does before each setup (one paragraph per setup).
+
+    ``programs``: each setup's program file name, None when it has none (default
+    ``cut.script``); ``blocked``: why there is nothing to run (a failed make), said instead."""
     out = []
     for s in setups:
         run = (f"Nothing to run: {blocked} ({_cuts(s)})." if blocked

@@ -21,9 +21,11 @@ STEPS_PER_SETUP = 3
 
 @dataclass(frozen=True)
 class Step:
-    """One report of progress: step ``index`` (1-based) of ``total`` known so far, its
-    ``name`` (``carve``, ``plan setup 1``, ...), the current ``message`` within it, whether
-    it is ``done``, and the seconds since the run started (``elapsed_s``)."""
+    """One report of progress.
+
+    Step ``index`` (1-based) of ``total`` known so far, its ``name`` (``carve``, ``plan setup
+    1``, ...), the current ``message`` within it, whether it is ``done``, and the seconds since
+    the run started (``elapsed_s``)."""
 
     index: int
     total: int

@@ -27,10 +27,12 @@ FORMAT = "ruledrobot.make/1"
 
 @dataclass(frozen=True)
 class SetupOutcome:
-    """One setup made: its :class:`~.setups.Setup`, the verdict (the plan's checks and the
-    ``program`` check; None when the planner refused the job: ``refused`` says why), the
-    plan's ``report`` (report.json), the program and viewer outcomes, and the seconds of
-    each step (``timings_s``)."""
+    """One setup made.
+
+    Its :class:`~.setups.Setup`, the verdict (the plan's checks and the ``program`` check; None
+    when the planner refused the job: ``refused`` says why), the plan's ``report``
+    (report.json), the program and viewer outcomes, and the seconds of each step
+    (``timings_s``)."""
 
     setup: Setup
     verdict: Verdict | None
@@ -52,8 +54,10 @@ class SetupOutcome:
 
     @property
     def cut_duration_s(self) -> float | None:
-        """The cutting time [s]: each cut's passes, lead-in to lead-out, summed (the
-        transits between them left out; None without a motion)."""
+        """The cutting time [s].
+
+        Each cut's passes, lead-in to lead-out, summed (the transits between them left out;
+        None without a motion)."""
         cuts = self.report.get("cuts")
         if self.duration_s is None or not cuts:
             return None

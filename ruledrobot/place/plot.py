@@ -25,9 +25,10 @@ def _outline(job, cand: Candidate | None) -> np.ndarray:
 
 def plot_place(path: str | Path, res: PlaceResult, extra: list[Candidate] | None = None,
                sweep: tuple[np.ndarray, np.ndarray] | None = None) -> Path:  # fmt: skip
-    """Write the search's picture (module doc) to ``path`` atomically; ``extra``: more
-    placements to outline (setups), numbered; ``sweep``: yaws (rad) and margins (m) at
-    the best place (else the samples nearest it are drawn)."""
+    """Write the search's picture (module doc) to ``path`` atomically.
+
+    ``extra``: more placements to outline (setups), numbered; ``sweep``: yaws (rad) and margins
+    (m) at the best place (else the samples nearest it are drawn)."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.colors import TwoSlopeNorm
     from matplotlib.figure import Figure

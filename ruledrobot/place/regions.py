@@ -63,10 +63,11 @@ def parse_range(text: str, what: str, unit: float = 1.0) -> tuple[float, float]:
 
 @dataclass(frozen=True)
 class Turn:
-    """A turn of the block before it is placed: ``axis`` "z" (about the vertical through
-    its centre) or "x" / "y" (tipped over a bottom edge parallel to the block's own x / y
-    axis, landing on another face at the same support height), by ``degrees`` (a
-    multiple of 90)."""
+    """A turn of the block before it is placed.
+
+    ``axis`` "z" (about the vertical through its centre) or "x" / "y" (tipped over a bottom
+    edge parallel to the block's own x / y axis, landing on another face at the same support
+    height), by ``degrees`` (a multiple of 90)."""
 
     axis: str = "z"
     degrees: int = 0
@@ -119,9 +120,10 @@ def parse_turns(text: str) -> tuple[Turn, ...]:
 
 @dataclass(frozen=True)
 class Region:
-    """Where to search: ``x``, ``y`` (m) and ``yaw`` (rad) ranges (LOW, HIGH) — of the
-    block's centre and yaw (``move = "stock"``), or of the robot base's move
-    (``"robot"``), see the module doc."""
+    """Where to search.
+
+    ``x``, ``y`` (m) and ``yaw`` (rad) ranges (LOW, HIGH) — of the block's centre and yaw
+    (``move = "stock"``), or of the robot base's move (``"robot"``), see the module doc."""
 
     x: tuple[float, float]
     y: tuple[float, float]
@@ -180,8 +182,9 @@ class Region:
 
 @dataclass(frozen=True)
 class Placement:
-    """One placement: ``x, y`` (m), ``yaw`` (rad) in the sense of ``move`` (module doc),
-    after ``turn``."""
+    """One placement.
+
+    ``x, y`` (m), ``yaw`` (rad) in the sense of ``move`` (module doc), after ``turn``."""
 
     x: float
     y: float
@@ -194,8 +197,9 @@ class Placement:
         return transforms(job, np.array([[self.x, self.y, self.yaw]]), self.move, self.turn)[0]
 
     def base_motion(self) -> FloatArray:
-        """How the robot's base moves (4, 4), in its present base frame: ``Tr(x, y, 0)
-        Rz(yaw)`` for ``move = "robot"``, the identity when the block moves."""
+        """How the robot's base moves (4, 4), in its present base frame.
+
+        ``Tr(x, y, 0) Rz(yaw)`` for ``move = "robot"``, the identity when the block moves."""
         if self.move != "robot":
             return np.eye(4)
         return transforms_of_base(np.array([[self.x, self.y, self.yaw]]))[0]
@@ -247,10 +251,10 @@ def transforms(job: Job, xyz: FloatArray, move: str, turn: Turn = AS_CLAMPED) ->
 
 
 def moved_job(job: Job, T: FloatArray) -> Job:
-    """The job with its block moved by T (4, 4): the stock, every cut's surface pose and
-    keep point (in memory; :mod:`.job_file` writes it)."""
-    st = job.stock
-    stock = Box(T[:3, :3] @ st.centre + T[:3, 3], st.size, T[:3, :3] @ st.rotation)
+    """The job with its block moved by T (4, 4).
+
+    The stock, every cut's surface pose and keep point (in memory; :mod:`.job_file` writes it)."""
+    stock = job.stock.moved(T)
     cuts = []
     for cut in job.cuts:
         keep = cut.keep

@@ -39,9 +39,11 @@ PLACE_FORMAT = "ruledrobot.place/1"
 
 @dataclass(frozen=True, eq=False)
 class PlaceOutcome:
-    """What :func:`run_place` did: the search, the verification of its best, the setups
-    (when needed) with their verifications, the operator's steps, the files, whether it
-    ends with something that passes the planner (``ok``) and lines to print."""
+    """What :func:`run_place` did.
+
+    The search, the verification of its best, the setups (when needed) with their
+    verifications, the operator's steps, the files, whether it ends with something that passes
+    the planner (``ok``) and lines to print."""
 
     result: PlaceResult
     verified: Verified | None
@@ -56,10 +58,11 @@ class PlaceOutcome:
 
 
 def limiting(ev: Evaluator, T: np.ndarray) -> str:
-    """Where and why the placement T (4, 4) has its worst margin, in words: the best
-    constant roll of its worst pass
-    (:meth:`~ruledrobot.wirecut.reach.evaluate.ColumnDetail.words`, the sentence a
-    failed plan and ``ruledrobot reach`` say of the same pass)."""
+    """Where and why the placement T (4, 4) has its worst margin, in words.
+
+    The best constant roll of its worst pass
+    (:meth:`~ruledrobot.wirecut.reach.evaluate.ColumnDetail.words`, the sentence a failed plan
+    and ``ruledrobot reach`` say of the same pass)."""
     cols = details(ev, T)
     if not cols:
         return ""

@@ -40,9 +40,10 @@ __all__ = ["Candidate", "PlaceResult", "job_passes", "search", "verify_best"]
 
 @dataclass(frozen=True)
 class Candidate:
-    """A scored placement: ``margin`` (m, the worst over every pass), ``score`` (the
-    ranking value), ``cut_margins`` (m, per cut scored: every cut of the job, or a
-    setup's), ``xyz`` its ``[x, y, yaw]``."""
+    """A scored placement.
+
+    ``margin`` (m, the worst over every pass), ``score`` (the ranking value), ``cut_margins``
+    (m, per cut scored: every cut of the job, or a setup's), ``xyz`` its ``[x, y, yaw]``."""
 
     placement: Placement
     margin: float
@@ -78,11 +79,12 @@ class Candidate:
 
 @dataclass(frozen=True, eq=False)
 class PlaceResult:
-    """What :func:`search` found.  ``ranked``: the best candidates, best first;
-    ``current``: the job's own placement; ``samples`` (N, 3) every evaluated
-    ``[x, y, yaw]`` with its ``margins`` (N,) and per cut ``cut_margins`` (N, n_cuts);
-    ``rate``: candidates evaluated per minute; ``rulings`` / ``rolls`` /
-    ``directions``: what each candidate checks."""
+    """What :func:`search` found.
+
+    ``ranked``: the best candidates, best first; ``current``: the job's own placement;
+    ``samples`` (N, 3) every evaluated ``[x, y, yaw]`` with its ``margins`` (N,) and per cut
+    ``cut_margins`` (N, n_cuts); ``rate``: candidates evaluated per minute; ``rulings`` /
+    ``rolls`` / ``directions``: what each candidate checks."""
 
     job: Job
     region: Region
@@ -203,9 +205,10 @@ def _current(job: Job, region: Region, ev: Evaluator, turn: Turn, which: list[in
 
 @dataclass(frozen=True, eq=False)
 class Verified:
-    """The outcome of verifying candidates with the full planner: the candidate that
-    passed (None: none did), the job file written for it, the plan's result, and a
-    line per candidate tried."""
+    """The outcome of verifying candidates with the full planner.
+
+    The candidate that passed (None: none did), the job file written for it, the plan's result,
+    and a line per candidate tried."""
 
     candidate: Candidate | None
     job_file: Path | None

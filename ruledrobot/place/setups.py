@@ -44,8 +44,10 @@ MAX_SETUPS = 4
 
 @dataclass(frozen=True)
 class Setup:
-    """One setup: the cuts it makes (indices into the job's cuts) and its placement (the
-    best of ``ranked``, its search's best candidates)."""
+    """One setup.
+
+    The cuts it makes (indices into the job's cuts) and its placement (the best of ``ranked``,
+    its search's best candidates)."""
 
     number: int
     cuts: tuple[int, ...]

@@ -182,8 +182,9 @@ def kinematics_info_subpackage(info: KinematicsInfo) -> bytes:
 
 
 def robot_mode_subpackage(data: RobotModeData, *, reserved: bool = True) -> bytes:
-    """The robot mode data sub-package: 47 bytes with the reserved byte of 5.x
-    (``reserved=True``), 46 bytes as 3.x sends it."""
+    """The robot mode data sub-package.
+
+    47 bytes with the reserved byte of 5.x (``reserved=True``), 46 bytes as 3.x sends it."""
     body = _MODE_BODY.pack(int(data.timestamp), bool(data.real_robot_connected),
                            bool(data.real_robot_enabled), bool(data.power_on),
                            bool(data.emergency_stopped), bool(data.protective_stopped),
@@ -264,9 +265,10 @@ def parse_kinematics_info(body: bytes) -> KinematicsInfo:
 
 
 def parse_robot_mode_data(body: bytes) -> RobotModeData:
-    """A robot mode data sub-package body (without its header): the 41 bytes of the
-    documented fields; what follows (5.x's reserved byte, fields a later version adds)
-    is ignored, as UR asks clients to do."""
+    """A robot mode data sub-package body (without its header).
+
+    The 41 bytes of the documented fields; what follows (5.x's reserved byte, fields a later
+    version adds) is ignored, as UR asks clients to do."""
     if len(body) < _MODE_BODY.size:
         raise PrimaryProtocolError(f"robot mode data: {len(body) + 5} bytes, expected at least "
                                    f"{ROBOT_MODE_DATA_SIZE_V3}")  # fmt: skip

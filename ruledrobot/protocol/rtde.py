@@ -161,8 +161,10 @@ def _counts(types: list[str]) -> list[int]:
 
 
 class RecipeKey:
-    """Recipe id and names, hashed once: equal recipes share one packed package per period
-    (a tuple of 59 names would be hashed again at every lookup)."""
+    """Recipe id and names, hashed once.
+
+    Equal recipes share one packed package per period (a tuple of 59 names would be hashed
+    again at every lookup)."""
 
     __slots__ = ("_hash", "items")
 

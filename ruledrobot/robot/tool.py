@@ -118,8 +118,10 @@ class BowTool:
         return x / np.linalg.norm(x)
 
     def segments(self) -> FloatArray:
-        """The bow's rods (3, 2, 3) in the flange frame: arm at the start, arm at the end,
-        crossbar (the same rods as ``ruledrobot.wirecut.cut.wire_pose.bow_segments``)."""
+        """The bow's rods (3, 2, 3) in the flange frame.
+
+        Arm at the start, arm at the end, crossbar (the same rods as
+        ``ruledrobot.wirecut.cut.wire_pose.bow_segments``)."""
         x = self.depth_direction()
         a = self.wire_start - (self.wire_start @ x) * x
         b = self.wire_end - (self.wire_end @ x) * x
@@ -151,8 +153,10 @@ class BowTool:
         return com, inertia
 
     def wire_frame(self) -> FloatArray:
-        """The wire frame W (4, 4) in the flange frame: origin at the wire midpoint, z
-        from ``wire_start`` to ``wire_end``, x the depth direction, y = z x x."""
+        """The wire frame W (4, 4) in the flange frame.
+
+        Origin at the wire midpoint, z from ``wire_start`` to ``wire_end``, x the depth
+        direction, y = z x x."""
         z = (self.wire_end - self.wire_start) / self.wire_length
         x = self.depth_direction()
         W = np.eye(4)

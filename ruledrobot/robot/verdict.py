@@ -130,8 +130,10 @@ class Verdict:
                          for c in doc["checks"]))  # fmt: skip
 
     def as_dict(self) -> dict[str, Any]:
-        """The verdict as a dict for a report: ``ok``, ``summary``, the ``failed`` checks'
-        names and every check's :meth:`Check.as_dict`; :meth:`from_dict` reads it back."""
+        """The verdict as a dict for a report.
+
+        ``ok``, ``summary``, the ``failed`` checks' names and every check's
+        :meth:`Check.as_dict`; :meth:`from_dict` reads it back."""
         return {
             "ok": self.ok,
             "summary": self.summary(),

@@ -31,9 +31,8 @@ import numpy as np
 from ..geometry._arrays import FloatArray
 from ..geometry.box import Box
 from ..geometry.interp import interp_linear
-from ..geometry.se3 import transform_points
 from ..robot.motion.trajectory import CUTTING_PHASES
-from ..robot.wire.in_stock import chord_fractions, wire_in_stock
+from ..robot.wire.in_stock import chord_fractions, flange_wire_ends, wire_in_stock
 
 __all__ = ["CutAnnotator", "phase_labels"]
 
@@ -58,13 +57,6 @@ def phase_labels(phases: Any, n: int) -> np.ndarray | None:
     return labels
 
 
-def _stock_in_world(scene: Any) -> Box:
-    base = np.asarray(scene.robot.base)
-    R, p = base[:3, :3], base[:3, 3]
-    s = scene.stock
-    return Box(centre=R @ s.centre + p, size=s.size, rotation=R @ s.rotation)
-
-
 class CutAnnotator:
     """Annotated frames of a motion (see the module doc); a context manager.
 
@@ -80,7 +72,7 @@ class CutAnnotator:
         mj = self.mj = renderer._mj
         scene = renderer.scene
         model = renderer.model
-        self.stock = _stock_in_world(scene)
+        self.stock: Box = scene.stock.moved(scene.robot.base)  # in the world frame
         # wire ends at the frames, from MuJoCo's sites
         s0 = mj.mj_name2id(model, mj.mjtObj.mjOBJ_SITE, "wire_start")
         s1 = mj.mj_name2id(model, mj.mjtObj.mjOBJ_SITE, "wire_end")
@@ -112,8 +104,7 @@ class CutAnnotator:
                                   0.5 * length], axis=1)  # fmt: skip
         # feed at every sample (forward kinematics of the samples), then at the frames
         flange = dataclasses.replace(scene.robot, tool=np.eye(4)).fk(q)
-        w = np.stack([scene.tool.wire_start, scene.tool.wire_end])
-        all_ends = transform_points(flange, w)
+        all_ends = flange_wire_ends(flange, scene.tool)
         feed = wire_in_stock(t, all_ends, self.stock).feed
         k = np.clip(np.searchsorted(t, times - 1e-9), 0, t.size - 1)
         self.feed = feed[k]

@@ -14,9 +14,8 @@ import numpy as np
 
 from ..geometry.box import Box
 from ..geometry.checks import FloatArray
-from ..geometry.se3 import transform_points
 from ..robot.arm.model import RobotModel
-from ..robot.wire.in_stock import chord_fractions
+from ..robot.wire.in_stock import chord_fractions, flange_wire_ends
 from .scene import BowTool
 
 __all__ = ["Collision", "ProgressCallback"]
@@ -43,8 +42,10 @@ class Collision:
     depth: float
 
     def as_dict(self) -> dict[str, Any]:
-        """The event for a report: ``start_s``, ``end_s`` [s], the geom and body names, and
-        ``max_depth_mm`` the deepest penetration [mm]."""
+        """The event for a report.
+
+        ``start_s``, ``end_s`` [s], the geom and body names, and ``max_depth_mm`` the deepest
+        penetration [mm]."""
         return {
             "start_s": self.start,
             "end_s": self.end,
@@ -198,8 +199,7 @@ def _wire(
     """Wire ends (M, 2, 3) in the base frame and the wire length inside the stock (M,) [m]
     (:func:`~ruledrobot.robot.wire.in_stock.chord_fractions`: 0 where it only touches)."""
     flange = dataclasses.replace(robot, base=np.eye(4), tool=np.eye(4)).fk(q)
-    ends = np.stack([tool.wire_start, tool.wire_end])  # (2, 3)
-    wire = transform_points(flange, ends)
+    wire = flange_wire_ends(flange, tool)
     if stock is None:
         return wire, None
     lo, hi = chord_fractions(wire, stock)  # the planner's model: a touch is not inside

@@ -14,6 +14,7 @@ import numpy as np
 
 from ..geometry import se3
 from ..geometry.checks import FloatArray
+from ..geometry.rotations import angle_between
 from ..io.atomic import atomic_open, atomic_write_json
 from ..robot.arm.model import RobotModel
 from ..robot.motion.rates import RATIO_MAX
@@ -92,12 +93,13 @@ class PlaybackResult:
 
     def tcp_orientation_error(self) -> FloatArray:
         """(M,) rotation angle between simulated and reference TCP frames [rad]."""
-        R = np.einsum("nji,njk->nik", self.tcp_ref[:, :3, :3], self.tcp[:, :3, :3])
-        return np.linalg.norm(se3.rotvec_from_matrix(R), axis=-1)
+        return angle_between(self.tcp_ref, self.tcp)
 
     def verdict(self) -> Verdict:
-        """The playback's checks: collisions, joint positions, speeds and torques of the
-        simulated arm against the robot's limits (gating); TCP error (information)."""
+        """The playback's checks.
+
+        Collisions, joint positions, speeds and torques of the simulated arm against the
+        robot's limits (gating); TCP error (information)."""
         rep = self.report()
         names = [f"{c['geom1']}/{c['geom2']} {c['max_depth_mm']:.1f} mm at {c['start_s']:.2f} s"
                  for c in rep["collisions"]]  # fmt: skip
@@ -118,8 +120,9 @@ class PlaybackResult:
         ))  # fmt: skip
 
     def report(self) -> dict[str, Any]:
-        """The playback report as a JSON-ready dict (keys documented in ``docs/sim.md``):
-        measured once per result (a pure function of it), a fresh copy each call."""
+        """The playback report as a JSON-ready dict (keys documented in ``docs/sim.md``).
+
+        Measured once per result (a pure function of it), a fresh copy each call."""
         cached = self.__dict__.get("_report")
         if cached is None:
             cached = self._measure()

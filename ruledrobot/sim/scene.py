@@ -48,9 +48,10 @@ class _Placed(Protocol):
 
 
 class CutJob(Protocol):
-    """What :meth:`Scene.from_job` reads of a cut job (``ruledrobot.wirecut.job.spec.Job``):
-    ``robot.base`` (4, 4) where the arm stands in the world, ``tool`` the bow's spec,
-    ``stock`` the block (robot base frame) and ``robot_model()`` the arm."""
+    """What :meth:`Scene.from_job` reads of a cut job (``ruledrobot.wirecut.job.spec.Job``).
+
+    ``robot.base`` (4, 4) where the arm stands in the world, ``tool`` the bow's spec, ``stock``
+    the block (robot base frame) and ``robot_model()`` the arm."""
 
     @property
     def robot(self) -> _Placed:
@@ -164,7 +165,8 @@ class Scene:
     def from_job(
         cls, job: CutJob, robot: RobotModel | None = None, bow: BowTool | None = None, **kw: Any
     ) -> Scene:
-        """The cell of a cut job (:class:`CutJob`: ``ruledrobot.wirecut.job.spec.Job``):
+        """The cell of a cut job (:class:`CutJob`: ``ruledrobot.wirecut.job.spec.Job``).
+
         ``job.robot_model()`` (model, calibration; unless ``robot`` is given) placed at the
         job's ``[robot] base``, the bow of ``job.tool`` (:meth:`BowTool.from_spec`; ``bow``
         when the caller built it already) and ``job.stock`` (in the robot base frame, like
@@ -461,9 +463,11 @@ def scene_mjcf(
 
 
 def example_scene() -> Scene:
-    """The example cell of ``models/ur5e_hotwire_cell.xml``: a UR5e with a 400 mm bow
-    (wire from ``(-0.2, 0, 0.25)`` to ``(0.2, 0, 0.25)`` in the flange frame, 1 kg) and a
-    200 mm foam cube on the table, centred at ``(0.5, 0, 0.1)`` in the base frame."""
+    """The example cell of ``models/ur5e_hotwire_cell.xml``.
+
+    A UR5e with a 400 mm bow (wire from ``(-0.2, 0, 0.25)`` to ``(0.2, 0, 0.25)`` in the flange
+    frame, 1 kg) and a 200 mm foam cube on the table, centred at ``(0.5, 0, 0.1)`` in the base
+    frame."""
     from ..robot import load
 
     return Scene(

@@ -408,9 +408,10 @@ class Emulator:
 
     @property
     def io_log(self) -> list[tuple[float, int, int, int, float, float]]:
-        """Every change of the outputs: (controller time [s], standard, configurable and
-        tool digital output bits, standard analog outputs 0 and 1 [fraction]) — what a
-        test reads to see when the wire was hot."""
+        """Every change of the outputs.
+
+        (controller time [s], standard, configurable and tool digital output bits, standard
+        analog outputs 0 and 1 [fraction]) — what a test reads to see when the wire was hot."""
         return list(self._call("io_log"))
 
     def reset_stats(self) -> None:
@@ -443,9 +444,10 @@ def embedded_emulator(
     *,
     find_free_host: bool = True,
 ) -> Iterator[Emulator]:
-    """The default target of ``ruledrobot run`` and ``demo`` without a robot address: a
-    MuJoCo-backed emulator of ``model`` with the arm at ``q0`` (rad), on loopback, closed
-    on exit.
+    """The default target of ``ruledrobot run`` and ``demo`` without a robot address.
+
+    A MuJoCo-backed emulator of ``model`` with the arm at ``q0`` (rad), on loopback, closed on
+    exit.
 
     It listens on ``host`` or, when that is taken (another emulator runs there) and
     ``find_free_host``, on the next free loopback address: ``emulator.host`` says where.

@@ -79,8 +79,9 @@ def _check_host(host: str, allow_remote: bool) -> None:
 
 
 class ThreadedEmulator:
-    """A UR controller on ``host`` in this process: RTDE, dashboard, script port, primary
-    and secondary interfaces, simulated arm.
+    """A UR controller on ``host`` in this process.
+
+    RTDE, dashboard, script port, primary and secondary interfaces, simulated arm.
 
     Runs on threads of the calling process.  ur_rtde's Python bindings hold
     the GIL while they wait for the controller, so a ur_rtde client in the
@@ -444,15 +445,18 @@ class ThreadedEmulator:
 
     @property
     def io_log(self) -> list[tuple[float, int, int, int, float, float]]:
-        """Every change of the outputs: (controller time [s], standard, configurable and
-        tool digital output bits, standard analog outputs 0 and 1 [fraction])."""
+        """Every change of the outputs.
+
+        (controller time [s], standard, configurable and tool digital output bits, standard
+        analog outputs 0 and 1 [fraction])."""
         with self.controller.lock:
             return list(self.controller.io_log)
 
     @property
     def ports(self) -> dict[str, int]:
-        """The bound ports: ``{"rtde": ..., "dashboard": ..., "script": ..., "primary": ...,
-        "secondary": ...}``."""
+        """The bound ports.
+
+        ``{"rtde": ..., "dashboard": ..., "script": ..., "primary": ..., "secondary": ...}``."""
         return {
             "rtde": self.rtde.port,
             "dashboard": self.dashboard.port,

@@ -27,8 +27,10 @@ __all__ = ["Contact", "Event", "contacts_along", "locate", "near_misses"]
 
 @dataclass(frozen=True)
 class Contact:
-    """Two geoms closer than the margin at sample ``index``: ``distance`` m (< 0:
-    penetration depth), ``position`` (3,) world m, midway between the surfaces."""
+    """Two geoms closer than the margin at sample ``index``.
+
+    ``distance`` m (< 0: penetration depth), ``position`` (3,) world m, midway between the
+    surfaces."""
 
     index: int
     geom1: str
@@ -104,8 +106,10 @@ def near_misses(
     *,
     samples: int | None = None,
 ) -> list[Event]:
-    """Events from :func:`contacts_along` contacts: per geom pair, each run of samples
-    closer than ``threshold`` (m) becomes one event at its closest sample.
+    """Events from :func:`contacts_along` contacts.
+
+    Per geom pair, each run of samples closer than ``threshold`` (m) becomes one event at its
+    closest sample.
 
     ``t`` (K,) s and ``phases`` (K,) names of the samples the contacts were found
     at.  Penetrations are ``"collision"`` events, the rest ``"near miss"``.  A
@@ -150,7 +154,8 @@ def near_misses(
 def locate(
     contacts: list[Contact], geom1: str, geom2: str
 ) -> tuple[int, float, tuple[float, float, float]] | None:
-    """The deepest contact of the pair ``geom1``, ``geom2`` among ``contacts``:
+    """The deepest contact of the pair ``geom1``, ``geom2`` among ``contacts``.
+
     ``(index, distance m, position)``, or None when the pair is not among them."""
     pair = tuple(sorted((geom1, geom2)))
     cs = [c for c in contacts if (c.geom1, c.geom2) == pair]

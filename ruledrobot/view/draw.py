@@ -205,8 +205,9 @@ class Painter:
         self.frame = k
 
     def set_visible(self, group: str, visible: bool) -> None:
-        """Show or hide a group of nodes: ``"trail"``, ``"cut"``, ``"rulings"``,
-        ``"surface"``, ``"stock"``, ``"events"``."""
+        """Show or hide a group of nodes.
+
+        ``"trail"``, ``"cut"``, ``"rulings"``, ``"surface"``, ``"stock"``, ``"events"``."""
         api = self.server.scene
         if group in ("trail", "cut"):
             self.enabled[group] = visible

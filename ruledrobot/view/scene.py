@@ -30,12 +30,11 @@ import numpy as np
 from ..geometry._arrays import FloatArray
 from ..geometry.box import Box
 from ..geometry.mesh import Mesh
-from ..geometry.se3 import transform_points
 from ..robot.arm.model import RobotModel
 from ..robot.motion.rates import finite_difference_rates
 from ..robot.motion.trajectory import KinematicsRef, model_for
 from ..robot.verdict import Check
-from ..robot.wire.in_stock import chord_fractions, wire_in_stock
+from ..robot.wire.in_stock import chord_fractions, flange_wire_ends, wire_in_stock
 from ..sim._mujoco import mujoco
 from ..sim.scene import Scene, default_camera
 from .clearance import Event, contacts_along, locate, near_misses
@@ -213,8 +212,7 @@ def build_scene(
     ids = np.array([g.geom_id for g in geoms], dtype=int)
     base = np.asarray(robot.base)
     R, p = base[:3, :3], base[:3, 3]
-    stock = Box(centre=R @ job.stock.centre + p, size=job.stock.size,
-                rotation=R @ job.stock.rotation)  # fmt: skip
+    stock = job.stock.moved(base)
 
     rulings = np.zeros((0, 2, 3))
     if folder.rulings is not None:
@@ -245,8 +243,7 @@ def build_scene(
         flange = dataclasses.replace(robot, tool=np.eye(4)).fk(traj.q)
         tool = sim_scene.tool
         assert tool is not None
-        ends = np.stack([tool.wire_start, tool.wire_end])
-        all_wire = transform_points(flange, ends)
+        all_wire = flange_wire_ends(flange, tool)
         feed = wire_in_stock(traj.t, all_wire, stock).feed[k]
         qd, _ = finite_difference_rates(traj.t, traj.q)
         vmax = np.asarray(robot.max_velocity, dtype=np.float64)

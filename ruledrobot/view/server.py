@@ -42,8 +42,10 @@ class RemoteRefused(ValueError):
 
 
 def check_host(host: str, allow_remote: bool = False) -> str:
-    """``host`` if the server may bind it: a loopback address (127.0.0.0/8, ::1,
-    ``localhost``), or any address with ``allow_remote``; else :class:`RemoteRefused`."""
+    """``host`` if the server may bind it.
+
+    A loopback address (127.0.0.0/8, ::1, ``localhost``), or any address with ``allow_remote``;
+    else :class:`RemoteRefused`."""
     if host == "localhost":
         return host
     try:

@@ -21,9 +21,16 @@ ROOT = Path(__file__).resolve().parents[2] / "ruledrobot"
 PACKAGES = ("subdivision", "algorithms", "geometry", "robot", "io", "sim", "export", "wirecut",
             "place", "batch", "cli", "protocol", "view",
             "carve", "gallery", "ursim")  # fmt: skip
-#: packages whose docstrings also open with a one-line summary (numpydoc); the others
-#: still hold docstrings of the older style, a paragraph from the first line
-SUMMARY_PACKAGES = ("subdivision", "algorithms")
+#: every package of ruledrobot (found on disk, so that a new one is held too): their
+#: docstrings open with a one-line summary (numpydoc)
+SUMMARY_PACKAGES = tuple(sorted(p.name for p in ROOT.iterdir() if (p / "__init__.py").is_file()))
+#: definitions whose docstring still opens with a paragraph (``path qualified.name``, one a
+#: line): a ratchet, not a licence.  A definition not listed must hold the rule; a listed
+#: one that holds it now fails until its line is removed.  Issue 34 rewrote the summaries
+#: that split mechanically (the first sentence, or its head before a colon, fits a line);
+#: these have a first sentence too long for one line, or sit in modules other helpers were
+#: rewriting at the time.
+PENDING_FILE = Path(__file__).with_name("summary_pending.txt")
 
 Definition = ast.FunctionDef | ast.AsyncFunctionDef | ast.ClassDef
 
@@ -97,15 +104,45 @@ def test_modules_have_docstrings(path: Path) -> None:
     assert ast.get_docstring(tree), f"{_where(path)}: module without a docstring"
 
 
-@pytest.mark.parametrize("path", _files(SUMMARY_PACKAGES), ids=lambda p: str(p.relative_to(ROOT)))
-def test_docstrings_start_with_a_summary_line(path: Path) -> None:
-    """The first line is the summary: a full sentence, then a blank line or the end."""
-    bad = []
+def _pending() -> set[str]:
+    lines = PENDING_FILE.read_text(encoding="utf-8").splitlines()
+    return {ln.strip() for ln in lines if ln.strip() and not ln.startswith("#")}
+
+
+def _summary_offences(path: Path) -> list[tuple[str, str]]:
+    """(``path qualified.name``, where and first line) of docstrings without a summary line."""
+    out = []
     for name, node in public_definitions(path):
         doc = ast.get_docstring(node)
         if not doc:
             continue  # reported by test_public_definitions_have_docstrings
         lines = doc.splitlines()
         if not lines[0].strip().endswith(".") or (len(lines) > 1 and lines[1].strip()):
-            bad.append(f"{_where(path, node)} {name}: {lines[0]!r}")
+            key = f"{path.relative_to(ROOT.parent).as_posix()} {name}"
+            out.append((key, f"{_where(path, node)} {name}: {lines[0]!r}"))
+    return out
+
+
+def _summary_files() -> list[Path]:
+    return sorted({*_files(SUMMARY_PACKAGES), *ROOT.glob("*.py")})
+
+
+@pytest.mark.parametrize("path", _summary_files(), ids=lambda p: str(p.relative_to(ROOT)))
+def test_docstrings_start_with_a_summary_line(path: Path) -> None:
+    """The first line is the summary: a full sentence, then a blank line or the end."""
+    pending = _pending()
+    bad = [where for key, where in _summary_offences(path) if key not in pending]
     assert not bad, "docstrings whose first line is not a one-line summary:\n  " + "\n  ".join(bad)
+
+
+def test_the_pending_summaries_are_still_pending() -> None:
+    """Every line of ``summary_pending.txt`` names a definition that still breaks the rule
+    (fixed or removed ones leave the list, so that it only shrinks)."""
+    found = {key for path in _summary_files() for key, _ in _summary_offences(path)}
+    stale = sorted(_pending() - found)
+    assert not stale, (f"{PENDING_FILE.name}: these now hold the summary rule (or are gone); "
+                       "remove their lines:\n  " + "\n  ".join(stale))  # fmt: skip
+
+
+def test_every_package_is_held_to_the_summary_rule() -> None:
+    assert {"geometry", "robot", "wirecut", "ursim", "cli"} <= set(SUMMARY_PACKAGES)

@@ -1,9 +1,10 @@
 """Box.corners and Box.edges: the one home of a block's corners (plots, transits,
-placement, scene)."""
+placement, scene); Box.moved and Box.grown: a block placed elsewhere, grown by a margin."""
 
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -34,3 +35,38 @@ def test_corner_order_is_low_high_per_axis():
     np.testing.assert_allclose(box.corners[0], [-1, -2, -3])
     np.testing.assert_allclose(box.corners[7], [1, 2, 3])
     np.testing.assert_allclose(box.corners[4 + 2], [1, 2, -3])
+
+
+@settings(max_examples=50, deadline=None)
+@given(st.tuples(coords, coords, coords), st.tuples(sizes, sizes, sizes),
+       st.tuples(coords, coords, coords), st.tuples(coords, coords, coords),
+       st.tuples(coords, coords, coords))
+def test_a_moved_box_has_the_moved_corners(c, s, rv, turn, shift):
+    """``Box.moved(T)``: its corners are ``T`` applied to the corners (order kept)."""
+    box = Box(np.array(c), np.array(s), pose_from_rotvec(np.array(rv))[:3, :3])
+    T = pose_from_rotvec(np.array(turn), np.array(shift))
+    moved = box.moved(T)
+    want = box.corners @ T[:3, :3].T + T[:3, 3]
+    np.testing.assert_allclose(moved.corners, want, atol=1e-12)
+    np.testing.assert_array_equal(moved.size, box.size)
+
+
+@settings(max_examples=50, deadline=None)
+@given(st.tuples(coords, coords, coords), st.tuples(sizes, sizes, sizes),
+       st.tuples(coords, coords, coords), st.floats(0.0, 0.5), st.integers(0, 2**32 - 1))
+def test_a_grown_box_holds_what_the_margin_tests_hold(c, s, rv, margin, seed):
+    """``Box.grown(m)`` is the box ``contains(.., m)`` and ``clip_lines(.., m)`` test."""
+    box = Box(np.array(c), np.array(s), pose_from_rotvec(np.array(rv))[:3, :3])
+    grown = box.grown(margin)
+    rng = np.random.default_rng(seed)
+    p = box.centre + rng.uniform(-1.5, 1.5, size=(400, 3))
+    np.testing.assert_array_equal(grown.contains(p), box.contains(p, margin))
+    np.testing.assert_allclose(grown.size - box.size, 2.0 * margin, atol=1e-15)
+
+
+def test_a_box_shrunk_away_or_moved_by_a_non_pose_is_refused():
+    box = Box(np.zeros(3), np.array([0.2, 0.4, 0.6]))
+    with pytest.raises(ValueError, match=r"box_size\[0\]"):
+        box.grown(-0.1)
+    with pytest.raises(ValueError, match=r"T: expected a pose"):
+        box.moved(np.eye(3))

@@ -10,10 +10,12 @@ from hypothesis import strategies as st
 
 from ruledrobot.geometry import se3
 from ruledrobot.geometry.box import Box
+from ruledrobot.robot.tool import BowTool
 from ruledrobot.robot.wire.cut import FeedWindow, WireCut, feed_checks, feed_measures
 from ruledrobot.robot.wire.in_stock import (
     TOUCH,
     feed_chord,
+    flange_wire_ends,
     largest_line_distance,
     wire_ends,
     wire_in_stock,
@@ -179,3 +181,19 @@ def test_largest_line_distance_is_the_projection_residual(seed):
     r = np.linalg.norm(w - np.einsum("kpi,ki->kp", w, n)[..., None] * n[:, None], axis=2)
     np.testing.assert_allclose(largest_line_distance(x, o, u), np.nanmax(
         np.where(np.isnan(r), -np.inf, r), axis=1).clip(0.0), rtol=1e-12, atol=1e-12)
+
+
+@settings(max_examples=50, deadline=None)
+@given(st.lists(st.floats(-0.4, 0.4), min_size=6, max_size=6), st.integers(0, 2**32 - 1))
+def test_flange_wire_ends_carry_the_bows_wire_start_and_end(xyz, seed):
+    """The wire from flange poses is the bow's ``wire_start`` / ``wire_end`` (flange frame)
+    carried by each pose: ``T [p, 1]`` written out here, not through the wire frame."""
+    start, end = np.asarray(xyz[:3]), np.asarray(xyz[3:])
+    if np.linalg.norm(end - start) < 0.05:
+        end = start + np.array([0.0, 0.0, 0.3])
+    bow = BowTool(wire_start=start, wire_end=end)
+    rng = np.random.default_rng(seed)
+    T = se3.pose_from_rotvec(rng.normal(size=(7, 3)), rng.normal(size=(7, 3)))
+    ends = flange_wire_ends(T, bow)
+    want = np.einsum("mij,kj->mki", T[:, :3, :3], np.stack([start, end])) + T[:, None, :3, 3]
+    np.testing.assert_allclose(ends, want, atol=1e-14)

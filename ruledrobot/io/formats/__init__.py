@@ -57,8 +57,10 @@ def kind_of(path: str | os.PathLike[str], writing: bool = False) -> str:
 
 @dataclass(frozen=True)
 class ReadSpec:
-    """A checked request to read rulings: the ``kind``, the ``path`` of the file (an
-    airfoil's root) and the reader's ``options`` object."""
+    """A checked request to read rulings.
+
+    The ``kind``, the ``path`` of the file (an airfoil's root) and the reader's ``options``
+    object."""
 
     kind: str
     path: Path
@@ -101,9 +103,10 @@ _READ_OPTIONS: dict[str, Callable[[Options], Any]] = {
 
 def parse_read_spec(kind: str, value: str | os.PathLike[str] | Mapping[str, Any], where: str,
                     base_dir: Path | None = None, cli: bool = False) -> ReadSpec:  # fmt: skip
-    """Check a request to read ``kind``: ``value`` is the file's path, or a mapping of
-    the reader's options with the path under ``file`` (an airfoil: ``root`` and
-    ``tip``).  Relative paths are taken from ``base_dir``."""
+    """Check a request to read ``kind``.
+
+    ``value`` is the file's path, or a mapping of the reader's options with the path under
+    ``file`` (an airfoil: ``root`` and ``tip``). Relative paths are taken from ``base_dir``."""
     if kind not in READ_KINDS:
         raise ValueError(f"{where}: unknown kind {kind!r}; expected one of {', '.join(READ_KINDS)}")
     key = "root" if kind == "airfoil" else "file"

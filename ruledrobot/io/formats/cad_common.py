@@ -17,8 +17,10 @@ __all__ = ["CadWriteOptions", "MatchOptions", "pair_to_rulings", "segments"]
 
 @dataclass(frozen=True)
 class MatchOptions:
-    """How two profiles make rulings (:mod:`.profiles`); ``match`` None: ``"parameter"``,
-    or ``"index"`` for ruledrobot's own files (their points are matched already)."""
+    """How two profiles make rulings (:mod:`.profiles`).
+
+    ``match`` None: ``"parameter"``, or ``"index"`` for ruledrobot's own files (their points
+    are matched already)."""
 
     match: str | None = None
     points: int | None = None
@@ -26,8 +28,9 @@ class MatchOptions:
 
     @classmethod
     def parse(cls, o: Options) -> MatchOptions:
-        """The options ``match``, ``points`` (3 to 100 000) and ``spacing`` read from ``o``;
-        does not call :meth:`.options.Options.done`, the caller's reader does.
+        """The options ``match``, ``points`` (3 to 100 000) and ``spacing`` read from ``o``.
+
+        Does not call :meth:`.options.Options.done`, the caller's reader does.
         """
         return cls(o.choice("match", MATCH_RULES, None),
                    o.integer("points", lo=3, hi=100_000),
@@ -36,9 +39,10 @@ class MatchOptions:
 
 @dataclass(frozen=True)
 class CadWriteOptions:
-    """How to draw rulings in a CAD file: ``units`` of the file (default mm); the
-    segments end on the source's ends or planes, or on the planes ``length`` apart
-    (m) of ``frame`` (a pose, default fitted) when those are given."""
+    """How to draw rulings in a CAD file.
+
+    ``units`` of the file (default mm); the segments end on the source's ends or planes, or on
+    the planes ``length`` apart (m) of ``frame`` (a pose, default fitted) when those are given."""
 
     units: str = "mm"
     length: float | None = None

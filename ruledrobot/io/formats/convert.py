@@ -35,8 +35,10 @@ MESH_SUFFIXES = (".stl", ".obj")
 
 @dataclass(frozen=True)
 class Conversion:
-    """What :func:`convert` did: the files, their kinds, the number of rulings (mesh:
-    triangles), whether closed, and the reader's notes."""
+    """What :func:`convert` did.
+
+    The files, their kinds, the number of rulings (mesh: triangles), whether closed, and the
+    reader's notes."""
 
     source: Path
     target: Path
@@ -53,8 +55,10 @@ def convert(source: str | os.PathLike[str], target: str | os.PathLike[str], *,
             read_options: Mapping[str, Any] | None = None,
             write_options: Mapping[str, Any] | None = None, cli: bool = False,
             ) -> Conversion:  # fmt: skip
-    """Read ``source`` and write ``target`` (see the module doc).  ``cli=True`` names
-    options as command-line options in errors (writer options with ``--out-``)."""
+    """Read ``source`` and write ``target`` (see the module doc).
+
+    ``cli=True`` names options as command-line options in errors (writer options with
+    ``--out-``)."""
     src, dst = Path(source), Path(target)
     tip = (read_options or {}).get("tip")
     check_not_input(dst, src, *([] if tip is None else [tip]))

@@ -11,8 +11,10 @@ _PIP_NAME = {"ezdxf": "ezdxf", "rhino3dm": "rhino3dm"}
 
 
 class MissingExtraError(ValueError):
-    """An optional package a format needs is not installed.  A ValueError, so that
-    commands report it like any other unusable input (exit status 2, one line)."""
+    """An optional package a format needs is not installed.
+
+    A ValueError, so that commands report it like any other unusable input (exit status 2, one
+    line)."""
 
 
 def require(module: str, what: str) -> ModuleType:

@@ -108,9 +108,11 @@ class GcodeWriteOptions:
 
 
 def resolve_planes(rulings: Rulings, opts: GcodeWriteOptions, where: str) -> Planes:
-    """The tower planes (see the module doc): a G-code source keeps its towers; the
-    faces or profiles of a source are placed ``block_offset`` from tower A (default:
-    centred between the towers); rulings without planes get fitted ones."""
+    """The tower planes (see the module doc).
+
+    A G-code source keeps its towers; the faces or profiles of a source are placed
+    ``block_offset`` from tower A (default: centred between the towers); rulings without planes
+    get fitted ones."""
     src = rulings.planes
     distance = opts.tower_distance
     if distance is None:
@@ -133,8 +135,9 @@ def resolve_planes(rulings: Rulings, opts: GcodeWriteOptions, where: str) -> Pla
 
 def faces_in_cutter_frame(rulings: Rulings, planes: Planes, opts: GcodeWriteOptions,
                           where: str) -> tuple[float, float]:  # fmt: skip
-    """The z of the block faces in the cutter frame: the option's, else the source's
-    faces or profiles."""
+    """The z of the block faces in the cutter frame.
+
+    The option's, else the source's faces or profiles."""
     if opts.faces is not None:
         return opts.faces
     src = rulings.planes

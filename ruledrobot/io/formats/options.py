@@ -46,8 +46,9 @@ class Options(FieldReader):
         return "--" + (self.prefix + key).replace("_", "-") if self.cli else key
 
     def label(self, key: str) -> str:
-        """Where a field is: ``"a.ngc (gcode): --tower-distance"``, ``"job.toml:
-        [surface.gcode] tower_distance"``."""
+        """Where a field is.
+
+        ``"a.ngc (gcode): --tower-distance"``, ``"job.toml: [surface.gcode] tower_distance"``."""
         sep = ": " if self.cli else " "
         return f"{self.where}{sep}{self.name(key)}"
 

@@ -81,8 +81,9 @@ def write_rhino(path: str | os.PathLike[str], rulings: Rulings,
 
 def write_mesh_3dm(path: str | os.PathLike[str], vertices: ArrayLike, faces: ArrayLike,
                    units: str = "mm") -> Path:  # fmt: skip
-    """Write a triangle mesh (``vertices`` (V, 3) m, ``faces`` (F, 3)) as a 3DM model
-    in ``units``; returns the path."""
+    """Write a triangle mesh (``vertices`` (V, 3) m, ``faces`` (F, 3)) as a 3DM model in ``units``.
+
+    Returns the path."""
     rhino = require("rhino3dm", "writing Rhino .3dm files")
     v, f = validate_mesh(vertices, faces)
     v = np.asarray(v, dtype=np.float64) / unit_scale(units, str(path))

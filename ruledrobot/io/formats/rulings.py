@@ -84,16 +84,19 @@ class Rulings:
         return len(self.lines)
 
     def path_lines(self) -> Lines:
-        """The lines as an open path: a closed sequence gets its first ruling again at
-        the end, so that a cut along the path goes all the way round."""
+        """The lines as an open path.
+
+        A closed sequence gets its first ruling again at the end, so that a cut along the path
+        goes all the way round."""
         if not self.closed:
             return self.lines
         return Lines(np.concatenate([self.lines.plucker, self.lines.plucker[:1]]))
 
 
 def rulings_from_ends(a: ArrayLike, b: ArrayLike, where: str) -> Lines:
-    """Lines through ``a`` (N, 3) towards ``b`` (N, 3); ValueError naming the first
-    ruling whose two ends coincide."""
+    """Lines through ``a`` (N, 3) towards ``b`` (N, 3).
+
+    ValueError naming the first ruling whose two ends coincide."""
     a = np.asarray(a, dtype=np.float64)
     b = np.asarray(b, dtype=np.float64)
     scale = max(1.0, float(np.abs(np.concatenate([a, b])).max(initial=0.0)))
@@ -106,9 +109,10 @@ def rulings_from_ends(a: ArrayLike, b: ArrayLike, where: str) -> Lines:
 
 
 def plane_ends(lines: Lines, planes: Planes, where: str = "rulings") -> FloatArray:
-    """Where each line meets the planes ``z = 0`` and ``z = distance`` of ``planes``:
-    (N, 2, 3) m in the lines' frame.  A line within 1e-6 rad of parallel to the planes
-    has no such points: ValueError naming it."""
+    """Where each line meets the planes ``z = 0`` and ``z = distance`` of ``planes``.
+
+    (N, 2, 3) m in the lines' frame. A line within 1e-6 rad of parallel to the planes has no
+    such points: ValueError naming it."""
     T = planes.pose
     R, t = T[:3, :3], T[:3, 3]
     l = lines.direction @ R  # directions in the plane frame
@@ -129,11 +133,12 @@ def plane_ends(lines: Lines, planes: Planes, where: str = "rulings") -> FloatArr
 
 
 def fit_planes(lines: Lines, distance: float) -> Planes:
-    """Planes for rulings that came without any: z along the mean ruling direction
-    (signs aligned with the first ruling), x along the largest spread of the rulings
-    in the planes, the two planes ``distance`` apart and centred on the rulings'
-    points nearest their centroid, the origin placed so that every end has
-    ``x, y >= 0`` (machine coordinates of a foam cutter start at zero)."""
+    """Planes for rulings that came without any.
+
+    Z along the mean ruling direction (signs aligned with the first ruling), x along the
+    largest spread of the rulings in the planes, the two planes ``distance`` apart and centred
+    on the rulings' points nearest their centroid, the origin placed so that every end has ``x,
+    y >= 0`` (machine coordinates of a foam cutter start at zero)."""
     d = lines.direction
     d = d * np.where(d @ d[0] < 0, -1.0, 1.0)[:, None]
     z = d.mean(axis=0)

@@ -42,6 +42,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ...geometry.angles import wrap_angle
+from ...geometry.rotations import angle_between
 from .._checks import FloatArray, readonly
 from .ur_tables import MODEL_NAMES, NominalDH, nominal_dh
 
@@ -218,9 +219,9 @@ class Calibration:
         return np.stack([self.theta_offset, self.a, self.d, self.alpha], axis=1)
 
     def deltas(self) -> FloatArray:
-        """(6, 4) effective minus nominal ``[theta_offset, a, d, alpha]`` (angles not
-        wrapped): what a controller's ``calibration.conf`` calls ``delta_theta`` ...
-        ``delta_alpha``."""
+        """(6, 4) effective minus nominal ``[theta_offset, a, d, alpha]`` (angles not wrapped).
+
+        What a controller's ``calibration.conf`` calls ``delta_theta`` ... ``delta_alpha``."""
         m = _nominal_model(self.model)
         return self.dh() - np.stack([m.theta_offset, m.a, m.d, m.alpha], axis=1)
 
@@ -317,8 +318,7 @@ def calibration_deviations(cal: Calibration) -> dict[str, Any]:
         zn, zc = Fn[i, :3, 2], Fc[i, :3, 2]
         tilt[i] = math.atan2(float(np.linalg.norm(np.cross(zn, zc))), float(zn @ zc))
         offset[i] = float(np.linalg.norm(np.cross(Fn[i, :3, 3] - Fc[i, :3, 3], zc)))
-    R = Fn[6, :3, :3].T @ Fc[6, :3, :3]
-    rot = math.acos(max(-1.0, min(1.0, (float(np.trace(R)) - 1.0) / 2.0)))
+    rot = float(angle_between(Fn[6], Fc[6]))
     return {
         "delta": delta,
         "d_sum": float(delta[1:4, 2].sum()),

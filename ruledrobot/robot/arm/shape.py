@@ -52,9 +52,10 @@ def link_radii(model: RobotModel) -> FloatArray:
 
 @dataclass(frozen=True)
 class Segment:
-    """A primitive of a link, in its body frame: a ``kind`` ("capsule" or "cylinder")
-    from ``a`` to ``b`` (3,) [m] of ``radius`` [m]; ``part`` "joint" (a housing) or
-    "link" (a tube)."""
+    """A primitive of a link, in its body frame.
+
+    A ``kind`` ("capsule" or "cylinder") from ``a`` to ``b`` (3,) [m] of ``radius`` [m];
+    ``part`` "joint" (a housing) or "link" (a tube)."""
 
     kind: str
     a: FloatArray

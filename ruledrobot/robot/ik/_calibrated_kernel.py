@@ -496,11 +496,13 @@ def _closed_form(g, tg, out, ok):
 
 @_jit
 def seeds(geoms, flange, out, exact, numpy_rows):
-    """Nominal seeds of ``calibrated_ik.nominal_seeds``: the closed form of ``geoms[0]``
-    (d1, a2, a3, d4, d5, d6), branches it misses filled from ``geoms[1]`` (1 cm further) for
-    every pose with a missing branch, from ``geoms[2]`` (3 cm) for poses with none.  Fills
-    ``out`` (n, 8, 6) (NaN rows = none) and ``exact`` (n, 8); ``numpy_rows`` (n,) is set where
-    the wrist is nearly singular and the caller must seed the pose with the numpy closed form.
+    """Nominal seeds of ``calibrated_ik.nominal_seeds``.
+
+    The closed form of ``geoms[0]`` (d1, a2, a3, d4, d5, d6), branches it misses filled from
+    ``geoms[1]`` (1 cm further) for every pose with a missing branch, from ``geoms[2]`` (3 cm)
+    for poses with none. Fills ``out`` (n, 8, 6) (NaN rows = none) and ``exact`` (n, 8);
+    ``numpy_rows`` (n,) is set where the wrist is nearly singular and the caller must seed the
+    pose with the numpy closed form.
     """
     n = flange.shape[0]
     tg = np.empty(12)

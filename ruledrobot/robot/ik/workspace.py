@@ -62,8 +62,9 @@ def reach_margin(model: RobotModel, q: ArrayLike) -> FloatArray:
 def reach_excess(
     model: RobotModel, T: ArrayLike, check: bool = True
 ) -> tuple[FloatArray, np.ndarray]:
-    """Per IK branch, how far (m) TCP poses ``T`` (..., 4, 4, world frame) miss the arm's
-    reach: ``(excess, kind)``, both (..., 8) in the branch order of ``model.ik``.
+    """Per IK branch, how far (m) TCP poses ``T`` (..., 4, 4, world frame) miss the arm's reach.
+
+    ``(excess, kind)``, both (..., 8) in the branch order of ``model.ik``.
 
     ``excess > 0``: the pose is out of reach on that branch by that distance (the
     elbow target beyond the stretched arm, inside the folded one, or the wrist point

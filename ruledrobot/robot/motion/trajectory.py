@@ -34,6 +34,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ...geometry.rotations import angle_between
 from ...geometry.se3 import pose_from_ur_vector, ur_vector_from_pose
 from .._checks import FloatArray, as_array, as_pose_or_vector, readonly
 from ..arm.model import DEFAULT_ACCELERATION, RobotModel
@@ -403,12 +404,7 @@ class Trajectory:
         T = robot.fk(self.q)
         P = self.tcp_poses()
         dp = np.linalg.norm(T[:, :3, 3] - P[:, :3, 3], axis=1)
-        R = np.einsum("kji,kjl->kil", T[:, :3, :3], P[:, :3, :3])
-        cos = np.clip((np.trace(R, axis1=1, axis2=2) - 1.0) / 2.0, -1.0, 1.0)
-        # arccos loses precision near 0: use the skew part as well
-        skew = np.stack([R[:, 2, 1] - R[:, 1, 2], R[:, 0, 2] - R[:, 2, 0],
-                         R[:, 1, 0] - R[:, 0, 1]], axis=1)  # fmt: skip
-        ang = np.arctan2(0.5 * np.linalg.norm(skew, axis=1), cos)
+        ang = angle_between(T, P)
         k = int(np.argmax(dp))
         return float(dp[k]), float(ang.max()), k
 

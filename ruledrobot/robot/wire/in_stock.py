@@ -40,6 +40,7 @@ from numpy.typing import ArrayLike
 from ...geometry.box import Box
 from ...geometry.ranges import runs_of
 from .._checks import FloatArray
+from ..tool import BowTool
 
 __all__ = [
     "TOUCH",
@@ -47,6 +48,7 @@ __all__ = [
     "across_speeds",
     "chord_fractions",
     "feed_chord",
+    "flange_wire_ends",
     "largest_line_distance",
     "wire_ends",
     "wire_gap",
@@ -83,12 +85,24 @@ def wire_ends(tcp: ArrayLike, wire_length: float) -> FloatArray:
     return np.stack([p - half, p + half], axis=-2)
 
 
+def flange_wire_ends(flange: ArrayLike, bow: BowTool) -> FloatArray:
+    """Wire ends (M, 2, 3) of flange poses (M, 4, 4) that carry ``bow``.
+
+    :func:`wire_ends` of the wire frames ``flange @ W``
+    (:meth:`~ruledrobot.robot.tool.BowTool.wire_frame`), i.e. the bow's ``wire_start`` and
+    ``wire_end`` carried by each flange pose. The one derivation of the wire from the arm (the
+    planner, the playback's contacts and video, the viewer); the ends are in the flange poses'
+    frame (base or world)."""
+    return wire_ends(np.asarray(flange, dtype=np.float64) @ bow.wire_frame(), bow.wire_length)
+
+
 def chord_fractions(
     ends: ArrayLike, stock: Box, margin: float = 0.0
 ) -> tuple[FloatArray, FloatArray]:
-    """The chord of each wire in the block grown by ``margin``: ``(lo, hi)`` (M,) as
-    fractions of the wire from its start, NaN where the chord is shorter than
-    :data:`TOUCH` (the wire misses or only touches the block)."""
+    """The chord of each wire in the block grown by ``margin``.
+
+    ``(lo, hi)`` (M,) as fractions of the wire from its start, NaN where the chord is shorter
+    than :data:`TOUCH` (the wire misses or only touches the block)."""
     e = np.asarray(ends, dtype=np.float64)
     a, d = e[..., 0, :], e[..., 1, :] - e[..., 0, :]
     length = np.linalg.norm(d, axis=-1)
@@ -227,8 +241,10 @@ class WireInStock:
 
 
 def wire_in_stock(t: ArrayLike, ends: ArrayLike, stock: Box) -> WireInStock:
-    """The wire against ``stock`` along a motion: ``t`` (M,) s strictly increasing,
-    ``ends`` (M, 2, 3) the wire's start and end in the block's frame (module doc)."""
+    """The wire against ``stock`` along a motion.
+
+    ``t`` (M,) s strictly increasing, ``ends`` (M, 2, 3) the wire's start and end in the
+    block's frame (module doc)."""
     ta = np.asarray(t, dtype=np.float64)
     e = np.asarray(ends, dtype=np.float64)
     if e.ndim != 3 or e.shape[1:] != (2, 3) or e.shape[0] != ta.size:
@@ -274,11 +290,12 @@ def wire_gap(ends: ArrayLike, stock: Box) -> FloatArray:
 
 
 def feed_chord(ends: ArrayLike, stock: Box, near: float) -> FloatArray:
-    """The chord ends (M, 2) whose speed the time law bounds: the chord where the wire
-    is in the stock; where it is outside but within ``near`` (m) of the block, the part
-    of the wire nearest the block — its chord in the block grown by the wire's distance
-    from it (a point, or a stretch where the wire runs parallel to a face); NaN further
-    away (``near = inf``: nowhere).
+    """The chord ends (M, 2) whose speed the time law bounds.
+
+    The chord where the wire is in the stock; where it is outside but within ``near`` (m) of
+    the block, the part of the wire nearest the block — its chord in the block grown by the
+    wire's distance from it (a point, or a stretch where the wire runs parallel to a face); NaN
+    further away (``near = inf``: nowhere).
 
     As the wire comes to the block, that part becomes the part where it first touches,
     so the bound meets the chord's without a jump (a bound that appears only once the

@@ -17,11 +17,12 @@ __all__ = ["emulated_model", "kinematics_info_of"]
 def emulated_model(
     model: str | RobotModel, calibration: Calibration | str | os.PathLike | None = None
 ) -> RobotModel:
-    """The arm an emulator runs: ``model`` (a catalogue name or a :class:`RobotModel`) with
-    ``calibration`` (a :class:`~ruledrobot.robot.Calibration`, a ``ruledrobot.calibration/1``
-    file, or ``"random:SEED"`` for a seeded realistic one) attached.  ValueError (naming both
-    models) for a calibration of another model, :class:`~ruledrobot.robot.CalibrationError`
-    for a bad file."""
+    """The arm an emulator runs.
+
+    ``model`` (a catalogue name or a :class:`RobotModel`) with ``calibration`` (a
+    :class:`~ruledrobot.robot.Calibration`, a ``ruledrobot.calibration/1`` file, or
+    ``"random:SEED"`` for a seeded realistic one) attached. ValueError (naming both models) for
+    a calibration of another model, :class:`~ruledrobot.robot.CalibrationError` for a bad file."""
     arm = load(model) if isinstance(model, str) else model
     if not isinstance(arm, RobotModel):
         raise ValueError(f"model: expected a model name or a RobotModel, got {type(arm).__name__}")
@@ -45,10 +46,11 @@ def emulated_model(
 
 
 def kinematics_info_of(model: RobotModel) -> KinematicsInfo:
-    """The KinematicsInfo an emulator of ``model`` serves: its calibration's (effective table,
-    checksums, status; checksums 0 and status 2 where the calibration has none), or for
-    an uncalibrated model its DH table with checksums 0 and status 2 ("linearised": the
-    table is the emulated arm's exact kinematics)."""
+    """The KinematicsInfo an emulator of ``model`` serves.
+
+    Its calibration's (effective table, checksums, status; checksums 0 and status 2 where the
+    calibration has none), or for an uncalibrated model its DH table with checksums 0 and
+    status 2 ("linearised": the table is the emulated arm's exact kinematics)."""
     if model.calibration is not None:
         return model.calibration.kinematics_info()
     if model.n_joints != 6:

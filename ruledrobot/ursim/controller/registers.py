@@ -115,8 +115,10 @@ class IOMixin:
             self._note_io()
 
     def set_digital_out(self, kind: str, n: int, value: bool) -> None:
-        """A digital output: ``kind`` ``"standard"`` (pins 0-7), ``"configurable"`` (0-7)
-        or ``"tool"`` (0-1); ValueError for another kind or pin."""
+        """A digital output.
+
+        ``kind`` ``"standard"`` (pins 0-7), ``"configurable"`` (0-7) or ``"tool"`` (0-1);
+        ValueError for another kind or pin."""
         top = {"standard": 7, "configurable": 7, "tool": 1}.get(kind)
         if top is None:
             raise ValueError(f"digital output kind: expected standard, configurable or tool, "

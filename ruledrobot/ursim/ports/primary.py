@@ -172,9 +172,10 @@ class PrimaryServer(TcpServer):
 
 
 def robot_state(ctrl: Controller, kinematics: bytes, reserved: bool = True) -> bytes:
-    """The robot-state message of ``ctrl`` now: robot mode data and ``kinematics`` (the
-    KinematicsInfo sub-package).  Reads the controller without its lock (single
-    attribute reads; the values are at most one period old)."""
+    """The robot-state message of ``ctrl`` now.
+
+    Robot mode data and ``kinematics`` (the KinematicsInfo sub-package). Reads the controller
+    without its lock (single attribute reads; the values are at most one period old)."""
     robot_mode = ctrl.robot_mode
     safety = ctrl.safety_mode
     runtime = ctrl.runtime_state
@@ -225,8 +226,10 @@ class PrimaryPublisher:
         self._thread: threading.Thread | None = None
 
     def hello(self) -> bytes:
-        """What a new connection gets first: the version message (timestamp: the controller
-        time [us]) and the current robot-state message."""
+        """What a new connection gets first.
+
+        The version message (timestamp: the controller time [us]) and the current robot-state
+        message."""
         return version_message(self.version, round(self.controller.time * 1e6)) + self.message()
 
     def message(self) -> bytes:

@@ -83,8 +83,10 @@ def receive_programs(
     controller: Controller,
     received: Callable[[str], None] | None = None,
 ) -> None:
-    """Read URScript from ``conn`` until it closes (:class:`ProgramReceiver`); a program or
-    line beyond the bounds is refused: logged at error level, the connection closed."""
+    """Read URScript from ``conn`` until it closes (:class:`ProgramReceiver`).
+
+    A program or line beyond the bounds is refused: logged at error level, the connection
+    closed."""
     receiver = ProgramReceiver(controller, received)
     try:
         server.recv_loop(conn, receiver.feed, bufsize=1 << 18)

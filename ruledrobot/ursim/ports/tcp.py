@@ -125,8 +125,10 @@ class QueuedConnection(Connection):
         return self.broken
 
     def push(self, data: bytes, max_backlog: int, send: bool = True) -> None:
-        """Queue bytes and send what the socket takes now, never blocking; beyond
-        ``max_backlog`` queued bytes the connection is marked broken (closed by its thread).
+        """Queue bytes and send what the socket takes now, never blocking.
+
+        Beyond ``max_backlog`` queued bytes the connection is marked broken (closed by its
+        thread).
 
         ``send=False``: only queue (the socket is known not to be writable: a send
         attempt would only cost a GIL hand-off)."""
@@ -204,9 +206,10 @@ FALLBACK_NICE = -10
 
 
 def try_realtime_priority(priority: int) -> bool:
-    """Give the calling thread ``SCHED_FIFO`` ``priority`` if allowed (Linux, CAP_SYS_NICE);
-    when refused, nice :data:`FALLBACK_NICE` if allowed (Linux nice values are per
-    thread).  Returns whether the thread is real-time."""
+    """Give the calling thread ``SCHED_FIFO`` ``priority`` if allowed (Linux, CAP_SYS_NICE).
+
+    When refused, nice :data:`FALLBACK_NICE` if allowed (Linux nice values are per thread).
+    Returns whether the thread is real-time."""
     setter = getattr(os, "sched_setscheduler", None)
     if setter is not None:
         try:

@@ -74,8 +74,10 @@ def compile_script(text: str, *, max_payload: float | None = None) -> CompiledSc
 
 
 def load_program(text: str, *, max_payload: float | None = None) -> Program:
-    """A program as the controller receives it: ur_rtde's control script classified
-    (:func:`~.program.parse_program`), any other compiled (``Program.compiled``)."""
+    """A program as the controller receives it.
+
+    Ur_rtde's control script classified (:func:`~.program.parse_program`), any other compiled
+    (``Program.compiled``)."""
     prog = parse_program(text)
     if prog.kind != "rtde_control":
         prog.compiled = compile_script(text, max_payload=max_payload)

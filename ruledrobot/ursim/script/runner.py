@@ -48,8 +48,9 @@ def move_segment(
     r: float,
     unreachable: str,
 ) -> Segment:
-    """The segment of one move of a blended path, as the controller plans it: the one
-    reading of ``movej`` / ``movel`` / ``movep`` for programs and injected paths.
+    """The segment of one move of a blended path, as the controller plans it.
+
+    The one reading of ``movej`` / ``movel`` / ``movep`` for programs and injected paths.
 
     Parameters
     ----------

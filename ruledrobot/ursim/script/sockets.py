@@ -121,8 +121,10 @@ class _Conn:
 
 
 class ScriptSockets:
-    """The sockets of one program run; ``period`` is the control period [s]; ``realtime``:
-    their threads ask for real-time priority (the emulator's setting)."""
+    """The sockets of one program run.
+
+    ``period`` is the control period [s]; ``realtime``: their threads ask for real-time
+    priority (the emulator's setting)."""
 
     def __init__(self, period: float, realtime: bool = False) -> None:
         self.period = float(period)

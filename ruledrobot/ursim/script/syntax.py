@@ -54,8 +54,10 @@ def _parser() -> Lark:
 
 
 def warm_up() -> None:
-    """Build the parser now (about 0.1 s, once per process): the emulator does it before
-    its clock starts, so that the first program does not stall the clock."""
+    """Build the parser now (about 0.1 s, once per process).
+
+    The emulator does it before its clock starts, so that the first program does not stall the
+    clock."""
     _parser()
 
 

@@ -37,8 +37,10 @@ _NOT_LITERAL = object()
 
 @dataclass
 class Transpiled:
-    """A program as Python: ``source``, the URScript line of each Python line
-    (``lines[i]`` for line ``i + 1``), the main program's name and whether it is ``sec``."""
+    """A program as Python.
+
+    ``source``, the URScript line of each Python line (``lines[i]`` for line ``i + 1``), the
+    main program's name and whether it is ``sec``."""
 
     source: str
     lines: list[int]

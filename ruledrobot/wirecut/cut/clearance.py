@@ -127,9 +127,11 @@ class Cell:
 
 
 def base_capsule(model: RobotModel) -> tuple[FloatArray, float]:
-    """The robot's base as a capsule: its axis (2, 3) [m] in the robot base frame and its
-    radius [m] — the MuJoCo ``base`` geom (:func:`ruledrobot.sim.mjcf.build_robot`: a
-    cylinder of 1.15 shoulder-housing radii from the base plane up to the column)."""
+    """The robot's base as a capsule.
+
+    Its axis (2, 3) [m] in the robot base frame and its radius [m] — the MuJoCo ``base`` geom
+    (:func:`ruledrobot.sim.mjcf.build_robot`: a cylinder of 1.15 shoulder-housing radii from
+    the base plane up to the column)."""
     nom = model.nominal
     _, base_h = link_segments(nom)
     z = (0.0, base_h) if nom.d[0] >= 0.0 else (-base_h, 0.0)

@@ -65,9 +65,10 @@ def _loop(F: FloatArray, flip: bool, start: int, direction: int, length: int) ->
 
 
 def slit_direction(frames: FloatArray, i: int, stock: Box) -> FloatArray:
-    """Unit direction (3,) the wire moves in at ruling ``i`` of a closed sequence: the
-    tangent of the chord midpoints' loop there, normal to the ruling (central
-    differences, periodic)."""
+    """Unit direction (3,) the wire moves in at ruling ``i`` of a closed sequence.
+
+    The tangent of the chord midpoints' loop there, normal to the ruling (central differences,
+    periodic)."""
     c0, c1, hit = chords(frames, stock)
     t = np.where(hit, 0.5 * (c0 + c1), 0.0)[:, None]
     mid = frames[:, :3, 3] + t * frames[:, :3, 2]
@@ -108,7 +109,7 @@ def _slit(frame: FloatArray, direction: FloatArray, stock: Box, lead: float,
     slit's outer end, so that the wire's angular velocity, like its velocity, is
     continuous where the slit meets the loop (a jump there jumps the joint rates and the
     feed with them)."""
-    grown = Box(stock.centre, stock.size + 2.0 * lead, stock.rotation)
+    grown = stock.grown(lead)
     o, z = frame[:3, 3], frame[:3, 2]
     dist = _clear_distance(grown, o, z, direction)
     n = max(2, int(np.ceil(dist / SLIT_STEP)) + 1)
@@ -165,8 +166,10 @@ def loop_paths(
     cell: Cell,
     options: SearchOptions,
 ) -> list[CutPath]:
-    """The passes of a closed cut (module doc): one, or two that meet opposite the slit;
-    each pass's wire pose searched in ``cell`` with ``options``."""
+    """The passes of a closed cut (module doc).
+
+    One, or two that meet opposite the slit; each pass's wire pose searched in ``cell`` with
+    ``options``."""
     M = wire.shape[0]
     wire = world_referenced(wire)
     S = world_referenced(rc.frames)

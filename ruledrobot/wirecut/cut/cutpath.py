@@ -46,8 +46,10 @@ class CutPath:
         return np.arange(len(self.frames), dtype=np.float64) if self.param is None else self.param
 
     def locate(self, s: FloatArray) -> tuple[np.ndarray, FloatArray]:
-        """For path parameters ``s`` (K,): the ruling before each (K,) int, clipped to
-        ``0 .. M - 2``, and the fraction (K,) of the way to the next."""
+        """For path parameters ``s`` (K,).
+
+        The ruling before each (K,) int, clipped to ``0 .. M - 2``, and the fraction (K,) of
+        the way to the next."""
         p = self.s
         i0 = np.clip(np.searchsorted(p, s, side="right") - 1, 0, len(p) - 2)
         frac = np.clip((np.asarray(s) - p[i0]) / (p[i0 + 1] - p[i0]), 0.0, 1.0)
@@ -60,8 +62,9 @@ class CutPath:
 
     @property
     def target_frames(self) -> FloatArray:
-        """(M, 4, 4) the target surface's rulings: ``surface_frames``, or ``frames`` when
-        the pass is not kerf-compensated (None given)."""
+        """(M, 4, 4) the target surface's rulings.
+
+        ``surface_frames``, or ``frames`` when the pass is not kerf-compensated (None given)."""
         return self.frames if self.surface_frames is None else self.surface_frames
 
 

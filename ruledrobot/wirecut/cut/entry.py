@@ -60,9 +60,10 @@ MAX_RULINGS = 60
 
 @dataclass(frozen=True)
 class ProfileEntry:
-    """The profile's rulings with their moves: ``lines`` (N + before + after),
-    ``before`` rulings of the entry move ahead of the profile's first and ``after`` of
-    the exit move past its last."""
+    """The profile's rulings with their moves.
+
+    ``lines`` (N + before + after), ``before`` rulings of the entry move ahead of the profile's
+    first and ``after`` of the exit move past its last."""
 
     lines: Lines
     before: int
@@ -99,7 +100,7 @@ def _move(ends: FloatArray, step: FloatArray, stock: Box) -> FloatArray:
     if not (h > 0.0).any():
         raise ValueError("the profile's end rulings coincide: no direction to enter along")
     u = step / np.where(h > 0.0, h, 1.0)[:, None]  # an end that does not move stays
-    grown = Box(stock.centre, stock.size + 2.0 * CLEAR, stock.rotation)
+    grown = stock.grown(CLEAR)
     k = np.arange(1, MAX_RULINGS + 1)
     s = np.cumsum(GROWTH ** (k - 1))  # in units of the end step
     pts = ends[None] + s[:, None, None] * h[None, :, None] * u[None]

@@ -49,8 +49,9 @@ def _frames_of(doc: LinesDocument) -> FloatArray:
 
 def check_cut_order(job: Job, documents: Sequence[LinesDocument] | None = None) -> None:
     """ValueError naming the cuts when the job's order breaks a rule of the module doc.
-    ``documents``: the cuts' input rulings (``cut.surface.document()`` of each, in the
-    job's order) when the caller read them already."""
+
+    ``documents``: the cuts' input rulings (``cut.surface.document()`` of each, in the job's
+    order) when the caller read them already."""
     where = str(job.source or "job")
     docs = list(documents) if documents is not None else [None] * len(job.cuts)
     for k, cut in enumerate(job.cuts):

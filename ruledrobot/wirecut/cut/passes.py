@@ -454,7 +454,7 @@ def cut_paths(
     if rc.closed:
         return loop_paths(job, cut, rc, wire, kerf, cell, options)
     lead = max(cut.lead_in, cut.lead_out)
-    grown = Box(job.stock.centre, job.stock.size + 2.0 * lead, job.stock.rotation)
+    grown = job.stock.grown(lead)
     _, _, near = chords(wire, grown)
     if not near.any():
         raise ValueError(f"cut '{cut.name}': no refined ruling comes near the stock; check the "

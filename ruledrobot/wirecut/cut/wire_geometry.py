@@ -29,7 +29,12 @@ from ...geometry import se3
 from ...geometry.box import Box
 from ...geometry.checks import FloatArray
 from ...robot.tool import BowTool
-from ...robot.wire.in_stock import across_speeds, feed_chord, largest_line_distance, wire_ends
+from ...robot.wire.in_stock import (
+    across_speeds,
+    feed_chord,
+    flange_wire_ends,
+    largest_line_distance,
+)
 from ..job.spec import ToolSpec
 
 __all__ = [
@@ -46,10 +51,11 @@ __all__ = [
 
 
 def wire_frame(tool: ToolSpec | BowTool) -> FloatArray:
-    """The wire frame W (4, 4) in the flange frame (see the module doc): origin at the
-    wire midpoint, z along the wire, x the bow's depth direction
-    (:meth:`ruledrobot.robot.tool.BowTool.wire_frame`); ``tool`` the job's spec or the
-    bow built from it."""
+    """The wire frame W (4, 4) in the flange frame (see the module doc).
+
+    Origin at the wire midpoint, z along the wire, x the bow's depth direction
+    (:meth:`ruledrobot.robot.tool.BowTool.wire_frame`); ``tool`` the job's spec or the bow
+    built from it."""
     return BowTool.of(tool).wire_frame()
 
 
@@ -112,9 +118,10 @@ def world_referenced(F: FloatArray) -> FloatArray:
 def slide_bounds(
     c0: FloatArray, c1: FloatArray, hit: np.ndarray, tool: ToolSpec
 ) -> tuple[FloatArray, FloatArray, np.ndarray]:
-    """Slides ``lo <= s <= hi`` (M,) for which the wire covers each chord with the
-    clearance; ``(-inf, inf)`` where the ruling misses the stock.  ``ok`` is False
-    where the chord is longer than the wire allows."""
+    """Slides ``lo <= s <= hi`` (M,) for which the wire covers each chord with the clearance.
+
+    ``(-inf, inf)`` where the ruling misses the stock. ``ok`` is False where the chord is
+    longer than the wire allows."""
     half = 0.5 * tool.wire_length - tool.clearance
     lo = np.where(hit, c1 - half, -np.inf)
     hi = np.where(hit, c0 + half, np.inf)
@@ -137,8 +144,9 @@ def _rz_tz(psi: FloatArray, s: FloatArray, reverse: FloatArray | bool) -> FloatA
 def wire_poses(
     frames: ArrayLike, roll: ArrayLike, slide: ArrayLike, reverse: ArrayLike | bool = False
 ) -> FloatArray:
-    """Wire poses ``G = F Rz(roll) Tz(slide) [Rx(pi)]``: frames (M, 4, 4), roll and
-    slide broadcast to (..., M) -> (..., M, 4, 4)."""
+    """Wire poses ``G = F Rz(roll) Tz(slide) [Rx(pi)]``.
+
+    Frames (M, 4, 4), roll and slide broadcast to (..., M) -> (..., M, 4, 4)."""
     F = np.asarray(frames, dtype=np.float64)
     psi, s = np.broadcast_arrays(np.asarray(roll, float), np.asarray(slide, float))
     return F @ _rz_tz(psi, s, reverse)
@@ -164,7 +172,7 @@ def speed_factor(
     job's spec or the bow built from it.
     """
     bow = BowTool.of(tool)
-    ends = wire_ends(np.asarray(flange, dtype=np.float64) @ bow.wire_frame(), bow.wire_length)
+    ends = flange_wire_ends(flange, bow)
     f = feed_chord(ends, stock, near)
     if len(ends) < 2:
         return np.zeros(len(ends))

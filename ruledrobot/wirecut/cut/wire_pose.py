@@ -89,8 +89,9 @@ class SearchOptions:
             )
 
     def cell(self, model: RobotModel, tool: ToolSpec | BowTool, stock: Box) -> Cell:
-        """The clearance cell of these options (built once per plan and passed down): the
-        whole collision model, the arm against itself included, as the transits between the
+        """The clearance cell of these options (built once per plan and passed down).
+
+        The whole collision model, the arm against itself included, as the transits between the
         passes judge their ends (one model: a pass may not end where no transit may start)."""
         cell = Cell.of(model, tool, stock, self.table_z, self.margin, self.singular_min,
                        self.q_start)  # fmt: skip

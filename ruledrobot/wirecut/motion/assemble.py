@@ -30,7 +30,7 @@ from ...robot.arm.model import RobotModel
 from ...robot.arm.nearest import nearest_ik
 from ...robot.motion.trajectory import HEATED_PHASES
 from ...robot.tool import BowTool
-from ...robot.wire.in_stock import WireInStock, wire_ends, wire_gap, wire_in_stock
+from ...robot.wire.in_stock import WireInStock, flange_wire_ends, wire_gap, wire_in_stock
 from ..cut.clearance import Cell
 from ..cut.passes import CutPath
 from ..cut.wire_geometry import speed_factor
@@ -184,12 +184,14 @@ def _across(p: FloatArray, o: FloatArray, z: FloatArray) -> FloatArray:
 def feed_param(
     job: Job, cp: CutPath, feed_speed: float, bow: BowTool | None = None
 ) -> tuple[FloatArray, float]:
-    """(M,) the path parameter the feed is held in, and ``near`` (m): the distance [m]
-    travelled across the wire by the part of it nearest the block — the chord's ends
-    inside it — as the speed factor measures it (:func:`~..cut.wire_geometry.speed_factor`, the
-    one model); ``near``: how far out of the block the time law bounds that part's
-    speed: :data:`FEED_NEAR`, or farther so that the bound reaches three rulings beyond
-    every entry and exit and the wire moves at the feed for :data:`SETTLE_S` before it.
+    """(M,) the path parameter the feed is held in, and ``near`` (m).
+
+    The distance [m] travelled across the wire by the part of it nearest the block — the
+    chord's ends inside it — as the speed factor measures it
+    (:func:`~..cut.wire_geometry.speed_factor`, the one model); ``near``: how far out of the
+    block the time law bounds that part's speed: :data:`FEED_NEAR`, or farther so that the
+    bound reaches three rulings beyond every entry and exit and the wire moves at the feed for
+    :data:`SETTLE_S` before it.
 
     First the frame origins' travel across the wire ``s0``; then each interval's length
     is the mean speed factor at its ends (per unit of ``s0``) times its ``s0`` length,
@@ -208,7 +210,7 @@ def feed_param(
     step0 = np.maximum(step0, 1e-9)  # strictly increasing, also where the wire holds still
     s0 = np.r_[0.0, np.cumsum(step0)]
     bow = BowTool.of(job.tool if bow is None else bow)
-    ends = wire_ends(cp.motion.flange @ bow.wire_frame(), bow.wire_length)
+    ends = flange_wire_ends(cp.motion.flange, bow)
     step = np.empty_like(step0)
     cuts = [0, *(int(c) for c in corner_nodes(F, 0.5 * job.tool.wire_length)), len(F) - 1]
     for a, b in pairwise(cuts):  # between corners: differences never reach across one
@@ -231,7 +233,7 @@ def measure_wire(
     times ``t`` (M,) (``model``: the planner's, flange without tool, base frame; ``bow``:
     the job's, when the caller built it)."""
     bow = BowTool.of(job.tool if bow is None else bow)
-    ends = wire_ends(model.fk(q) @ bow.wire_frame(), bow.wire_length)
+    ends = flange_wire_ends(model.fk(q), bow)
     return wire_in_stock(t, ends, job.stock)
 
 

@@ -87,11 +87,12 @@ def joint_reach(cell: Cell) -> FloatArray:
 
 @dataclass(frozen=True)
 class TransitFailure:
-    """A transit no route was found for.  ``what``: which one, in words ("from 'top' to
-    'side'"); ``start``, ``goal``: the rules its start and its goal break (empty: free);
-    ``move``: the rules the direct move breaks (the union over its samples);
-    ``searched``: the search ran (start and goal free) and found nothing in
-    ``time_limit`` s."""
+    """A transit no route was found for.
+
+    ``what``: which one, in words ("from 'top' to 'side'"); ``start``, ``goal``: the rules its
+    start and its goal break (empty: free); ``move``: the rules the direct move breaks (the
+    union over its samples); ``searched``: the search ran (start and goal free) and found
+    nothing in ``time_limit`` s."""
 
     what: str
     start: tuple[str, ...]
@@ -104,8 +105,10 @@ class TransitFailure:
     qb: tuple[float, ...] = ()
 
     def sentence(self) -> str:
-        """The failure in words: the transit, why no search could run or that it found
-        nothing, and the bodies in the direct move's way."""
+        """The failure in words.
+
+        The transit, why no search could run or that it found nothing, and the bodies in the
+        direct move's way."""
         why = []
         for name, rules in (("its start", self.start), ("its goal", self.goal)):
             if rules:
@@ -149,10 +152,12 @@ class TransitPlanner:
         cls, job: Job, model: RobotModel, margin: float = MARGIN, cell: Cell | None = None,
         time_limit: float = TIME_LIMIT,
     ) -> TransitPlanner:
-        """The transits of ``job``: its whole stock an obstacle, the table at z = 0,
-        ``margin`` [m] clearance, the arm against itself, no singularity threshold;
-        ``cell``: the plan's cell (its robot, bow and stock: no bow built again), else
-        built here; ``time_limit``: the search's per transit [s].
+        """The transits of ``job``.
+
+        Its whole stock an obstacle, the table at z = 0, ``margin`` [m] clearance, the arm
+        against itself, no singularity threshold; ``cell``: the plan's cell (its robot, bow and
+        stock: no bow built again), else built here; ``time_limit``: the search's per transit
+        [s].
 
         The step between checked samples: ``step = min(r_min, 2 margin)``, with ``r_min``
         the thinnest radius of the model (the arm's capsules, the bow's rods and wire,
@@ -183,13 +188,15 @@ class TransitPlanner:
 
     @property
     def resolution(self) -> float:
-        """The joint step [rad] between checked samples of a move of every joint at once
-        (max norm): ``step / sum_j R_j``."""
+        """The joint step [rad] between checked samples of a move of every joint at once (max norm).
+
+        ``step / sum_j R_j``."""
         return self.step / float(self.reach.sum())
 
     def samples(self, qa: FloatArray, qb: FloatArray) -> FloatArray:
-        """The checked samples (n, J) of the straight joint move qa -> qb, both ends
-        included: ``n = ceil(sum_j R_j |qb_j - qa_j| / step) + 1`` (:meth:`of`)."""
+        """The checked samples (n, J) of the straight joint move qa -> qb, both ends included.
+
+        ``n = ceil(sum_j R_j |qb_j - qa_j| / step) + 1`` (:meth:`of`)."""
         travel = float(self.reach @ np.abs(qb - qa))
         n = max(2, int(np.ceil(travel / self.step)) + 1)
         u = np.linspace(0.0, 1.0, n)[:, None]
@@ -212,8 +219,9 @@ class TransitPlanner:
         return self.cell.stock.segment_hits(w[:, 0], w[:, 1], self.cell.margin)
 
     def clear(self, qa: FloatArray, qb: FloatArray) -> bool:
-        """True when every sample of the straight joint move qa -> qb is free.  Every
-        eighth sample is checked first (a blocked move is usually blocked over many
+        """True when every sample of the straight joint move qa -> qb is free.
+
+        Every eighth sample is checked first (a blocked move is usually blocked over many
         samples), the others only when those are free."""
         q = self.samples(qa, qb)
         if len(q) > 16 and not self.free(q[::8]).all():
@@ -272,8 +280,9 @@ class TransitPlanner:
     def route(
         self, qa: FloatArray, qb: FloatArray, notes: list[str], what: str
     ) -> list[tuple[FloatArray, FloatArray]]:
-        """Joint moves from ``qa`` to ``qb`` (rad) clear of the cell (module doc); a note
-        says when the direct move was not.  Raises :class:`TransitNotFound` when no route
+        """Joint moves from ``qa`` to ``qb`` (rad) clear of the cell (module doc).
+
+        A note says when the direct move was not. Raises :class:`TransitNotFound` when no route
         is found (``what`` names the transit in its words)."""
         qa, qb = np.asarray(qa, dtype=np.float64), np.asarray(qb, dtype=np.float64)
         if np.allclose(qa, qb):

@@ -66,10 +66,12 @@ SCREEN = 6
 
 @dataclass(frozen=True, eq=False)
 class PassSample:
-    """A pass as the search samples it: its cut (index, name), the sampled rulings
-    ``idx`` (R,), the flange poses ``P0`` (2, K, R, 4, 4) at the job's placement,
-    ``bow_ok`` (2, K, R) whether the bow clears the stock there (a rule placement does
-    not change), and ``too_long`` (m, > 0 when a chord is longer than the wire allows)."""
+    """A pass as the search samples it.
+
+    Its cut (index, name), the sampled rulings ``idx`` (R,), the flange poses ``P0`` (2, K, R,
+    4, 4) at the job's placement, ``bow_ok`` (2, K, R) whether the bow clears the stock there
+    (a rule placement does not change), and ``too_long`` (m, > 0 when a chord is longer than
+    the wire allows)."""
 
     cut: int
     name: str
@@ -90,10 +92,11 @@ class PassSample:
 
 @dataclass(frozen=True, eq=False)
 class Scores:
-    """Scores of C candidates: ``margin`` (C,) m, the worst over passes; per pass
-    ``pass_margin`` (C, n) m and ``column`` (C, n) the best column (index into
-    directions x rolls x branches); ``score`` (C,) the ranking value (module doc);
-    ``exact`` (C,) False where the search of columns was cut short."""
+    """Scores of C candidates.
+
+    ``margin`` (C,) m, the worst over passes; per pass ``pass_margin`` (C, n) m and ``column``
+    (C, n) the best column (index into directions x rolls x branches); ``score`` (C,) the
+    ranking value (module doc); ``exact`` (C,) False where the search of columns was cut short."""
 
     margin: FloatArray
     score: FloatArray
@@ -151,7 +154,8 @@ class Evaluator:
                                            tuple(opts[1:])))  # fmt: skip
 
     def subset(self, cuts: list[int]) -> Evaluator:
-        """This evaluator for the passes of ``cuts`` only (indices into the job's cuts);
+        """This evaluator for the passes of ``cuts`` only (indices into the job's cuts).
+
         :meth:`cut_margins` is then inf for the others."""
         import copy
 
@@ -285,14 +289,15 @@ class Evaluator:
 
 @dataclass(frozen=True, eq=False)
 class ColumnDetail:
-    """One pass of one placement in detail: its best column — the **best constant roll**
-    (``reverse``, ``roll`` rad, IK ``branch``: the one with the largest worst margin, the
-    search's choice) —, per sampled ruling (R,) the margin (m) and the reason it fails
-    (:class:`~.margins.Reason`), and which part of the margin is the least there
-    (``limit``: "reach", "joint limits", "singularity", "clearance" or a reason).
-    ``worst`` (m) is the column's value as the search scores it: the least of the
-    rulings' margins and of ``travel`` (the joints' travel along the pass centred in
-    their limits, m); ``rulings`` the rulings of the pass."""
+    """One pass of one placement in detail.
+
+    Its best column — the **best constant roll** (``reverse``, ``roll`` rad, IK ``branch``: the
+    one with the largest worst margin, the search's choice) —, per sampled ruling (R,) the
+    margin (m) and the reason it fails (:class:`~.margins.Reason`), and which part of the
+    margin is the least there (``limit``: "reach", "joint limits", "singularity", "clearance"
+    or a reason). ``worst`` (m) is the column's value as the search scores it: the least of the
+    rulings' margins and of ``travel`` (the joints' travel along the pass centred in their
+    limits, m); ``rulings`` the rulings of the pass."""
 
     name: str
     idx: np.ndarray
@@ -355,9 +360,10 @@ class ColumnDetail:
 
 
 def details(ev: Evaluator, T: FloatArray) -> list[ColumnDetail]:
-    """The best column of every pass for the placement T (4, 4), ruling by ruling: the
-    same margins the search scores (:meth:`Evaluator.__call__`), the bow's gate and a
-    chord longer than the wire included."""
+    """The best column of every pass for the placement T (4, 4), ruling by ruling.
+
+    The same margins the search scores (:meth:`Evaluator.__call__`), the bow's gate and a chord
+    longer than the wire included."""
     from ...robot.ik.workspace import reach_margin
     from .margins import REASON_TEXT, joint_limit_margin, limit_levers
 
@@ -413,11 +419,12 @@ def details(ev: Evaluator, T: FloatArray) -> list[ColumnDetail]:
 
 def constant_rolls(job: Job, passes: list[CutPath], model: RobotModel | None = None,
                    rules: Rules = DEFAULT_RULES) -> list[ColumnDetail]:  # fmt: skip
-    """The best constant roll of every pass of ``job`` where the job places its block:
-    the one model's fact (docs/place.md, "One model") that a failed plan's explanation,
+    """The best constant roll of every pass of ``job`` where the job places its block.
+
+    The one model's fact (docs/place.md, "One model") that a failed plan's explanation,
     ``ruledrobot reach`` and ``ruledrobot place`` all report — :class:`Evaluator` on its
-    default grid (:data:`~.grid.RULINGS` rulings x :data:`~.grid.ROLLS`
-    rolls), at the identity placement."""
+    default grid (:data:`~.grid.RULINGS` rulings x :data:`~.grid.ROLLS` rolls), at the identity
+    placement."""
     ev = Evaluator(job, list(passes), model, rules=rules)
     return details(ev, np.eye(4))
 
@@ -427,10 +434,11 @@ JUMP = JUMP_THRESHOLD
 
 
 def constant_words(job: Job, model: RobotModel, cp: CutPath, col: ColumnDetail) -> str:
-    """The best constant roll ``col`` of a pass in words; of a pass the planner could not
-    solve (:mod:`.explain`) never "serves all" without what fails between the samples (the
-    planner's own check of every ruling at that roll), so that it never stands beside the
-    planner's "no constant roll works" as a contradiction."""
+    """The best constant roll ``col`` of a pass in words.
+
+    Of a pass the planner could not solve (:mod:`.explain`) never "serves all" without what
+    fails between the samples (the planner's own check of every ruling at that roll), so that
+    it never stands beside the planner's "no constant roll works" as a contradiction."""
     if cp.feasible or (col.worst < 0.0 and not col.served.all()):
         return col.words()
     from ...io.words import index_ranges

@@ -112,8 +112,9 @@ def _joints_out(model: RobotModel, pm: PassMap, d: int, mask: np.ndarray) -> str
 
 
 def reach_reasons(plan: Plan) -> tuple[str, ...]:
-    """Extra reasons for a plan some pass of which is infeasible (module doc); () when
-    every pass is feasible."""
+    """Extra reasons for a plan some pass of which is infeasible (module doc).
+
+    () when every pass is feasible."""
     from .evaluate import Evaluator, constant_words, details
 
     bad = [(k, cp) for k, cp in enumerate(plan.passes) if not cp.feasible]

@@ -52,11 +52,12 @@ def job_cell(job: Job, model: RobotModel, rules: Rules) -> Cell:
 
 
 def directions_needed(W: FloatArray) -> tuple[bool, ...]:
-    """The wire directions worth sampling: both, unless reversing the wire is the same
-    as turning the flange half a turn about its own axis (the wire's midpoint on the
-    flange axis and the bow's depth direction along it, as on a symmetric bow).  The
-    planner's bow is symmetric about that axis, so the reversed wire then gives the
-    same configurations with ``q6 + pi`` (only joint 6's whole-turn margin, at least
+    """The wire directions worth sampling.
+
+    Both, unless reversing the wire is the same as turning the flange half a turn about its own
+    axis (the wire's midpoint on the flange axis and the bow's depth direction along it, as on
+    a symmetric bow). The planner's bow is symmetric about that axis, so the reversed wire then
+    gives the same configurations with ``q6 + pi`` (only joint 6's whole-turn margin, at least
     pi on a UR, differs)."""
     flip = np.diag([1.0, -1.0, -1.0, 1.0])
     S = W @ flip @ np.linalg.inv(W)
@@ -91,10 +92,11 @@ def planner_slide(frames: FloatArray, stock: Box, tool: ToolSpec) -> tuple[Float
 
 def planner_slides(frames: FloatArray, stock: Box, tool: ToolSpec
                    ) -> tuple[list[FloatArray], FloatArray]:  # fmt: skip
-    """The slides (each (M,) m) the redundancy search tries, in its order: the first
-    (:func:`planner_slide`), then, when one slide covers every chord, slides a tenth of
-    the common interval in from either end of it (tried when nothing works at the
-    first); and ``too_long`` as :func:`planner_slide`."""
+    """The slides (each (M,) m) the redundancy search tries, in its order.
+
+    The first (:func:`planner_slide`), then, when one slide covers every chord, slides a tenth
+    of the common interval in from either end of it (tried when nothing works at the first);
+    and ``too_long`` as :func:`planner_slide`."""
     first, too_long = planner_slide(frames, stock, tool)
     c0, c1, hit = chords(frames, stock)
     if not hit.any():
@@ -125,8 +127,10 @@ def pass_poses(
 
 
 class RowBoxes:
-    """One oriented box per configuration: the stock of many placements at once, for the
-    planner's clearance rules (:func:`ruledrobot.wirecut.cut.clearance.clearance`).
+    """One oriented box per configuration.
+
+    The stock of many placements at once, for the planner's clearance rules
+    (:func:`ruledrobot.wirecut.cut.clearance.clearance`).
 
     ``box`` the stock at the job's placement and ``T`` (n, 4, 4) the rigid motion of the
     n-th configuration's placement.  :meth:`segment_hits` takes segments whose leading

@@ -46,12 +46,13 @@ __all__ = ["PassMap", "ReachMap", "classify", "job_cell", "map_pass", "reach_map
 def classify(
     cell: Cell, P: FloatArray, rules: Rules, q: FloatArray | None = None, depth: bool = False
 ) -> tuple[FloatArray, np.ndarray, np.ndarray, FloatArray]:
-    """Best IK branch of each flange pose ``P`` (..., 4, 4): ``(margin (...) m, reason
-    (...) int8, branch (...) int8, q (..., 6))`` (:mod:`.margins`; q NaN where no branch
-    has a solution).  A pose is judged by the branches that reach it; only when none
-    does is it out of reach (by the least excess over the branches, :mod:`~ruledrobot.
-    robot.workspace`).  ``depth``: resolve how deep failing clearances fail (else they
-    are worth the value below the lowest level)."""
+    """Best IK branch of each flange pose ``P`` (..., 4, 4).
+
+    ``(margin (...) m, reason (...) int8, branch (...) int8, q (..., 6))`` (:mod:`.margins`; q
+    NaN where no branch has a solution). A pose is judged by the branches that reach it; only
+    when none does is it out of reach (by the least excess over the branches,
+    :mod:`~ruledrobot. robot.workspace`).  ``depth``: resolve how deep failing clearances fail
+    (else they are worth the value below the lowest level)."""
     shape = P.shape[:-2]
     Pf = P.reshape(-1, 4, 4)
     qs = cell.model.ik(Pf, check=False) if q is None else q.reshape(-1, 8, 6)
@@ -84,14 +85,15 @@ def classify(
 
 @dataclass(frozen=True, eq=False)
 class PassMap:
-    """The map of one pass: ``idx`` (R,) the sampled rulings (of ``rulings``), ``rolls``
-    (K,) rad; per (direction, roll, ruling) (2, K, R) the margin (m), the reason
-    (:class:`~.margins.Reason`), the best IK branch and its joints (2, K, R, 6), and the
-    slide (index into ``slides`` (S, R) m) where it is best.  ``slide`` (R,) m: the
-    planner's (``slides[0]``); ``in_stock`` (R,) whether the ruling crosses the stock.  The
-    planner's choice: ``chosen_roll`` (R,) rad (None when the pass is infeasible),
-    ``chosen_reverse``, and the map's verdict along it, ``path_margin`` / ``path_reason``
-    (R,) (classified at the chosen roll itself, not the nearest grid roll)."""
+    """The map of one pass.
+
+    ``idx`` (R,) the sampled rulings (of ``rulings``), ``rolls`` (K,) rad; per (direction,
+    roll, ruling) (2, K, R) the margin (m), the reason (:class:`~.margins.Reason`), the best IK
+    branch and its joints (2, K, R, 6), and the slide (index into ``slides`` (S, R) m) where it
+    is best. ``slide`` (R,) m: the planner's (``slides[0]``); ``in_stock`` (R,) whether the
+    ruling crosses the stock.  The planner's choice: ``chosen_roll`` (R,) rad (None when the
+    pass is infeasible), ``chosen_reverse``, and the map's verdict along it, ``path_margin`` /
+    ``path_reason`` (R,) (classified at the chosen roll itself, not the nearest grid roll)."""
 
     cut: str
     index: int
@@ -147,13 +149,13 @@ def map_pass(
     rolls: int = 72,
     slides: int = 1,
 ) -> PassMap:
-    """The map of one planned pass ``cp`` (see :class:`PassMap`) with the job's ``tool``:
-    ``rulings`` sampled evenly (ends included), ``rolls`` evenly over a turn, and
-    ``slides`` slides per ruling: the planner's, then ``slides - 1`` spread over the
-    interval in which the wire covers the ruling's chord (the common interval of the
-    pass for rulings outside the stock); each cell keeps its best slide.  A pass the
-    planner could not solve is mapped, with ``slides = 1``, at every slide the planner
-    tried (:func:`~.grid.planner_slides`)."""
+    """The map of one planned pass ``cp`` (see :class:`PassMap`) with the job's ``tool``.
+
+    ``rulings`` sampled evenly (ends included), ``rolls`` evenly over a turn, and ``slides``
+    slides per ruling: the planner's, then ``slides - 1`` spread over the interval in which the
+    wire covers the ruling's chord (the common interval of the pass for rulings outside the
+    stock); each cell keeps its best slide. A pass the planner could not solve is mapped, with
+    ``slides = 1``, at every slide the planner tried (:func:`~.grid.planner_slides`)."""
     F = cp.frames
     M = len(F)
     slide, too_long = planner_slide(F, cell.stock, tool)

@@ -138,7 +138,8 @@ DEFAULT_RULES = Rules()
 
 
 def limit_levers(model: RobotModel) -> FloatArray:
-    """Metres per radian (6,) that turn each joint's distance to its limit into a length:
+    """Metres per radian (6,) that turn each joint's distance to its limit into a length.
+
     ``|a2| + |a3|`` for joints 1-2, ``|a3|`` for the elbow, ``d5 + d6`` for the wrists."""
     g = model.nominal.ur_geometry
     arm, fore, wrist = abs(g.a2) + abs(g.a3), abs(g.a3), abs(g.d5) + abs(g.d6)

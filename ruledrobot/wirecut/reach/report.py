@@ -46,8 +46,10 @@ def ruling_ranges(pm: PassMap, mask: np.ndarray) -> str:
 
 
 def pass_summary(pm: PassMap) -> dict:
-    """Figures of one pass's map: reachable share, cells per reason, the planner's path
-    (its worst margin and where) or the best constant roll of the map."""
+    """Figures of one pass's map.
+
+    Reachable share, cells per reason, the planner's path (its worst margin and where) or the
+    best constant roll of the map."""
     d = pm.shown
     cells = pm.reason[d]
     counts = {REASON_TEXT[Reason(r)]: int((cells == r).sum()) for r in np.unique(cells)}

@@ -143,8 +143,9 @@ def _unreachable(plan: Plan) -> tuple[dict, Verdict]:
 
 
 def plan_outcome(plan: Plan, ver: Verification | None) -> tuple[dict, Verdict]:
-    """The report and the verdict of ``plan``; ``ver`` None: not verified in MuJoCo (the
-    ``verified`` check fails)."""
+    """The report and the verdict of ``plan``.
+
+    ``ver`` None: not verified in MuJoCo (the ``verified`` check fails)."""
     if plan.motion is None:
         return _unreachable(plan)
     job, mo, me = plan.job, plan.motion, plan.measured

@@ -71,7 +71,7 @@ def _surface_samples(
     midpoints of the whole cut (an arc's own centroid can lie near the arc)."""
     whole = len(passes) == 1
     arcs = []
-    grown = Box(stock.centre, stock.size + 0.004, stock.rotation)
+    grown = stock.grown(0.002)
     for cp in passes:
         S = cp.target_frames
         if cp.closed:
@@ -246,8 +246,9 @@ def _grid_step(world: FloatArray, shape: tuple[int, ...]) -> float | None:
 def part_mesh(
     job: Job, passes: tuple[CutPath, ...], resolution: float = RESOLUTION
 ) -> Mesh | None:
-    """The part's closed triangle mesh in the base frame [m] (module doc); None when no
-    cut names its kept side or nothing of the stock is kept."""
+    """The part's closed triangle mesh in the base frame [m] (module doc).
+
+    None when no cut names its kept side or nothing of the stock is kept."""
     if all(c.keep is None for c in job.cuts):
         return None
     return stock_mesh(job.stock, resolution,

@@ -13,6 +13,7 @@ from ...geometry.checks import FloatArray
 from ...io.atomic import atomic_write_bytes
 from ...io.pictures import thinned_series
 from ...robot.tool import BowTool
+from ...robot.wire.in_stock import flange_wire_ends
 from ..plan import Plan
 
 __all__ = ["PHASE_COLOURS", "plot_plan"]
@@ -43,8 +44,7 @@ def plot_plan(path: str | Path, plan: Plan, part=None) -> Path:
     fig = Figure(figsize=(14, 9))
     FigureCanvasAgg(fig)
     ax = fig.add_subplot(2, 2, (1, 3), projection="3d")
-    W = BowTool.of(job.tool if plan.bow is None else plan.bow).wire_frame()
-    half = 0.5 * job.tool.wire_length
+    bow = BowTool.of(job.tool if plan.bow is None else plan.bow)
     colours = ["tab:blue", "tab:green", "tab:brown", "tab:pink", "tab:olive", "tab:cyan"]
     # the many short segments of each kind as one collection each (an artist per
     # segment made the 3-D panel the slowest part of the picture)
@@ -63,8 +63,7 @@ def plot_plan(path: str | Path, plan: Plan, part=None) -> Path:
             F = cp.frames
             mid = F[h, :3, 3] + (0.5 * (c0 + c1))[h, None] * F[h, :3, 2]
             ax.plot(*mid.T, color="tab:red", lw=1.0)
-        G = m.flange @ W
-        ends = np.stack([G[:, :3, 3] - half * G[:, :3, 2], G[:, :3, 3] + half * G[:, :3, 2]], 1)
+        ends = flange_wire_ends(m.flange, bow)
         ax.add_collection3d(Line3DCollection(ends[:: max(1, len(ends) // 10)],
                                              colors="tab:orange", linewidths=1.2))  # fmt: skip
     ax.add_collection3d(Line3DCollection(job.stock.edges, colors="0.4", linewidths=0.8))

@@ -48,8 +48,9 @@ __all__ = ["CutMeasurements", "Measurements", "collision_sentence", "plan_verdic
 
 @dataclass(frozen=True)
 class CutMeasurements:
-    """What was measured on one cut (all its passes; None: not measured).  Units: mm,
-    mm/s, ratios; the tolerances are the cut's own."""
+    """What was measured on one cut (all its passes; None: not measured).
+
+    Units: mm, mm/s, ratios; the tolerances are the cut's own."""
 
     name: str
     feed_set_mm_s: float
@@ -70,8 +71,9 @@ class CutMeasurements:
 
 @dataclass(frozen=True)
 class Measurements:
-    """What the planner measured on the whole job (None: not measured).  Units: mm,
-    mm/s, ratios.  ``cuts``: per cut; a single cut's checks keep their plain names."""
+    """What the planner measured on the whole job (None: not measured).
+
+    Units: mm, mm/s, ratios.  ``cuts``: per cut; a single cut's checks keep their plain names."""
 
     reach_ok: bool
     reach_detail: str

@@ -40,9 +40,11 @@ SLOW_FACTOR = 10.0
 
 @dataclass(frozen=True)
 class Binding:
-    """The tightest bound on the path speed at a node: ``kind`` ``"velocity"``,
-    ``"acceleration"`` or ``"feed"``; ``joint`` (from 1) or None for the feed; ``x`` the
-    bound on σ̇² there [rad²/s²]; ``ds_dt`` the caller's ``s`` per second it allows."""
+    """The tightest bound on the path speed at a node.
+
+    ``kind`` ``"velocity"``, ``"acceleration"`` or ``"feed"``; ``joint`` (from 1) or None for
+    the feed; ``x`` the bound on σ̇² there [rad²/s²]; ``ds_dt`` the caller's ``s`` per second
+    it allows."""
 
     kind: str
     joint: int | None
@@ -130,9 +132,11 @@ def binding_at(
 def where_time_goes(
     prob: _Problem, x: FloatArray, vlim: FloatArray, alim: FloatArray
 ) -> tuple[float, tuple[float, float], float, Binding, float]:
-    """Of the solved law ``x`` (G,): its duration [s], the slow stretch (caller's ``s``),
-    its share of the duration, the binding at the slower node of the stage that takes
-    longest and the least ``ds/dt`` there (module doc)."""
+    """Of the solved law ``x`` (G,).
+
+    Its duration [s], the slow stretch (caller's ``s``), its share of the duration, the binding
+    at the slower node of the stage that takes longest and the least ``ds/dt`` there (module
+    doc)."""
     sd = np.sqrt(np.maximum(x, 0.0))
     D = prob.deltas
     den = sd[:-1] + sd[1:]

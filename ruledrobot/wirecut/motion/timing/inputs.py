@@ -14,8 +14,7 @@ __all__ = ["as_factor", "as_rate_limits"]
 def as_rate_limits(
     vel_limits: ArrayLike, acc_limits: ArrayLike, dt: float, joints: int
 ) -> tuple[FloatArray, FloatArray, float]:
-    """The limits a timed path keeps, checked in this order (ValueError names the first
-    bad one).
+    """The limits a timed path keeps, checked in this order (ValueError names the first bad one).
 
     Parameters
     ----------
@@ -34,7 +33,8 @@ def as_rate_limits(
 
 
 def as_factor(value: float, name: str) -> float:
-    """``value`` as a float in (0, 1] (a slow-down or safety factor, no unit);
+    """``value`` as a float in (0, 1] (a slow-down or safety factor, no unit).
+
     ValueError naming ``name`` otherwise."""
     x = as_number(value, name)
     if x > 1.0:
