@@ -40,7 +40,9 @@ def literal(text: str) -> str:
 
 
 def numbers(text: str | None, option: str, n: int | None = None) -> list[float] | None:
-    """``"a,b,c"`` -> floats (exactly ``n`` when given), or None for None; a ValueError
+    """Parse a comma-separated list of numbers.
+
+    ``"a,b,c"`` -> floats (exactly ``n`` when given), or None for None; a ValueError
     names the option."""
     if text is None:
         return None

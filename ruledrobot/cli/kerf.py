@@ -26,7 +26,7 @@ def ladder(
     speeds: str | None = typer.Option(None, help=literal(
         "Speeds, mm/s, comma-separated [default: 0.5, 0.75, 1, 1.5 x the job's feed].")),
     powers: str | None = typer.Option(None, help=literal(
-        "Wire powers, W per metre of wire, comma-separated [default: 0.8, 1.2 x the job's "
+        "Wire powers, W per metre of wire, comma-separated [default: 0.6, 1, 1.4 x the job's "
         "heat power, if it gives one].")),
     spacing: float | None = typer.Option(None, help=literal(
         "Distance between the cuts, mm [default: the block's length over the cuts + 1, at "
@@ -34,9 +34,10 @@ def ladder(
     full_scale: float | None = typer.Option(None, "--full-scale", help=literal(
         "W/m at the analog output's 1.0 [default: the job's heat full_scale].")),
 ) -> None:
-    """Write straight test cuts through the job's block — every speed at every power, one
-    job per power (powerN/job.toml) — with ladder.md saying what to measure and where,
-    and measured.csv to fill in.  Exits 2 on bad input (nothing written)."""
+    """Write a kerf ladder: straight test cuts through the job's block.
+
+    Every speed at every power, one job per power (powerN/job.toml) — with ladder.md
+    saying what to measure and where, and measured.csv to fill in.  Exits 2 on bad input (nothing written)."""
     from ..kerf import write_ladder
 
     try:
@@ -67,10 +68,11 @@ def fit(
     out: Path | None = typer.Option(None, "--out", "-o", help=literal(
         "Where to write the [material] table [default: material.toml beside the CSV].")),
 ) -> None:
-    """Fit the kerf model to measured test cuts by least squares: each constant with its
-    standard error, every row's residual and its error predicted from the other rows, the
-    verdict (is the fit good enough), and the [material] table to paste, written only
-    when every check holds.  Exits 1 when a check fails, 2 on bad input."""
+    """Fit the kerf model to measured test cuts by least squares.
+
+    Each constant with its standard error, every row's residual and its error predicted
+    from the other rows, the verdict (is the fit good enough), and the [material] table
+    to paste, written only when every check holds.  Exits 1 when a check fails, 2 on bad input."""
     from rich.text import Text
 
     from ..io.atomic import atomic_write_text

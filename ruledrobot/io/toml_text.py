@@ -37,6 +37,8 @@ def toml_value(v: Any) -> str:
 
 
 def toml_table(name: str, table: dict[str, Any], header: str = "[{}]") -> list[str]:
-    """The lines of the table ``name`` (``header`` ``"[[{}]]"`` for an array entry), one
+    """Write a TOML table as lines.
+
+    The lines of the table ``name`` (``header`` ``"[[{}]]"`` for an array entry), one
     ``key = value`` each, and a blank line."""
     return [header.format(name), *(f"{k} = {toml_value(v)}" for k, v in table.items()), ""]

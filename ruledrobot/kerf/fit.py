@@ -50,7 +50,9 @@ MAX_ROUNDS = 20
 
 @dataclass(frozen=True)
 class Constant:
-    """One fitted constant: ``name`` (the ``[material]`` field), ``value`` and ``sigma``
+    """One fitted constant with its standard error.
+
+    ``name`` (the ``[material]`` field), ``value`` and ``sigma``
     (its standard error) in ``unit`` (SI), ``scale`` what ``sigma`` is judged against, and
     ``why`` when the data cannot determine it (``value`` NaN then)."""
 
@@ -266,7 +268,9 @@ def _max_speed(m: Measured, ok: np.ndarray, p0: float, notes: list[str],
 
 
 def material_text(fit: KerfFit) -> str:
-    """The ``[material]`` table of a fit (4 significant digits, its standard errors in the
+    """The ``[material]`` table of a fit, to paste into a job.
+
+    4 significant digits, its standard errors in the
     comments), headed by what it was fitted from and its verdict; ValueError when the fit
     gives no material."""
     from ..io.toml_text import toml_value

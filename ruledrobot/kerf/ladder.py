@@ -74,7 +74,9 @@ _AXES = "xyz"
 
 @dataclass(frozen=True)
 class LadderCut:
-    """One test cut: ``name``, its job folder ``job`` (``"power1"``), ``speed`` [m/s],
+    """One test cut of a ladder.
+
+    ``name``, its job folder ``job`` (``"power1"``), ``speed`` [m/s],
     ``power`` [W/m] and ``offset`` [m] of its plane from the block's centre along the
     spacing axis (``+`` towards the block's ``+axis`` face)."""
 
@@ -87,7 +89,9 @@ class LadderCut:
 
 @dataclass(frozen=True)
 class Ladder:
-    """What :func:`write_ladder` wrote: ``out`` (the folder), ``jobs`` (the job files),
+    """What :func:`write_ladder` wrote.
+
+    ``out`` (the folder), ``jobs`` (the job files),
     ``cuts``, ``spacing`` [m], the block's ``wire_axis`` and ``spacing_axis`` (``"x"``,
     ``"y"`` or ``"z"`` of the block's own frame), ``size`` (3,) [m] and ``heat`` (how the
     power is set, in words)."""
@@ -152,7 +156,9 @@ def _has_measurements(out: Path) -> bool:
 def write_ladder(job_file: str | os.PathLike[str], out: str | os.PathLike[str],
                  speeds: Any = None, powers: Any = None, *, spacing: float | None = None,
                  full_scale: float | None = None) -> Ladder:  # fmt: skip
-    """Write the ladder of ``job_file``'s cell into ``out`` (module doc): ``speeds`` (m/s;
+    """Write the ladder of ``job_file``'s cell into ``out`` (module doc).
+
+    ``speeds`` (m/s;
     None: :data:`SPEED_FACTORS` of the first cut's feed) by ``powers`` (W/m; None:
     :data:`POWER_FACTORS` of the job's heat ``power``, when it gives one), cuts ``spacing``
     m apart (None: the default), ``full_scale`` the W/m at the analog output's 1.0 (None:

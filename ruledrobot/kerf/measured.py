@@ -37,7 +37,9 @@ _NO = ("no", "false", "0", "n", "")
 
 @dataclass(frozen=True)
 class Measured:
-    """The rows of a measured ladder: ``speed`` (N,) m/s, ``power`` (N,) W/m, ``kerf`` (N,)
+    """The rows of a measured ladder.
+
+    ``speed`` (N,) m/s, ``power`` (N,) W/m, ``kerf`` (N,)
     m (NaN on failed rows), ``failed`` (N,) bool, ``lines`` (N,) the file's line numbers,
     ``source`` the file."""
 
