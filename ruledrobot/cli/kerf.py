@@ -37,7 +37,8 @@ def ladder(
     """Write a kerf ladder: straight test cuts through the job's block.
 
     Every speed at every power, one job per power (powerN/job.toml) — with ladder.md
-    saying what to measure and where, and measured.csv to fill in.  Exits 2 on bad input (nothing written)."""
+    saying what to measure and where, and measured.csv to fill in.  Exits 2 on bad
+    input (nothing written)."""
     from ..kerf import write_ladder
 
     try:
