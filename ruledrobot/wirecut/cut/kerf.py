@@ -51,8 +51,8 @@ from ...robot.wire.kerf import Material
 from ..job.spec import CutSpec, HeatSpec
 from .wire_geometry import chords
 
-__all__ = ["KerfOffsets", "cut_offsets", "held_kerf", "kept_surface_error", "kerf_offsets",
-           "on_power", "point_kerf_offsets", "ruling_normals", "waste_sign"]
+__all__ = ["KerfOffsets", "cut_offsets", "face_points", "held_kerf", "kept_surface_error",
+           "kerf_offsets", "on_power", "point_kerf_offsets", "ruling_normals", "waste_sign"]
 
 #: points per chord at which the normals are sampled
 SAMPLES = 9
@@ -62,10 +62,10 @@ KEEP_CLEARANCE = 1e-4
 ROUNDS = 4
 #: m: half the length of the line the across-speeds are taken on (any length past the chord)
 _REACH = 10.0
-#: a chord shorter than this share of the cut's longest does not set the wire's tilt (the
-#: line through two moved ends a few millimetres apart turns wildly where the wire enters
-#: the block across a corner): it moves as the nearest ruling with a longer chord
-SHORT_CHORD = 0.25
+#: m: a chord shorter than this does not set the wire's tilt (the line through two moved
+#: ends a hair apart, where the wire enters the block across a corner, points anywhere):
+#: it moves as the nearest ruling with a longer chord
+SHORT_CHORD = 0.002
 
 
 @dataclass(frozen=True)
@@ -263,8 +263,8 @@ def point_kerf_offsets(
     """The per-point compensation (module doc) of the target rulings ``frames`` (M, 4, 4):
     each chord end moved by half the kerf predicted there (:func:`held_kerf`) into the
     waste, ``rounds`` times with the speed ratios of the moved wire.  Rulings that miss
-    the stock, or whose chord is shorter than :data:`SHORT_CHORD` of the longest, get the
-    offset and turn of the nearest ruling with a longer chord."""
+    the stock, or whose chord is shorter than :data:`SHORT_CHORD`, get the offset and turn
+    of the nearest ruling with a longer chord."""
     M = frames.shape[0]
     sign = waste_sign(frames, stock, cut.keep, closed)
     c0, c1, hit = chords(frames, stock)
@@ -276,7 +276,7 @@ def point_kerf_offsets(
     P = o[:, None, :] + t[..., None] * z[:, None, :]  # (M, K, 3) target chord samples
     x = np.arange(M, dtype=np.float64)
     span = np.where(hit, c[:, 1] - c[:, 0], 0.0)
-    near = _nearest_hit(span >= SHORT_CHORD * span.max())
+    near = _nearest_hit(span >= SHORT_CHORD)
     wo, wz = o, z
     for _ in range(max(int(rounds), 1)):
         # the (moved) wire's chord, its points' speeds across it per ruling, their ratios
@@ -315,3 +315,25 @@ def cut_offsets(
     if material is None or cut.keep is None or cut.kerf <= 0.0:
         return kerf_offsets(frames, stock, cut.kerf, cut.keep, closed)
     return point_kerf_offsets(frames, stock, cut, heat, material, closed)
+
+
+def face_points(
+    target: FloatArray, wire: FloatArray, stock: Box, keep: str | FloatArray
+) -> tuple[FloatArray, FloatArray]:
+    """The part's surface along a pass (``face_error``'s target): the chord ends (K, 2, 3)
+    [m] of the target rulings ``target`` (M, 4, 4) that cross the stock and the unit
+    normals (K, 2, 3) there into the waste.  Each ruling's normals point the way its wire
+    (``wire`` (M, 4, 4), the compensated rulings) is moved off it -- a pass that goes
+    out and back along a loop turns its normals round halfway -- and by ``keep``
+    (:func:`waste_sign`) where the wire is not moved."""
+    c0, c1, hit = chords(target, stock)
+    S, W = target[hit], wire[hit]
+    t = np.stack([c0[hit], c1[hit]], axis=1)
+    n = ruling_normals(target, np.stack([np.nan_to_num(c0), np.nan_to_num(c1)], axis=1))[hit]
+    off = np.einsum("ki,kji->kj", W[:, :3, 3] - S[:, :3, 3], n)  # (K, 2)
+    moved = np.abs(off) > 1e-12
+    if not moved.all():
+        fallback = waste_sign(target, stock, keep)
+        off = np.where(moved, off, fallback)
+    points = S[:, None, :3, 3] + t[..., None] * S[:, None, :3, 2]
+    return points, np.sign(off)[..., None] * n

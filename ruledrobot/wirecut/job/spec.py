@@ -15,14 +15,12 @@ import numpy as np
 from ...geometry.box import Box
 from ...geometry.lines import Lines
 from ...robot.arm.calibration import Calibration
+from ...robot.motion.trajectory import HEAT_MODES
 from ...robot.wire.cut import WIRE_TOLERANCE
 from ...robot.wire.kerf import Material
 
 __all__ = ["HEAT_MODES", "CutSpec", "HeatSpec", "Job", "RobotSpec", "SurfaceSpec", "ToolSpec"]
 
-#: how the wire's heat follows the plan (docs/kerf.md): switched on and off, a constant
-#: power, or the power that holds the kerf at the cut's reference point
-HEAT_MODES = ("on_off", "constant", "constant_kerf")
 #: m: how far the predicted cut face may lie from the part's surface, by default
 FACE_TOLERANCE = 1e-4
 
