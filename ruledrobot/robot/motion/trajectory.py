@@ -414,6 +414,26 @@ class Trajectory:
             return None
         return self.meta.cut.measure(self.t, self.tcp_poses())
 
+    def face_errors(
+        self, wis: WireInStock | None = None, heat_power: ArrayLike | None = None
+    ) -> dict:
+        """``face_error`` per cut (:func:`..wire.face.face_errors`) of this motion -- or of
+        ``wis``, the wire of a motion measured against this trajectory's block (an exported
+        program's, a run's recording) -- with the wire's power from ``heat_power`` (M,)
+        W/m, recorded set-points (default: this trajectory's), delayed by the heat's lag;
+        {} when the sidecar names no face."""
+        from ..wire.face import face_errors
+        from ..wire.kerf import wire_power
+
+        cut = self.meta.cut
+        if cut is None or not cut.faces:
+            return {}
+        wis = self.wire_in_stock() if wis is None else wis
+        hp = self.heat_power if heat_power is None else heat_power
+        lag = 0.0 if self.meta.heat is None else self.meta.heat.lag
+        power = None if hp is None else wire_power(wis.t, hp, lag)
+        return face_errors(wis, power, cut.material, cut.faces)
+
     def phase_at(self, k: int) -> str:
         """The name of the phase sample ``k`` belongs to (``"move"`` if none is named)."""
         for p in self.meta.phases:

@@ -36,7 +36,7 @@ from .._checks import FloatArray
 from .in_stock import WireInStock, across_speeds
 from .kerf import Material
 
-__all__ = ["FaceError", "FaceTarget", "face_error"]
+__all__ = ["FaceError", "FaceTarget", "face_error", "face_errors"]
 
 #: W/m: a power within this of the threshold melts nothing (a schedule that drops to the
 #: threshold at a stop, interpolated)
@@ -178,3 +178,22 @@ def face_error(
     kerf[rows] = w
     j = int(rows[np.argmax(error[rows])])
     return FaceError(face.name, error, kerf, float(error[j]), j, float(wis.t[j]), face.tolerance)
+
+
+def face_errors(
+    wis: WireInStock, power: ArrayLike | None, material: Material | None,
+    faces: tuple[FaceTarget, ...],
+) -> dict[str, FaceError]:
+    """:func:`face_error` per cut name (the passes of one cut joined: the larger error per
+    sample, the kerf where a pass is on its face), in the order of ``faces``."""
+    out: dict[str, FaceError] = {}
+    for f in faces:
+        e = face_error(wis, power, material, f)
+        if f.name in out:
+            a = out[f.name]
+            error = np.fmax(a.error, e.error)
+            kerf = np.where(np.isnan(e.kerf), a.kerf, e.kerf)
+            e = e if not np.isnan(e.worst) and not (e.worst <= a.worst) else a
+            e = FaceError(f.name, error, kerf, e.worst, e.at, e.t, e.tolerance)
+        out[f.name] = e
+    return out

@@ -13,7 +13,7 @@ Z0 = 0.3
 ROOT, TIP = 0.10, 0.08  # m: the chords the wire's ends sweep at y = -0.1 and y = +0.1
 FEED = 0.02
 KERF = 0.0008
-MATERIAL = {"kerf_base": 0.0003, "kerf_gain": 1.0e-8, "power_threshold": 20.0}
+MATERIAL = {"kerf_base": 0.0003, "kerf_gain": 2.5e-7, "power_threshold": 10.0}
 
 MATERIAL_TABLE = "\n[material]\n" + "".join(f"{k} = {v!r}\n" for k, v in MATERIAL.items())
 
