@@ -10,14 +10,16 @@ distance from the surface is::
 
 at both chord ends of every sample where the wire is on the face (the cut phase, its
 corner stops included; not the lead-in/out, not a closed cut's slits).  ``s`` and ``n``
-are those of the nearest chord end of the target rulings (a k-d tree; the tangent plane
-there stands for the surface within half a ruling interval).  The kerf ``w`` at each
+are those of the nearest chord ends of the target rulings (a k-d tree; their tangent
+planes stand for the surface within a ruling interval; the plane nearest the face decides,
+:data:`NEAREST`).  The kerf ``w`` at each
 end: the cut's constant ``kerf`` without a material; with one, ``material.kerf(v, p)``
 with ``v`` the end's speed across the wire (:func:`.in_stock.across_speeds` in time)
 and ``p`` the wire's power (:func:`.kerf.wire_power` of the set-points).  A wire that
 melts nothing new (power at or below the threshold) stands in the channel it melted
-before: the kerf of the last sample that melted carries on.  A hot wire that stops is
-a burn: ``e = inf``.
+before: the kerf of the last sample that melted carries on; so does a wire that stands
+(slower than :data:`STILL`) -- unless at that speed it melts wider than the channel: a
+hot wire that stops is a burn, ``e = inf``.
 
 Everyone who holds a motion and its heat calls :func:`face_error` with the
 :class:`FaceTarget` of the trajectory's sidecar: the plan, an export's verification,
@@ -38,6 +40,14 @@ from .kerf import Material
 
 __all__ = ["FaceError", "FaceTarget", "face_error", "face_errors"]
 
+#: the target chord ends whose tangent planes stand for the surface near a chord end: the
+#: nearest of them decides (at a corner of the path the corner ruling's normal bisects
+#: the faces; a neighbour's plane is the face)
+NEAREST = 3
+#: m/s: a hot wire slower than this stands still and burns: the melt then grows with the
+#: time it stays, which the energy balance does not describe (a sampled stop never reaches
+#: exactly 0)
+STILL = 1e-3
 #: W/m: a power within this of the threshold melts nothing (a schedule that drops to the
 #: threshold at a stop, interpolated)
 MELT_SLACK = 1e-9
@@ -129,15 +139,31 @@ class FaceError:
         return np.stack([k.min(axis=0), k.max(axis=0)], axis=1)
 
 
-def _carried(w: FloatArray, melts: np.ndarray) -> FloatArray:
-    """``w`` (M, 2) with the rows where the wire melts nothing replaced by the last row
-    that melted (the first melting row before any)."""
-    if melts.all() or not melts.any():
-        return w
-    idx = np.where(melts, np.arange(len(w)), -1)
-    idx = np.maximum.accumulate(idx)
-    idx = np.where(idx < 0, int(np.flatnonzero(melts)[0]), idx)
-    return w[idx]
+def _carried(w: FloatArray, moves: np.ndarray) -> FloatArray:
+    """Per column of ``w`` (R, 2): the value of the last row where ``moves`` (R, 2), the
+    first such row's before any (NaN where a column never moves)."""
+    out = np.full(w.shape, np.nan)
+    for j in range(w.shape[1]):
+        m = moves[:, j]
+        if not m.any():
+            continue
+        idx = np.maximum.accumulate(np.where(m, np.arange(len(w)), -1))
+        out[:, j] = w[np.where(idx < 0, int(np.flatnonzero(m)[0]), idx), j]
+    return out
+
+
+def _kerf(v: FloatArray, p: FloatArray, material: Material) -> FloatArray:
+    """The kerf (R, 2) [m] at the chord ends' speeds ``v`` (R, 2) and the wire's power
+    ``p`` (R,) (module doc): where the wire moves and melts, the model; where it melts
+    nothing new or stands still, the channel it melted last -- unless, standing, it melts
+    wider than that at :data:`STILL`: a burn (inf)."""
+    melts = (p > material.power_threshold + MELT_SLACK)[:, None]
+    still = v < STILL
+    w = material.kerf(np.where(still, STILL, v), p[:, None])
+    channel = _carried(w, melts & ~still)
+    channel = np.where(np.isnan(channel), material.kerf_base, channel)
+    burn = melts & still & (w > channel * (1.0 + 1e-9))
+    return np.where(burn, np.inf, np.where(melts & ~still, w, channel))
 
 
 def face_error(
@@ -162,17 +188,15 @@ def face_error(
     else:
         p = np.asarray(power, dtype=np.float64)[rows]
         v = across_speeds(wis.t, wis.ends, wis.fractions())[rows]  # (R, 2)
-        w = material.kerf(v, p[:, None])
-        melts = p > material.power_threshold + MELT_SLACK
-        w = np.where(melts[:, None] | ~np.isfinite(w), w, np.nan)
-        w = np.where(melts[:, None], w, _carried(w, melts))
-        w = np.where(np.isnan(w), material.kerf_base, w)
-    tree = cKDTree(face.points.reshape(-1, 3))
-    _, k = tree.query(x.reshape(-1, 3))
-    s = face.points.reshape(-1, 3)[k].reshape(x.shape)
-    n = face.normals.reshape(-1, 3)[k].reshape(x.shape)
+        w = _kerf(v, p, material)
+    pts = face.points.reshape(-1, 3)
+    near = min(NEAREST, len(pts))
+    _, k = cKDTree(np.array(pts)).query(np.array(x.reshape(-1, 3)), k=near)  # writable
+    k = k.reshape(*x.shape[:2], near)  # (R, 2, near)
+    s, n = pts[k], face.normals.reshape(-1, 3)[k]
     with np.errstate(invalid="ignore"):
-        e = np.abs(np.einsum("rki,rki->rk", x - s, n) - 0.5 * w)
+        d = np.einsum("rkji,rkji->rkj", x[:, :, None, :] - s, n)
+        e = np.abs(d - 0.5 * w[..., None]).min(axis=2)
     e = np.where(np.isinf(w), np.inf, e)
     error[rows] = e.max(axis=1)
     kerf[rows] = w

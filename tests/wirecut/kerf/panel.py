@@ -62,3 +62,22 @@ keep = [0.5, 0.0, 0.27]
 {cut}
 """ + (MATERIAL_TABLE if material else ""))
     return job
+
+
+def write_corner(folder: Path, heat: str) -> Path:
+    """A cut with a corner stop in the block: the wire (along y) runs along ``z = Z0``
+    in +x, then turns 40 degrees down (more than the 30 the time law stops at); the part
+    is above.  Its job's path."""
+    a = np.radians(40.0)
+    pts = [[0.44 + 0.01 * i, 0.0, Z0] for i in range(7)]
+    pts += [[0.5 + 0.01 * i * np.cos(a), 0.0, Z0 - 0.01 * i * np.sin(a)] for i in range(1, 8)]
+    (folder / "corner.json").write_text(json.dumps({
+        "format": "ruledrobot.lines/1", "units": "m", "closed": False,
+        "lines": [{"point": p, "direction": [0.0, 1.0, 0.0]} for p in pts]}))
+    text = (write_panel(folder, heat).read_text()
+            .replace('file = "panel.json"', 'file = "corner.json"')
+            .replace("steps = 3", "steps = 2")
+            .replace("keep = [0.5, 0.0, 0.27]", "keep = [0.49, 0.0, 0.34]"))
+    job = folder / "corner.toml"
+    job.write_text(text)
+    return job
