@@ -97,3 +97,17 @@ def test_corner_stop_burns_with_constant_heat_only(tmp_path, mode, ok):
     if not ok:
         assert check.detail.startswith("burn at t = ")
         assert check.value == float("inf")
+
+
+def test_sidecar_keeps_the_face_and_the_material(panel, tmp_path):
+    """The face target and the material survive the sidecar: a reader of the trajectory
+    computes the same face_error as the plan (its heat power given, as a run records it)."""
+    from ruledrobot.io.trajectory import meta_from_dict, meta_to_dict
+
+    traj = panel.trajectory
+    meta = meta_from_dict(meta_to_dict(traj.meta))
+    assert meta.cut.material == traj.meta.cut.material
+    back = type(traj)(traj.t, traj.q, traj.tcp, meta)
+    a = traj.face_errors()["cut"]
+    b = back.face_errors(heat_power=traj.heat_power)["cut"]
+    assert b.worst == pytest.approx(a.worst, rel=1e-9) and b.at == a.at
