@@ -12,7 +12,8 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike
 
-__all__ = ["run_indices", "runs_of", "runs_of_indices"]
+__all__ = ["checked_ranges", "ranges_mask", "run_indices", "runs_of", "runs_of_indices",
+           "shifted_ranges"]
 
 
 def runs_of(mask: ArrayLike) -> tuple[tuple[int, int], ...]:
@@ -43,3 +44,31 @@ def run_indices(mask: ArrayLike, closed: bool = False) -> list[np.ndarray]:
     if closed and len(runs) > 1 and m[0] and m[-1]:
         runs = [np.concatenate([runs[-1], runs[0]]), *runs[1:-1]]
     return runs
+
+
+def checked_ranges(value: object, what: str) -> tuple[tuple[int, int], ...]:
+    """``value`` (pairs of integers) as half-open ranges; ValueError naming ``what[i]``
+    where a pair is not ``0 <= start < stop``."""
+    out = []
+    for i, r in enumerate(value or ()):  # type: ignore[attr-defined]
+        a, b = (int(x) for x in r)
+        if not 0 <= a < b:
+            raise ValueError(f"{what}[{i}]: expected sample indices 0 <= start < stop, got {r!r}")
+        out.append((a, b))
+    return tuple(out)
+
+
+def ranges_mask(ranges: tuple[tuple[int, int], ...], n: int) -> np.ndarray:
+    """(n,) bool: sample k lies in one of the half-open ``ranges``."""
+    m = np.zeros(n, dtype=bool)
+    for a, b in ranges:
+        m[a:b] = True
+    return m
+
+
+def shifted_ranges(
+    ranges: tuple[tuple[int, int], ...], start: int, stop: int
+) -> tuple[tuple[int, int], ...]:
+    """The parts of ``ranges`` within samples ``start:stop``, renumbered from 0."""
+    return tuple((max(a, start) - start, min(b, stop) - start) for a, b in ranges
+                 if min(b, stop) > max(a, start))  # fmt: skip

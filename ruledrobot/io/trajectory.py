@@ -56,6 +56,8 @@ from ..robot.motion.trajectory import (
     TrajectoryMeta,
 )
 from ..robot.wire.cut import WIRE_TOLERANCE, FeedWindow, WireCut
+from ..robot.wire.face import FaceTarget
+from ..robot.wire.kerf import Material
 from .atomic import atomic_write_bytes, atomic_write_json, atomic_write_text
 from .text import read_user_text
 
@@ -136,7 +138,44 @@ def _cut_to_dict(cut: WireCut) -> dict[str, Any]:
                    "tolerance": w.tolerance, "held": [list(r) for r in w.held],
                    "wire_tolerance_m": w.wire_tolerance}
                   for w in cut.feeds],
+        "faces": [{"name": f.name, "points_m": f.points.tolist(), "normals": f.normals.tolist(),
+                   "ranges": [list(r) for r in f.ranges], "kerf_m": f.kerf,
+                   "tolerance_m": f.tolerance} for f in cut.faces],
+        "material": None if cut.material is None else {
+            "kerf_base_m": cut.material.kerf_base, "kerf_gain": cut.material.kerf_gain,
+            "power_threshold_w_m": cut.material.power_threshold,
+            "max_speed": cut.material.max_speed},
     }  # fmt: skip
+
+
+def _faces(d: _Doc, c: dict) -> tuple[FaceTarget, ...]:
+    """The sidecar's ``cut.faces`` (absent in older files: none)."""
+    faces = []
+    for i, f in enumerate(c.get("faces") or []):
+        try:
+            faces.append(FaceTarget(str(f["name"]), np.asarray(f["points_m"], dtype=np.float64),
+                                    np.asarray(f["normals"], dtype=np.float64),
+                                    tuple(tuple(r) for r in f.get("ranges", [])),
+                                    float(f["kerf_m"]), float(f["tolerance_m"])))  # fmt: skip
+        except (KeyError, TypeError, ValueError, AttributeError) as exc:
+            raise d.fail(f"cut.faces[{i}]", "expected {name, points_m, normals, ranges, kerf_m, "
+                         f"tolerance_m}}: {exc}") from None  # fmt: skip
+    return tuple(faces)
+
+
+def _material(d: _Doc, c: dict) -> Material | None:
+    """The sidecar's ``cut.material`` (absent or null: none)."""
+    m = c.get("material")
+    if m is None:
+        return None
+    try:
+        top = m.get("max_speed")
+        return Material(float(m["kerf_base_m"]), float(m["kerf_gain"]),
+                        float(m.get("power_threshold_w_m", 0.0)),
+                        None if top is None else float(top))  # fmt: skip
+    except (KeyError, TypeError, ValueError, AttributeError) as exc:
+        raise d.fail("cut.material", "expected {kerf_base_m, kerf_gain, power_threshold_w_m, "
+                     f"max_speed}}: {exc}") from None  # fmt: skip
 
 
 class _Doc:
@@ -219,7 +258,7 @@ def _cut(d: _Doc) -> WireCut | None:
             raise d.fail(f"cut.feeds[{i}]", "expected {name, start, stop, speed_m_s, tolerance, "
                          f"held}}: {exc}") from None  # fmt: skip
     try:
-        return WireCut(stock, float(length), tuple(feeds))
+        return WireCut(stock, float(length), tuple(feeds), _faces(d, c), _material(d, c))
     except ValueError as exc:
         raise d.fail("cut", str(exc)) from None
 

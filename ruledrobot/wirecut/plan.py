@@ -25,7 +25,9 @@ from ..robot.motion.rates import trajectory_limits_report
 from ..robot.motion.trajectory import Heat, Trajectory, phases_from_labels
 from ..robot.tool import BowTool
 from ..robot.wire.cut import FeedWindow, WireCut
+from ..robot.wire.face import FaceTarget
 from .cut.clearance import SINGULAR_MIN
+from .cut.kerf import face_points
 from .cut.order import check_cut_order
 from .cut.passes import CutPath, cut_paths, job_search
 from .cut.wire_geometry import distance_from_rulings
@@ -33,6 +35,7 @@ from .cut.wire_pose import SearchOptions
 from .job.spec import Job
 from .motion.assemble import Motion, PassNotTimed, assemble_motion
 from .motion.densify import target_frames
+from .motion.heat import heat_schedule
 from .motion.timing import TimingFailure
 from .motion.transit import TransitFailure, TransitNotFound
 
@@ -142,10 +145,12 @@ def _deviation_at(flange: FloatArray, passes: tuple[CutPath, ...], mo: Motion) -
 def wire_cut(job: Job, motion: Motion, bow: BowTool | None = None) -> WireCut:
     """What the planned trajectory cuts (the sidecar's ``cut``): the block, the wire and
     per pass the feed window — the pass's samples, the cut's feed and tolerance, and
-    where the feed is held (its cut phase less the corner stops and slits).  ``bow``: the
-    job's, when the caller built it."""
+    where the feed is held (its cut phase less the corner stops and slits) — and, for a
+    cut that names the part's side (``keep``), the face it must leave (``face_error``'s
+    target: the target rulings' chord ends and normals, the samples on the face), and the
+    job's material.  ``bow``: the job's, when the caller built it."""
     held_all = motion.surface & ~(False if motion.corner_stop is None else motion.corner_stop)
-    feeds = []
+    feeds, faces = [], []
     for k, cp in enumerate(motion.passes):
         rows = np.flatnonzero(motion.pass_of == k)
         if not rows.size:
@@ -156,8 +161,13 @@ def wire_cut(job: Job, motion: Motion, bow: BowTool | None = None) -> WireCut:
         feeds.append(FeedWindow(cut.name, int(rows[0]), int(rows[-1]) + 1, cut.feed_speed,
                                 cut.feed_tolerance, runs_of(held_all & mask),
                                 cut.wire_tolerance))  # fmt: skip
+        on_face = runs_of(motion.surface & mask)
+        if cut.keep is not None and on_face:  # the part's side is known: its face is judged
+            points, normals = face_points(cp.target_frames, cp.frames, job.stock, cut.keep)
+            faces.append(FaceTarget(cut.name, points, normals, on_face, cut.kerf,
+                                    cut.tolerance))  # fmt: skip
     bow = BowTool.of(job.tool if bow is None else bow)
-    return WireCut(job.stock, bow.wire_length, tuple(feeds))
+    return WireCut(job.stock, bow.wire_length, tuple(feeds), tuple(faces), job.material)
 
 
 def _bow_outside_cuts(
@@ -232,7 +242,8 @@ def _heat(job: Job, motion: Motion) -> Heat | None:
     h = job.tool.heat
     if h is None:
         return None
-    return Heat(h.kind, h.index, h.value, runs_of(motion.heat), h.preheat)
+    return Heat(h.kind, h.index, h.value, runs_of(motion.heat), h.preheat, h.mode,
+                h.full_scale, h.lag)  # fmt: skip
 
 
 def make_plan(
@@ -310,6 +321,9 @@ def make_plan(
         in_stock=motion.wire.runs(), job=ref, source="ruledrobot plan",
         heat=_heat(job, motion), cut=wire_cut(job, motion, bow),
     )  # fmt: skip
+    power = heat_schedule(job, motion)
+    if power is not None:
+        trajectory = dataclasses.replace(trajectory, heat_power=power)
     timings["measure_s"] = time.perf_counter() - t2
     return Plan(job, model, tuple(passes), motion, trajectory, measured, reasons,
                 notes + motion.notes, timings, bow, data, ref)  # fmt: skip

@@ -45,6 +45,7 @@ from .rates import finite_difference_rates
 __all__ = [
     "CUTTING_PHASES",
     "HEATED_PHASES",
+    "HEAT_MODES",
     "PHASE_NAMES",
     "Heat",
     "KinematicsRef",
@@ -152,6 +153,8 @@ class Phase:
 
 #: heat output kinds and how many outputs of each a UR controller has
 HEAT_OUTPUT_KINDS = {"standard": 8, "configurable": 8, "tool": 2, "analog": 2}
+#: how the wire's heat follows the plan (docs/kerf.md)
+HEAT_MODES = ("on_off", "constant", "constant_kerf")
 
 
 @dataclass(frozen=True)
@@ -163,7 +166,10 @@ class Heat:
     its range; off = 0); ``windows``: half-open sample ranges ``(start, stop)`` with the
     heat on — from the start of a pre-heat dwell to the end of a lead-out; ``preheat``:
     the seconds the wire heats before it moves into the stock (a run resumed inside a
-    window heats that long before it moves).
+    window heats that long before it moves).  The heat model (docs/kerf.md): ``mode``
+    ``"on_off"``, ``"constant"`` or ``"constant_kerf"``; ``full_scale`` W/m at an analog
+    output's 1.0 (None: not given); ``lag`` s, the wire's thermal delay the trajectory's
+    ``heat_power`` set-points lead the motion by.
     """
 
     kind: str
@@ -171,6 +177,9 @@ class Heat:
     value: float = 1.0
     windows: tuple[tuple[int, int], ...] = ()
     preheat: float = 0.0
+    mode: str = "on_off"
+    full_scale: float | None = None
+    lag: float = 0.0
 
     def __post_init__(self) -> None:
         if self.kind not in HEAT_OUTPUT_KINDS:
@@ -194,6 +203,14 @@ class Heat:
                     f"heat.windows: expected ranges 0 <= start < stop, got [{a}, {b}]"
                 )
         object.__setattr__(self, "windows", wins)
+        if self.mode not in HEAT_MODES:
+            raise ValueError(f"heat.mode: expected one of {', '.join(HEAT_MODES)}, got "
+                             f"{self.mode!r}")  # fmt: skip
+        if self.full_scale is not None and not float(self.full_scale) > 0.0:
+            raise ValueError(f"heat.full_scale: expected W/m > 0, got {self.full_scale!r}")
+        if not (np.isfinite(float(self.lag)) and float(self.lag) >= 0.0):
+            raise ValueError(f"heat.lag: expected seconds >= 0, got {self.lag!r}")
+        object.__setattr__(self, "lag", float(self.lag))
 
     @property
     def output(self) -> str:
@@ -310,13 +327,16 @@ class Trajectory:
     """A sampled joint trajectory with its metadata (see the module doc).
 
     ``t`` (M,) s from the start, strictly increasing; ``q`` (M, 6) rad; ``tcp``
-    (M, 6) UR pose vectors of the TCP in the robot base frame; ``meta``.
+    (M, 6) UR pose vectors of the TCP in the robot base frame; ``meta``;
+    ``heat_power`` (M,) W/m or None: the wire's power set-point per sample when the job
+    has a heat model (docs/kerf.md; led by ``meta.heat.lag``).
     """
 
     t: FloatArray
     q: FloatArray = field(repr=False)
     tcp: FloatArray = field(repr=False)
     meta: TrajectoryMeta = field(repr=False)
+    heat_power: FloatArray | None = field(default=None, repr=False)
 
     def __post_init__(self) -> None:
         t = as_array(self.t, "t")
@@ -333,6 +353,12 @@ class Trajectory:
             raise ValueError(f"t[{k}]: times must increase strictly")
         for name, arr in (("t", t), ("q", q), ("tcp", tcp)):
             object.__setattr__(self, name, readonly(arr))
+        if self.heat_power is not None:
+            hp = as_array(self.heat_power, "heat_power")
+            if hp.shape != t.shape or np.any(hp < 0.0):
+                raise ValueError(f"heat_power: expected {t.size} set-points >= 0 W/m, got "
+                                 f"shape {hp.shape}")  # fmt: skip
+            object.__setattr__(self, "heat_power", readonly(hp))
         m = t.size
         for p in self.meta.phases:
             if p.stop > m:
@@ -389,6 +415,26 @@ class Trajectory:
             return None
         return self.meta.cut.measure(self.t, self.tcp_poses())
 
+    def face_errors(
+        self, wis: WireInStock | None = None, heat_power: ArrayLike | None = None
+    ) -> dict:
+        """``face_error`` per cut (:func:`..wire.face.face_errors`) of this motion -- or of
+        ``wis``, the wire of a motion measured against this trajectory's block (an exported
+        program's, a run's recording) -- with the wire's power from ``heat_power`` (M,)
+        W/m, recorded set-points (default: this trajectory's), delayed by the heat's lag;
+        {} when the sidecar names no face."""
+        from ..wire.face import face_errors
+        from ..wire.kerf import wire_power
+
+        cut = self.meta.cut
+        if cut is None or not cut.faces:
+            return {}
+        wis = self.wire_in_stock() if wis is None else wis
+        hp = self.heat_power if heat_power is None else heat_power
+        lag = 0.0 if self.meta.heat is None else self.meta.heat.lag
+        power = None if hp is None else wire_power(wis.t, hp, lag)
+        return face_errors(wis, power, cut.material, cut.faces)
+
     def phase_at(self, k: int) -> str:
         """The name of the phase sample ``k`` belongs to (``"move"`` if none is named)."""
         for p in self.meta.phases:
@@ -429,8 +475,9 @@ class Trajectory:
             windows = tuple(c for a, b in heat.windows if (c := clip(a, b)))
             heat = dataclasses.replace(heat, windows=windows)
         meta = self.meta.replace(phases=phases, in_stock=stock, cut=cut, heat=heat)
+        hp = None if self.heat_power is None else self.heat_power[start:stop]
         return Trajectory(self.t[start:stop] - self.t[start], self.q[start:stop],
-                          self.tcp[start:stop], meta)  # fmt: skip
+                          self.tcp[start:stop], meta, hp)  # fmt: skip
 
 
 def phases_from_labels(labels: ArrayLike) -> tuple[Phase, ...]:

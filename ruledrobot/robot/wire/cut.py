@@ -23,9 +23,11 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ...geometry.box import Box
-from ...geometry.ranges import runs_of
+from ...geometry.ranges import checked_ranges, ranges_mask, runs_of, shifted_ranges
 from ..verdict import Check
+from .face import FaceTarget
 from .in_stock import WireInStock, wire_ends, wire_in_stock
+from .kerf import Material
 
 __all__ = ["DWELL_FRACTION", "DWELL_SLACK", "WIRE_TOLERANCE", "FeedMeasure", "FeedWindow",
            "HotDwell", "WireCut", "feed_checks", "feed_measures", "hot_dwell"]
@@ -38,16 +40,6 @@ WIRE_TOLERANCE = 0.0005
 DWELL_FRACTION = 0.5
 #: s: how much longer than its plan's a run's longest hot dwell may be
 DWELL_SLACK = 0.1
-
-
-def _ranges(value: object, what: str) -> tuple[tuple[int, int], ...]:
-    out = []
-    for i, r in enumerate(value or ()):  # type: ignore[attr-defined]
-        a, b = (int(x) for x in r)
-        if not 0 <= a < b:
-            raise ValueError(f"{what}[{i}]: expected sample indices 0 <= start < stop, got {r!r}")
-        out.append((a, b))
-    return tuple(out)
 
 
 @dataclass(frozen=True)
@@ -76,7 +68,8 @@ class FeedWindow:
                              f"{self.tolerance}")  # fmt: skip
         object.__setattr__(self, "start", int(self.start))
         object.__setattr__(self, "stop", int(self.stop))
-        object.__setattr__(self, "held", _ranges(self.held, f"feed window {self.name!r} held"))
+        held = checked_ranges(self.held, f"feed window {self.name!r} held")
+        object.__setattr__(self, "held", held)
         if not (np.isfinite(self.wire_tolerance) and self.wire_tolerance > 0):
             raise ValueError(f"feed window {self.name!r}: wire_tolerance must be > 0 m, got "
                              f"{self.wire_tolerance}")  # fmt: skip
@@ -89,18 +82,14 @@ class FeedWindow:
 
     def held_mask(self, n: int) -> np.ndarray:
         """(n,) bool: sample k is in one of the ``held`` ranges."""
-        m = np.zeros(n, dtype=bool)
-        for a, b in self.held:
-            m[a:b] = True
-        return m
+        return ranges_mask(self.held, n)
 
     def shifted(self, start: int, stop: int) -> FeedWindow | None:
         """The window on samples ``start:stop`` renumbered from 0 (None when outside)."""
         a, b = max(self.start, start) - start, min(self.stop, stop) - start
         if a >= b:
             return None
-        held = tuple((max(x, start) - start, min(y, stop) - start) for x, y in self.held
-                     if min(y, stop) > max(x, start))  # fmt: skip
+        held = shifted_ranges(self.held, start, stop)
         return FeedWindow(self.name, a, b, self.speed, self.tolerance, held, self.wire_tolerance)
 
 
@@ -108,17 +97,22 @@ class FeedWindow:
 class WireCut:
     """The block (robot base frame), the wire's length (m) and the passes' feeds: what
     a trajectory cuts, so that any motion of it can be measured (module doc).  The
-    trajectory's TCP is the wire's midpoint with z along the wire."""
+    trajectory's TCP is the wire's midpoint with z along the wire.  ``faces``: the part's
+    surface each pass leaves (:mod:`.face`: ``face_error``); ``material``: the foam's
+    kerf model (None: every cut's constant kerf)."""
 
     stock: Box
     wire_length: float
     feeds: tuple[FeedWindow, ...] = field(default=())
+    faces: tuple[FaceTarget, ...] = field(default=())
+    material: Material | None = None
 
     def __post_init__(self) -> None:
         if not (np.isfinite(self.wire_length) and self.wire_length > 0):
             raise ValueError(f"cut.wire_length: expected a length > 0 m, got {self.wire_length}")
         object.__setattr__(self, "wire_length", float(self.wire_length))
         object.__setattr__(self, "feeds", tuple(self.feeds))
+        object.__setattr__(self, "faces", tuple(self.faces))
 
     @property
     def wire_tolerance(self) -> float:
@@ -132,7 +126,8 @@ class WireCut:
     def sliced(self, start: int, stop: int) -> WireCut:
         """The same cut for samples ``start:stop`` numbered from 0."""
         feeds = tuple(w for f in self.feeds if (w := f.shifted(start, stop)) is not None)
-        return WireCut(self.stock, self.wire_length, feeds)
+        faces = tuple(w for f in self.faces if (w := f.shifted(start, stop)) is not None)
+        return WireCut(self.stock, self.wire_length, feeds, faces, self.material)
 
 
 @dataclass(frozen=True)

@@ -18,6 +18,23 @@ offsets give.
 Normals: ``n(t) = z x (o' + t z')`` of the discrete frame motion (origins ``o``,
 ruling directions ``z``), by central differences along the rulings (one-sided
 at the ends of open sequences).
+
+**Per point** (a job with ``[material]``, docs/kerf.md): the kerf follows the speed of
+each point of the wire, and on a robot-held wire the two chord ends move at different
+speeds.  The time law holds the chord's fastest point at the feed, so on the held
+stretches the reference end moves at the feed and the other at ``feed * ratio`` with
+``ratio = v_end / v_ref <= 1`` the ratio of their speeds across the wire per unit of
+path (:func:`~ruledrobot.robot.wire.in_stock.across_speeds` with the ruling index as
+parameter).  Each chord end ``P`` of the target ruling is moved by half the kerf
+predicted there along the normal ``n`` into the waste, ``P + w / 2 n``, and the wire is
+the line through the two moved ends (still a ruling: the frame turns by the smallest
+rotation from the old direction to the new).  The moved wire has other speeds, so the
+ratios are taken again on it, :data:`ROUNDS` times (the offsets change by less than a
+micrometre after two).  Kerf per end (:func:`held_kerf`): ``constant`` and ``on_off``
+``w = material.kerf(feed * ratio, p)`` with ``p`` the power while on
+(:func:`on_power`); ``constant_kerf`` ``w = kerf_base + (kerf - kerf_base) / ratio``
+(the power that holds ``kerf`` at the reference point, ``p0 + (kerf - kerf_base)
+feed / kerf_gain``, melts that at the end moving ``ratio`` as fast).
 """
 
 from __future__ import annotations
@@ -25,27 +42,62 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ...geometry.box import Box
 from ...geometry.checks import FloatArray
+from ...robot.wire.in_stock import across_speeds
+from ...robot.wire.kerf import Material
+from ..job.spec import CutSpec, HeatSpec
 from .wire_geometry import chords
 
-__all__ = ["KerfOffsets", "kept_surface_error", "kerf_offsets", "ruling_normals", "waste_sign"]
+__all__ = ["KerfOffsets", "cut_offsets", "face_points", "held_kerf", "kept_surface_error",
+           "kerf_offsets", "on_power", "point_kerf_offsets", "ruling_normals", "waste_sign"]
 
 #: points per chord at which the normals are sampled
 SAMPLES = 9
 #: a ``keep`` point nearer the surface than this [m] does not say which side is the part
 KEEP_CLEARANCE = 1e-4
+#: rounds of the per-point compensation (module doc)
+ROUNDS = 4
+#: m: half the length of the line the across-speeds are taken on (any length past the chord)
+_REACH = 10.0
+#: m: a chord shorter than this does not set the wire's tilt (the line through two moved
+#: ends a hair apart, where the wire enters the block across a corner, points anywhere):
+#: it moves as the nearest ruling with a longer chord
+SHORT_CHORD = 0.002
 
 
 @dataclass(frozen=True)
 class KerfOffsets:
     """Per ruling (M,) the wire's offset vector (M, 3) [m] and the predicted error of the
-    kept surface (M,) [m] (the largest over the chord, >= 0); zeros when not compensated."""
+    kept surface (M,) [m] (the largest over the chord, >= 0); zeros when not compensated.
+
+    ``turn`` (M, 3, 3): the rotation (world frame) of the wire's axes about its moved
+    origin, per point compensated (None: parallel offsets, the axes unchanged);
+    ``end_kerf`` (M, 2): the kerf [m] predicted at the chord's ends on the held feed
+    (NaN outside the stock; None: constant).  The wire frame of target frame ``S``:
+    axes ``turn @ S[:3, :3]``, origin ``S[:3, 3] + offset`` (:meth:`moved`)."""
 
     offset: FloatArray
     error: FloatArray
     compensated: bool
+    turn: FloatArray | None = None
+    end_kerf: FloatArray | None = None
+
+    def moved(self, frames: FloatArray, index: ArrayLike | None = None,
+              back: bool = False) -> FloatArray:  # fmt: skip
+        """Frames (K, 4, 4) moved as the wire of rulings ``index`` (K,) (default all) is
+        moved from its target; ``back``: the target of wire frames (the inverse)."""
+        k = slice(None) if index is None else np.asarray(index)
+        out = np.array(frames, dtype=np.float64)
+        off = np.broadcast_to(self.offset[k], out[:, :3, 3].shape)
+        if self.turn is not None:
+            R = np.broadcast_to(self.turn[k], out[:, :3, :3].shape)
+            R = np.swapaxes(R, -1, -2) if back else R
+            out[:, :3, :3] = R @ out[:, :3, :3]
+        out[:, :3, 3] += -off if back else off
+        return out
 
 
 def _derivative(x: FloatArray, closed: bool) -> FloatArray:
@@ -157,3 +209,131 @@ def kept_surface_error(
     d = wire_frames[:, :3, 3] - surface_frames[:, :3, 3]
     dist = np.einsum("mi,mki->mk", d, n)
     return np.where(hit, np.abs(dist - 0.5 * kerf).max(axis=1), 0.0)
+
+
+def on_power(cut: CutSpec, heat: HeatSpec | None, material: Material) -> float:
+    """The wire's power [W/m] while the heat is on in the modes ``on_off`` and
+    ``constant`` (docs/kerf.md): ``[tool] heat power`` when given (clipped to
+    ``full_scale`` on an analog output), else the power that melts the cut's ``kerf``
+    at its feed (the supply set up for the nominal kerf)."""
+    if heat is not None and heat.power is not None:
+        top = heat.full_scale if heat.kind == "analog" and heat.full_scale else np.inf
+        return float(min(heat.power, top))
+    return float(material.power_for_kerf(max(cut.kerf, material.kerf_base), cut.feed_speed))
+
+
+def held_kerf(
+    ratio: ArrayLike, cut: CutSpec, heat: HeatSpec | None, material: Material
+) -> FloatArray:
+    """The kerf [m] (ratio's shape) at chord points moving ``ratio`` (<= 1) times as fast
+    as the reference point, which the time law holds at the cut's feed (module doc):
+    ``constant_kerf`` ``kerf_base + (kerf - kerf_base) / ratio``, else
+    ``material.kerf(feed * ratio, on_power)``."""
+    r = np.asarray(ratio, dtype=np.float64)
+    if heat is not None and heat.mode == "constant_kerf":
+        with np.errstate(divide="ignore"):
+            return material.kerf_base + (cut.kerf - material.kerf_base) / r
+    return material.kerf(cut.feed_speed * r, on_power(cut, heat, material))
+
+
+def _rotation_between(a: FloatArray, b: FloatArray) -> FloatArray:
+    """(M, 3, 3) the smallest rotations taking unit vectors ``a`` (M, 3) to ``b`` (M, 3)
+    (Rodrigues: ``I + [v]x + [v]x^2 / (1 + c)``, ``v = a x b``, ``c = a . b``)."""
+    v = np.cross(a, b)
+    c = np.einsum("mi,mi->m", a, b)
+    V = np.zeros((len(a), 3, 3))
+    V[:, 0, 1], V[:, 0, 2], V[:, 1, 2] = -v[:, 2], v[:, 1], -v[:, 0]
+    V -= np.swapaxes(V, 1, 2)
+    return np.eye(3) + V + (V @ V) / (1.0 + c)[:, None, None]
+
+
+def _nearest_hit(hit: np.ndarray) -> np.ndarray:
+    """(M,) for every ruling the index of the nearest ruling that crosses the stock."""
+    M = hit.size
+    idx = np.flatnonzero(hit)
+    after = idx[np.clip(np.searchsorted(idx, np.arange(M)), 0, idx.size - 1)]
+    before = idx[np.clip(np.searchsorted(idx, np.arange(M)) - 1, 0, idx.size - 1)]
+    return np.where(np.abs(before - np.arange(M)) < np.abs(after - np.arange(M)), before, after)
+
+
+def point_kerf_offsets(
+    frames: FloatArray, stock: Box, cut: CutSpec, heat: HeatSpec | None, material: Material,
+    closed: bool = False, rounds: int = ROUNDS,
+) -> KerfOffsets:
+    """The per-point compensation (module doc) of the target rulings ``frames`` (M, 4, 4):
+    each chord end moved by half the kerf predicted there (:func:`held_kerf`) into the
+    waste, ``rounds`` times with the speed ratios of the moved wire.  Rulings that miss
+    the stock, or whose chord is shorter than :data:`SHORT_CHORD`, get the offset and turn
+    of the nearest ruling with a longer chord."""
+    M = frames.shape[0]
+    sign = waste_sign(frames, stock, cut.keep, closed)
+    c0, c1, hit = chords(frames, stock)
+    c = np.stack([np.where(hit, c0, 0.0), np.where(hit, c1, 0.0)], axis=1)  # (M, 2)
+    u = np.linspace(0.0, 1.0, SAMPLES)
+    t = c[:, :1] + (c[:, 1:] - c[:, :1]) * u[None, :]  # (M, K) along the target rulings
+    n = sign * ruling_normals(frames, t, closed)  # (M, K, 3) into the waste
+    o, z = frames[:, :3, 3], frames[:, :3, 2]
+    P = o[:, None, :] + t[..., None] * z[:, None, :]  # (M, K, 3) target chord samples
+    x = np.arange(M, dtype=np.float64)
+    span = np.where(hit, c[:, 1] - c[:, 0], 0.0)
+    near = _nearest_hit(span >= SHORT_CHORD)
+    wo, wz = o, z
+    for _ in range(max(int(rounds), 1)):
+        # the (moved) wire's chord, its points' speeds across it per ruling, their ratios
+        a0, a1, on = stock.clip_lines(wo, wz)
+        a0, a1 = np.where(on, a0, c[:, 0]), np.where(on, a1, c[:, 1])
+        lam = (a0[:, None] + (a1 - a0)[:, None] * u[None, :] + _REACH) / (2.0 * _REACH)
+        line = np.stack([wo - _REACH * wz, wo + _REACH * wz], axis=1)
+        v = across_speeds(x, line, lam)  # (M, K) per ruling
+        ref = np.max(v, axis=1, keepdims=True)
+        ratio = np.where(ref > 0.0, v / np.where(ref > 0.0, ref, 1.0), 1.0)
+        w = held_kerf(ratio, cut, heat, material)  # (M, K)
+        A = P[:, 0] + 0.5 * w[:, :1] * n[:, 0]
+        B = P[:, -1] + 0.5 * w[:, -1:] * n[:, -1]
+        d = B - A
+        length = np.linalg.norm(d, axis=1, keepdims=True)
+        wz = np.where(length > 0.0, d / np.where(length > 0, length, 1.0), z)
+        wo = A - c[:, :1] * wz
+        # rulings that miss the stock move as the nearest that crosses it (their speeds
+        # are differences with their neighbours: an unmoved neighbour would add a jump)
+        turn = _rotation_between(z, wz)[near]
+        offset = (wo - o)[near]
+        wo, wz = o + offset, np.einsum("mij,mj->mi", turn, z)
+    # the kept surface: the moved line against each target tangent plane, half a kerf off
+    W = A[:, None, :] + u[None, :, None] * (B - A)[:, None, :]
+    err = np.abs(np.einsum("mki,mki->mk", W - P, n) - 0.5 * w).max(axis=1)
+    end = np.where(hit[:, None], w[:, [0, -1]], np.nan)
+    return KerfOffsets(offset, np.where(hit, err, 0.0), True, turn, end)
+
+
+def cut_offsets(
+    frames: FloatArray, stock: Box, cut: CutSpec, heat: HeatSpec | None,
+    material: Material | None, closed: bool,
+) -> KerfOffsets:
+    """A cut's compensation: per point (:func:`point_kerf_offsets`) with a ``material``,
+    else today's constant kerf (:func:`kerf_offsets`); none without ``keep``."""
+    if material is None or cut.keep is None or cut.kerf <= 0.0:
+        return kerf_offsets(frames, stock, cut.kerf, cut.keep, closed)
+    return point_kerf_offsets(frames, stock, cut, heat, material, closed)
+
+
+def face_points(
+    target: FloatArray, wire: FloatArray, stock: Box, keep: str | FloatArray
+) -> tuple[FloatArray, FloatArray]:
+    """The part's surface along a pass (``face_error``'s target): the chord ends (K, 2, 3)
+    [m] of the target rulings ``target`` (M, 4, 4) that cross the stock and the unit
+    normals (K, 2, 3) there into the waste.  Each ruling's normals point the way its wire
+    (``wire`` (M, 4, 4), the compensated rulings) is moved off it -- a pass that goes
+    out and back along a loop turns its normals round halfway -- and by ``keep``
+    (:func:`waste_sign`) where the wire is not moved."""
+    c0, c1, hit = chords(target, stock)
+    S, W = target[hit], wire[hit]
+    t = np.stack([c0[hit], c1[hit]], axis=1)
+    n = ruling_normals(target, np.stack([np.nan_to_num(c0), np.nan_to_num(c1)], axis=1))[hit]
+    off = np.einsum("ki,kji->kj", W[:, :3, 3] - S[:, :3, 3], n)  # (K, 2)
+    moved = np.abs(off) > 1e-12
+    if not moved.all():
+        fallback = waste_sign(target, stock, keep)
+        off = np.where(moved, off, fallback)
+    points = S[:, None, :3, 3] + t[..., None] * S[:, None, :3, 2]
+    return points, np.sign(off)[..., None] * n

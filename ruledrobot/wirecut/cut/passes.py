@@ -50,7 +50,7 @@ from .clearance import Cell
 from .closed import loop_paths
 from .cutpath import CutPath, RefinedCut
 from .entry import PROFILE_KINDS, profile_entry
-from .kerf import kerf_offsets
+from .kerf import cut_offsets
 from .wire_geometry import anchored_frames, chords, world_referenced
 from .wire_pose import SearchOptions, search_wire_pose
 
@@ -409,12 +409,6 @@ def _extended_note(where: str, runs: list[_Overrun]) -> str:
     )
 
 
-def _translated(F: FloatArray, offset: FloatArray) -> FloatArray:
-    out = F.copy()
-    out[:, :3, 3] += offset
-    return out
-
-
 def job_search(job: Job, search: SearchOptions | None = None) -> SearchOptions:
     """The search options of ``job``'s passes: ``search`` (default: the planner's), whose
     motion starts near the job's ``[robot] home`` when it names one and the options no
@@ -447,10 +441,10 @@ def cut_paths(
     rc = refine_cut(cut, job.stock, str(job.source or "job"), job.tool.wire_length, document)
     where = "[cut]" if cut.name == "cut" else f"[cut '{cut.name}']"
     try:
-        kerf = kerf_offsets(rc.frames, job.stock, cut.kerf, cut.keep, rc.closed)
+        kerf = cut_offsets(rc.frames, job.stock, cut, job.tool.heat, job.material, rc.closed)
     except ValueError as exc:  # name the job file and the cut's section
         raise ValueError(f"{job.source or 'job'}: {where} {exc}") from None
-    wire = _translated(rc.frames, kerf.offset)
+    wire = kerf.moved(rc.frames)
     if rc.closed:
         return loop_paths(job, cut, rc, wire, kerf, cell, options)
     lead = max(cut.lead_in, cut.lead_out)
@@ -461,7 +455,7 @@ def cut_paths(
                          "surface's pose")  # fmt: skip
     first, last = np.flatnonzero(near)[[0, -1]]
     keep = slice(max(first - 1, 0), last + 2)
-    W, off = wire[keep], kerf.offset[keep]
+    W, rows = wire[keep], np.arange(len(wire))[keep]
     ext, runs = [], []
     for side in (0, 1):
         end = 0 if side == 0 else len(W) - 1
@@ -473,9 +467,10 @@ def cut_paths(
         run = None
         if len(frames):  # the surface ends within the lead of the stock, or in it
             # the target rulings past this end (the wire's, moved back by its kerf offset)
-            run = _overrun(side, _translated(W[[end, end + 1 - 2 * side]], -off[end]),
-                           _translated(frames, -off[end]),
-                           _translated(_first_gap(W, side, job.stock.centre), -off[end]),
+            back = rows[end]
+            run = _overrun(side, kerf.moved(W[[end, end + 1 - 2 * side]], back, back=True),
+                           kerf.moved(frames, back, back=True),
+                           kerf.moved(_first_gap(W, side, job.stock.centre), back, back=True),
                            job.stock, cut.wire_tolerance,
                            0 if side == 0 else rc.input_rulings - 1,
                            endless is not None)  # fmt: skip
@@ -494,8 +489,8 @@ def cut_paths(
         # common normals turn with its travel, half a turn round a leading edge): the
         # roll is the bow's attitude in the world, as a foam cutter's frame keeps it
         F = world_referenced(F)
-    off = np.concatenate([np.repeat(off[:1], before, 0), off, np.repeat(off[-1:], after, 0)])
-    S = _translated(F, -off)  # the target rulings (the lead-in/out ones lie outside the stock)
+    rows = np.r_[np.repeat(rows[:1], before), rows, np.repeat(rows[-1:], after)]
+    S = kerf.moved(F, rows, back=True)  # the target rulings (lead-in/out ones: outside the stock)
     notes = (_extended_note(where, runs),) if runs else ()
     err = np.r_[np.zeros(before), kerf.error[keep], np.zeros(after)]
     motion = search_wire_pose(F, job.tool, cell, options)

@@ -38,6 +38,16 @@ metres, radians, seconds)::
     clearance = 0.02           # wire kept this far beyond the stock at each end
     mass = 1.0
     # heat = { output = "standard:0", preheat = 2.0 }   # switch the wire's heat (robot IO)
+    # heat = { output = "analog:0", mode = "constant_kerf", full_scale = 400.0, lag = 0.2 }
+    #                          # the heat model (docs/kerf.md): mode = "on_off" (default) |
+    #                          # "constant" (power = W/m) | "constant_kerf" (needs [material]);
+    #                          # full_scale W/m at the analog output's 1.0; lag s
+
+    # [material]               # the foam's kerf model (docs/kerf.md); without it every cut
+    # kerf_base = 0.0003       # keeps its constant kerf. m: the wire's own width
+    # kerf_gain = 1.5e-8       # m^2/s per W/m: w = kerf_base + kerf_gain (p - p0) / v
+    # power_threshold = 20.0   # W/m: p0, what the wire loses without cutting
+    # max_speed = 0.002        # (m/s) per W/m above p0: faster, the wire drags (optional)
 
     [cut]
     feed_speed = 0.01          # m/s, wire speed inside the stock
@@ -51,6 +61,7 @@ metres, radians, seconds)::
     feed_tolerance = 0.05      # fraction: feed inside the stock within +-5 % (a check)
     # extend = true            # an open surface that stops short of the block is cut on
     #                          # through it along its extrapolation (noted); default: refused
+    tolerance = 0.0001         # m, the predicted cut face within this of the part (face_error)
 
 A part with several cuts lists them in order as ``[[cut]]`` tables, each with a
 ``name`` and its own ``[cut.surface]`` table (the fields of ``[surface]``), and
@@ -69,6 +80,7 @@ the section and the field.
 
 from __future__ import annotations
 
+import dataclasses
 import os
 import sys
 from pathlib import Path
@@ -80,6 +92,7 @@ from .sections import (
     FOREIGN_KINDS,
     Section,
     parse_heat,
+    parse_material,
     parse_robot,
     parse_stock,
     parse_surface,
@@ -164,6 +177,7 @@ def _cut(c: Section, name: str, surface: SurfaceSpec, surface_title: str = "surf
         feed_tolerance=c.number("feed_tolerance", CutSpec.feed_tolerance, lo=0.0, hi=1.0,
                                 strict_lo=True),
         extend=c.flag("extend", CutSpec.extend),
+        tolerance=c.number("tolerance", CutSpec.tolerance, lo=0.0, strict_lo=True),
     )
     if cut.extend and closed:
         raise c.fail("extend", "only for an open surface (a closed one is entered through a "
@@ -206,7 +220,7 @@ def _cuts(doc: dict, where: str, base_dir: Path | None) -> tuple[CutSpec, ...]:
 
 def parse_job(doc: dict, where: str = "job", base_dir: Path | None = None) -> Job:
     """Validate a job given as a TOML-like dict (see the module doc)."""
-    known = {"surface", "stock", "robot", "tool", "cut"}
+    known = {"surface", "stock", "robot", "tool", "cut", "material"}
     extra = sorted(set(doc) - known)
     if extra:
         raise ValueError(
@@ -216,7 +230,28 @@ def parse_job(doc: dict, where: str = "job", base_dir: Path | None = None) -> Jo
     stock = parse_stock(Section(doc, "stock", where))
     robot = parse_robot(Section(doc, "robot", where), base_dir)
     tool = _tool(Section(doc, "tool", where))
-    return Job(cuts, stock, robot, tool)
+    material = None
+    if doc.get("material") is not None:
+        material = parse_material(Section(doc, "material", where))
+    _check_heat_model(tool, cuts, material, where)
+    return Job(cuts, stock, robot, tool, material=material)
+
+
+def _check_heat_model(tool: ToolSpec, cuts: tuple[CutSpec, ...], material, where: str) -> None:
+    """The heat model's needs across tables (docs/kerf.md): ``constant_kerf`` needs
+    ``[material]`` and every cut's ``kerf`` at least the material's ``kerf_base``."""
+    heat = tool.heat
+    if heat is None or heat.mode != "constant_kerf":
+        return
+    if material is None:
+        raise ValueError(f'{where}: [tool.heat] mode: "constant_kerf" needs a [material] '
+                         "table (kerf_base, kerf_gain, power_threshold)")  # fmt: skip
+    for cut in cuts:
+        if cut.kerf < material.kerf_base:
+            title = "cut" if cut.name == "cut" and len(cuts) == 1 else f"cut '{cut.name}'"
+            raise ValueError(f"{where}: [{title}] kerf: {cut.kerf * 1e3:g} mm is below "
+                             f"[material] kerf_base {material.kerf_base * 1e3:g} mm: no heat "
+                             "melts less than the wire")  # fmt: skip
 
 
 def job_document(text: str, where: str) -> dict:
@@ -265,4 +300,4 @@ def load_job(path: str | os.PathLike[str]) -> Job:
     p, text = read_user_text(path, "job file")
     doc = job_document(text, str(p))
     job = parse_job(doc, str(p), base_dir=p.parent)
-    return Job(job.cuts, job.stock, job.robot, job.tool, source=p)
+    return dataclasses.replace(job, source=p)

@@ -18,10 +18,12 @@ from ...geometry.box import Box
 from ...io.fields import FieldReader
 from ...io.paths import input_path, missing_file
 from ...robot.arm.calibration import Calibration
+from ...robot.wire.kerf import Material
 from ...subdivision.schemes import SCHEME_NAMES
-from .spec import HeatSpec, RobotSpec, SurfaceSpec
+from .spec import HEAT_MODES, HeatSpec, RobotSpec, SurfaceSpec
 
-__all__ = ["Section", "parse_heat", "parse_robot", "parse_stock", "parse_surface"]
+__all__ = ["Section", "parse_heat", "parse_material", "parse_robot", "parse_stock",
+           "parse_surface"]
 
 ALGORITHMS = ("projection", "combined", "dh")
 #: the files of the field a surface can be read from (:mod:`ruledrobot.io.formats`)
@@ -321,9 +323,26 @@ def _calibration(sec: Section, model: str, base_dir: Path | None) -> Calibration
     return cal
 
 
+def parse_material(m: Section) -> Material:
+    """``[material]`` -> :class:`~ruledrobot.robot.wire.kerf.Material` (docs/kerf.md):
+    ``kerf_base`` m, ``kerf_gain`` m^2/s per W/m, ``power_threshold`` W/m (default 0),
+    ``max_speed`` (m/s) per W/m (optional)."""
+    top = m.get("max_speed")
+    material = Material(
+        kerf_base=m.number("kerf_base", lo=0.0),
+        kerf_gain=m.number("kerf_gain", lo=0.0, strict_lo=True),
+        power_threshold=m.number("power_threshold", 0.0, lo=0.0),
+        max_speed=None if top is None else m.number("max_speed", lo=0.0, strict_lo=True),
+    )
+    m.done()
+    return material
+
+
 def parse_heat(h: Section) -> HeatSpec:
     """``[tool.heat]`` -> :class:`.spec.HeatSpec`: ``output = "standard:0"`` (kind:index),
-    ``preheat`` (s), ``value`` (analog outputs: the fraction of the range)."""
+    ``preheat`` (s), ``value`` (analog outputs: the fraction of the range), and the heat
+    model (docs/kerf.md): ``mode``, ``power`` (W/m), ``full_scale`` (W/m at an analog
+    output's 1.0), ``lag`` (s).  What needs ``[material]`` is checked with the job."""
     out = h.get("output")
     if not isinstance(out, str) or ":" not in out:
         raise h.fail("output", 'expected "KIND:N" with KIND one of '
@@ -335,13 +354,27 @@ def parse_heat(h: Section) -> HeatSpec:
     if not index.isdigit() or not 0 <= int(index) < HEAT_OUTPUTS[kind]:
         raise h.fail("output", f"{kind} outputs are numbered 0..{HEAT_OUTPUTS[kind] - 1}, "
                      f"got {index!r}")  # fmt: skip
+    mode = h.choice("mode", HEAT_MODES, "on_off")
+    power = None if h.get("power") is None else h.number("power", lo=0.0, strict_lo=True)
+    full_scale = (None if h.get("full_scale") is None
+                  else h.number("full_scale", lo=0.0, strict_lo=True))  # fmt: skip
     heat = HeatSpec(
         kind=kind,
         index=int(index),
         preheat=h.number("preheat", 2.0, lo=0.0, hi=60.0),
         value=h.number("value", 1.0, lo=0.0, hi=1.0) if kind == "analog" else 1.0,
+        mode=mode, power=power, full_scale=full_scale,
+        lag=h.number("lag", 0.0, lo=0.0, hi=10.0),
     )
     if kind != "analog" and "value" in h.raw:
         raise h.fail("value", "only for an analog output")
+    if mode == "constant" and power is None:
+        raise h.fail("power", 'missing; mode = "constant" needs the wire\'s power (W/m)')
+    if kind == "analog" and mode != "on_off" and full_scale is None:
+        raise h.fail("full_scale", f'missing; mode = "{mode}" on an analog output needs the '
+                     "power (W/m) at the output's 1.0")  # fmt: skip
+    if kind == "analog" and mode != "on_off" and "value" in h.raw:
+        raise h.fail("value", f'not with mode = "{mode}": the power sets the output '
+                     "(power / full_scale)")  # fmt: skip
     h.done()
     return heat

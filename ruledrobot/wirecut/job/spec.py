@@ -15,9 +15,14 @@ import numpy as np
 from ...geometry.box import Box
 from ...geometry.lines import Lines
 from ...robot.arm.calibration import Calibration
+from ...robot.motion.trajectory import HEAT_MODES
 from ...robot.wire.cut import WIRE_TOLERANCE
+from ...robot.wire.kerf import Material
 
-__all__ = ["CutSpec", "HeatSpec", "Job", "RobotSpec", "SurfaceSpec", "ToolSpec"]
+__all__ = ["HEAT_MODES", "CutSpec", "HeatSpec", "Job", "RobotSpec", "SurfaceSpec", "ToolSpec"]
+
+#: m: how far the predicted cut face may lie from the part's surface, by default
+FACE_TOLERANCE = 1e-4
 
 
 @dataclass(frozen=True)
@@ -144,12 +149,21 @@ class HeatSpec:
     ``"analog"`` (standard analog output ``index`` set to ``value``, a fraction of its
     range: the wire's current); ``preheat``: seconds the wire heats, still, at the
     start of each lead-in before it moves into the stock.
+
+    The heat model (docs/kerf.md): ``mode`` one of :data:`HEAT_MODES`; ``power`` [W/m]
+    the wire's power while on (required by ``"constant"``; ``"on_off"`` without it: the
+    power that melts the cut's kerf at its feed); ``full_scale`` [W/m] the power at an
+    analog output's 1.0; ``lag`` [s] the wire's thermal delay the set-points lead by.
     """
 
     kind: str
     index: int
     preheat: float = 2.0
     value: float = 1.0
+    mode: str = "on_off"
+    power: float | None = None
+    full_scale: float | None = None
+    lag: float = 0.0
 
     @property
     def output(self) -> str:
@@ -196,6 +210,8 @@ class CutSpec:
     wire_tolerance: float = WIRE_TOLERANCE
     feed_tolerance: float = 0.05
     extend: bool = False
+    #: m: how far the predicted cut face may lie from the part's surface (``face_error``)
+    tolerance: float = FACE_TOLERANCE
 
 
 @dataclass(frozen=True)
@@ -214,6 +230,7 @@ class Job:
     tool: ToolSpec
     source: Path | None = None
     source_bytes: bytes | None = field(default=None, repr=False)
+    material: Material | None = None
 
     @property
     def cut(self) -> CutSpec:

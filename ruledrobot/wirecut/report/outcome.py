@@ -12,6 +12,7 @@ import numpy as np
 
 from ...robot.verdict import Check, Verdict
 from ...robot.wire.cut import feed_measures
+from ...robot.wire.face import FaceError
 from ..motion.feed_limit import feed_limit_reason
 from ..plan import SINGULARITY_MARGIN, Plan, job_reference
 from ..reach.explain import reach_reasons
@@ -44,6 +45,7 @@ def _cut_sections(plan: Plan, ver: Verification | None) -> tuple[list[dict], lis
     sections, measures = [], []
     cut_meta = plan.trajectory.meta.cut
     feeds = {f.name: f for f in feed_measures(mo.wire, cut_meta)}
+    faces = plan.trajectory.face_errors(mo.wire)
     for cut in plan.job.cuts:
         ks = [k for k, cp in enumerate(plan.passes) if cp.cut is cut]
         passes = [plan.passes[k] for k in ks]
@@ -61,6 +63,7 @@ def _cut_sections(plan: Plan, ver: Verification | None) -> tuple[list[dict], lis
         in_pass = np.isin(mo.pass_of, ks)
         t_cut = mo.timed.t[in_pass]
         m0 = passes[0].motion
+        fe = faces.get(cut.name)
         cm = CutMeasurements(
             name=cut.name, feed_set_mm_s=cut.feed_speed * 1e3,
             feed_max_mm_s=_mm(None if fm is None or np.isnan(fm.highest) else fm.highest),
@@ -73,6 +76,9 @@ def _cut_sections(plan: Plan, ver: Verification | None) -> tuple[list[dict], lis
             kerf_mm=cut.kerf * 1e3, compensated=compensated,
             kept_surface_error_mm=err * 1e3 if compensated else None,
             wire_tolerance_mm=cut.wire_tolerance * 1e3, feed_tolerance=cut.feed_tolerance,
+            face_error_mm=None if fe is None else _face_mm(fe), tolerance_mm=cut.tolerance * 1e3,
+            face_detail="" if fe is None else _face_detail(fe, mo),
+            predicted_kerf=None if fe is None else _kerf_words(fe),
         )  # fmt: skip
         measures.append(cm)
         sections.append({
@@ -95,6 +101,10 @@ def _cut_sections(plan: Plan, ver: Verification | None) -> tuple[list[dict], lis
             "kerf_compensated": compensated,
             "keep": _keep_text(cut.keep),
             "max_kept_surface_error_mm": cm.kept_surface_error_mm,
+            "max_face_error_mm": None if fe is None or fe.burn else cm.face_error_mm,
+            "face_burn": None if fe is None else fe.burn,
+            "face_tolerance_mm": cm.tolerance_mm,
+            "predicted_kerf_mm": None if fe is None else _kerf_range(fe),
             "roll_deg": float(np.degrees(m0.roll[0])),
             "constant_roll": bool(np.ptp(m0.roll) < 1e-12),
             "slide_m": float(m0.slide[0]),
@@ -104,6 +114,38 @@ def _cut_sections(plan: Plan, ver: Verification | None) -> tuple[list[dict], lis
                                float(me.feed[slits].max() * 1e3)] if slits.any() else None,
         })
     return sections, measures
+
+
+def _face_mm(fe: FaceError) -> float | None:
+    """The worst face error in mm (inf: a burn; None: the wire never on the face)."""
+    return None if np.isnan(fe.worst) else float(fe.worst) * 1e3
+
+
+def _face_detail(fe: FaceError, mo) -> str:
+    """Where the face is worst, in words: a burn's time, or the error's time and phase."""
+    if np.isnan(fe.worst):
+        return "the wire never cut the part's face"
+    if fe.burn:
+        return (f"burn at t = {fe.t:.3f} s: the wire stops in the foam with the heat above "
+                "its threshold")  # fmt: skip
+    return (f"worst at t = {fe.t:.3f} s ({mo.labels[fe.at]}), the predicted kerf there "
+            f"{fe.kerf[fe.at, 0] * 1e3:.3f} / {fe.kerf[fe.at, 1] * 1e3:.3f} mm at the wire's "
+            "start / end side")  # fmt: skip
+
+
+def _kerf_range(fe: FaceError) -> dict[str, list[float] | None]:
+    """The predicted kerf's range [min, max] in mm at each chord end on the face."""
+    r = fe.kerf_range() * 1e3
+    return {side: None if np.isnan(r[i]).any() else [float(r[i, 0]), float(r[i, 1])]
+            for i, side in enumerate(("wire_start_side", "wire_end_side"))}  # fmt: skip
+
+
+def _kerf_words(fe: FaceError) -> str | None:
+    """``"0.80-0.81 / 0.80-0.93 mm"``: the kerf's range at each chord end (None: none)."""
+    r = fe.kerf_range() * 1e3
+    if np.isnan(r).any():
+        return None
+    return " / ".join(f"{a:.3f}-{b:.3f}" for a, b in r) + " mm"
 
 
 def _unreachable(plan: Plan) -> tuple[dict, Verdict]:

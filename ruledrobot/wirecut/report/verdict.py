@@ -24,8 +24,13 @@ Gating (the plan is feasible only when all hold; ``docs/verdict.md``):
   (:mod:`..motion.corners`: a turn of more than 30 degrees, which no machine passes at the
   feed), counted in ``corner_stops``;
 * ``kept_surface`` (kerf compensated cuts) — the kept part's surface within
-  ``[cut] wire_tolerance`` of the target, from the kerf offsets (:mod:`..cut.kerf`)
-  (these four are per cut, named ``wire_deviation:NAME`` ... when a job has several);
+  ``[cut] wire_tolerance`` of the target, from the kerf offsets (:mod:`..cut.kerf`);
+* ``face_error`` (cuts that name the part's side, ``keep``) — the predicted cut face
+  (the wire's chord ends moved by half the kerf predicted there, from their speeds and
+  the wire's power) within ``[cut] tolerance`` of the part's surface, over the samples on
+  the face (:mod:`ruledrobot.robot.wire.face`); a stop with the heat on is a burn.  Such
+  a cut's ``feed_max`` / ``feed_min`` are information (the time law's target): the face
+  decides (these are per cut, named ``wire_deviation:NAME`` ... when a job has several);
 * ``joint_position`` / ``joint_speed`` / ``joint_acceleration`` — ratios to the
   robot's limits (finite differences of the samples) at most 1; ``joint_torque``
   — the simulated joint torques (MuJoCo, with the bow's mass) at most the limits;
@@ -36,6 +41,7 @@ Information only: TCP tracking error, feed within 1 %, kerf, corner stops, durat
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 from ...robot.motion.rates import RATIO_MAX
@@ -67,6 +73,13 @@ class CutMeasurements:
     corner_stops: int = 0
     #: what holds the wire below the feed where it is slowest, measured (None: it is not)
     feed_min_limit: str | None = None
+    #: the predicted face's largest distance from the part (None: no face judged, the cut
+    #: names no part side; inf: a burn), its tolerance, and where, in words
+    face_error_mm: float | None = None
+    tolerance_mm: float = 0.1
+    face_detail: str = ""
+    #: the predicted kerf's range on the face at the wire's start and end side, in words
+    predicted_kerf: str | None = None
 
 
 @dataclass(frozen=True)
@@ -116,6 +129,13 @@ def _cut_checks(c: CutMeasurements, single: bool) -> list[Check]:
             "kept_surface" + key, "kept surface from the target, kerf compensated" + of,
             c.kept_surface_error_mm, c.wire_tolerance_mm, "mm",
             "a straight wire's kerf offset cannot follow the surface's twist"))  # fmt: skip
+    if c.face_error_mm is not None:
+        checks.append(Check.at_most(
+            "face_error" + key, "predicted cut face from the part's surface" + of,
+            c.face_error_mm, c.tolerance_mm, "mm", c.face_detail))  # fmt: skip
+        # the face decides; the feed window is the time law's target, shown
+        checks = [dataclasses.replace(ch, gating=False) if ch.name.startswith("feed_") else ch
+                  for ch in checks]  # fmt: skip
     return checks
 
 
@@ -128,6 +148,9 @@ def _cut_info(c: CutMeasurements, single: bool) -> list[Check]:
                    c.feed_within_1pct),
         Check.info("kerf" + key, kerf + of, c.kerf_mm, "mm"),
     ]  # fmt: skip
+    if c.predicted_kerf is not None:
+        info.append(Check.info("predicted_kerf" + key, "predicted kerf on the face, wire start "
+                               "side / end side" + of, c.predicted_kerf))  # fmt: skip
     if c.corner_stops:
         info.append(Check.info(
             "corner_stops" + key, "corners where the wire stops (not in the lowest feed)" + of,

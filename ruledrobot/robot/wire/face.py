@@ -1,0 +1,223 @@
+"""The cut face as the foam sees it: how far the predicted face lies from the part's
+surface, per sample of any motion (docs/kerf.md, "face_error").
+
+The wire melts a channel of width ``w`` centred on itself (:mod:`.kerf`), so the face
+it leaves at a chord end ``x`` is ``x`` moved half a kerf towards the part.  With the
+target surface's point ``s`` and unit normal ``n`` into the waste there, the face's
+distance from the surface is::
+
+    e = |(x - s) . n - w / 2|
+
+at both chord ends of every sample where the wire is on the face (the cut phase, its
+corner stops included; not the lead-in/out, not a closed cut's slits).  ``s`` and ``n``
+are those of the nearest chord ends of the target rulings (a k-d tree; their tangent
+planes stand for the surface within a ruling interval; the plane nearest the face decides,
+:data:`NEAREST`).  The kerf ``w`` at each
+end: the cut's constant ``kerf`` without a material; with one, ``material.kerf(v, p)``
+with ``v`` the end's speed across the wire (:func:`.in_stock.across_speeds` in time)
+and ``p`` the wire's power (:func:`.kerf.wire_power` of the set-points).  A wire that
+melts nothing new (power at or below the threshold) stands in the channel it melted
+before: the kerf of the last sample that melted carries on; so does a wire that stands
+(slower than :data:`STILL`) -- unless at that speed it melts wider than the channel: a
+hot wire that stops is a burn, ``e = inf``.
+
+Everyone who holds a motion and its heat calls :func:`face_error` with the
+:class:`FaceTarget` of the trajectory's sidecar: the plan, an export's verification,
+a run's verdict on its recording.  Units: m, s, W/m; one frame (the robot base frame).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from ...geometry.ranges import checked_ranges, ranges_mask, shifted_ranges
+from .._checks import FloatArray
+from .in_stock import WireInStock, across_speeds
+from .kerf import Material
+
+__all__ = ["FaceError", "FaceTarget", "face_error", "face_errors"]
+
+#: the target chord ends whose tangent planes stand for the surface near a chord end: the
+#: nearest of them decides (at a corner of the path the corner ruling's normal bisects
+#: the faces; a neighbour's plane is the face)
+NEAREST = 3
+#: m/s: a hot wire slower than this stands still and burns: the melt then grows with the
+#: time it stays, which the energy balance does not describe (a sampled stop never reaches
+#: exactly 0)
+STILL = 1e-3
+#: W/m: a power within this of the threshold melts nothing (a schedule that drops to the
+#: threshold at a stop, interpolated)
+MELT_SLACK = 1e-9
+
+
+@dataclass(frozen=True, eq=False)
+class FaceTarget:
+    """The part's surface one cut's pass must leave (module doc).
+
+    ``name``: the cut; ``points`` (K, 2, 3) m: the chord ends of its target rulings in the
+    block; ``normals`` (K, 2, 3): unit normals of the surface there, into the waste;
+    ``ranges``: the half-open sample ranges with the wire on the face; ``kerf`` m: the
+    cut's constant kerf (used without a material); ``tolerance`` m: how far the face may
+    lie from the surface."""
+
+    name: str
+    points: FloatArray = field(repr=False)
+    normals: FloatArray = field(repr=False)
+    ranges: tuple[tuple[int, int], ...] = ()
+    kerf: float = 0.0
+    tolerance: float = 1e-4
+
+    def __post_init__(self) -> None:
+        p = np.asarray(self.points, dtype=np.float64).reshape(-1, 2, 3)
+        n = np.asarray(self.normals, dtype=np.float64).reshape(-1, 2, 3)
+        if p.shape != n.shape or not (np.isfinite(p).all() and np.isfinite(n).all()):
+            raise ValueError(f"face {self.name!r}: points {p.shape} and normals {n.shape} must "
+                             "be finite (K, 2, 3) arrays of one shape")  # fmt: skip
+        norm = np.linalg.norm(n, axis=-1, keepdims=True)
+        if np.any(norm <= 0.0):
+            raise ValueError(f"face {self.name!r}: a normal is zero")
+        object.__setattr__(self, "points", p)
+        object.__setattr__(self, "normals", n / norm)
+        ranges = checked_ranges(self.ranges, f"face {self.name!r} ranges")
+        object.__setattr__(self, "ranges", ranges)
+        if not (np.isfinite(self.kerf) and self.kerf >= 0.0):
+            raise ValueError(f"face {self.name!r}: kerf must be >= 0 m, got {self.kerf}")
+        if not (np.isfinite(self.tolerance) and self.tolerance > 0.0):
+            raise ValueError(f"face {self.name!r}: tolerance must be > 0 m, got {self.tolerance}")
+        object.__setattr__(self, "kerf", float(self.kerf))
+        object.__setattr__(self, "tolerance", float(self.tolerance))
+
+    def mask(self, n: int) -> np.ndarray:
+        """(n,) bool: sample k is on the face."""
+        return ranges_mask(self.ranges, n)
+
+    def shifted(self, start: int, stop: int) -> FaceTarget | None:
+        """The target on samples ``start:stop`` renumbered from 0 (None when no range is
+        left)."""
+        ranges = shifted_ranges(self.ranges, start, stop)
+        if not ranges:
+            return None
+        return FaceTarget(self.name, self.points, self.normals, ranges, self.kerf,
+                          self.tolerance)  # fmt: skip
+
+
+@dataclass(frozen=True)
+class FaceError:
+    """:func:`face_error` of one cut: ``error`` (M,) m per sample, the larger of its two
+    chord ends (NaN off the face, inf at a burn); ``kerf`` (M, 2) m at the chord ends
+    (NaN off the face); ``worst`` m (NaN when the wire was never on the face) at sample
+    ``at`` (-1: none), ``t`` s its time; ``burn``: the worst is a burn (a stop with the
+    heat above the threshold)."""
+
+    name: str
+    error: FloatArray = field(repr=False)
+    kerf: FloatArray = field(repr=False)
+    worst: float
+    at: int
+    t: float
+    tolerance: float
+
+    @property
+    def burn(self) -> bool:
+        """Whether the worst sample is a burn (``inf``)."""
+        return bool(np.isinf(self.worst))
+
+    @property
+    def ok(self) -> bool:
+        """Whether the worst error is at most the tolerance (False when never on the face)."""
+        return bool(np.isfinite(self.worst) and self.worst <= self.tolerance)
+
+    def kerf_range(self) -> FloatArray:
+        """(2, 2) m: per chord end (wire start side, wire end side) the smallest and the
+        largest predicted kerf on the face (NaN when never on it)."""
+        k = self.kerf[~np.isnan(self.kerf).any(axis=1)]
+        if not k.size:
+            return np.full((2, 2), np.nan)
+        return np.stack([k.min(axis=0), k.max(axis=0)], axis=1)
+
+
+def _carried(w: FloatArray, moves: np.ndarray) -> FloatArray:
+    """Per column of ``w`` (R, 2): the value of the last row where ``moves`` (R, 2), the
+    first such row's before any (NaN where a column never moves)."""
+    out = np.full(w.shape, np.nan)
+    for j in range(w.shape[1]):
+        m = moves[:, j]
+        if not m.any():
+            continue
+        idx = np.maximum.accumulate(np.where(m, np.arange(len(w)), -1))
+        out[:, j] = w[np.where(idx < 0, int(np.flatnonzero(m)[0]), idx), j]
+    return out
+
+
+def _kerf(v: FloatArray, p: FloatArray, material: Material) -> FloatArray:
+    """The kerf (R, 2) [m] at the chord ends' speeds ``v`` (R, 2) and the wire's power
+    ``p`` (R,) (module doc): where the wire moves and melts, the model; where it melts
+    nothing new or stands still, the channel it melted last -- unless, standing, it melts
+    wider than that at :data:`STILL`: a burn (inf)."""
+    melts = (p > material.power_threshold + MELT_SLACK)[:, None]
+    still = v < STILL
+    w = material.kerf(np.where(still, STILL, v), p[:, None])
+    channel = _carried(w, melts & ~still)
+    channel = np.where(np.isnan(channel), material.kerf_base, channel)
+    burn = melts & still & (w > channel * (1.0 + 1e-9))
+    return np.where(burn, np.inf, np.where(melts & ~still, w, channel))
+
+
+def face_error(
+    wis: WireInStock, power: ArrayLike | None, material: Material | None, face: FaceTarget
+) -> FaceError:
+    """The predicted cut face against ``face`` along a motion (module doc).
+
+    ``wis``: the wire against the block (M samples); ``power`` (M,) W/m the wire's power
+    (:func:`.kerf.wire_power` of the set-points; None: no heat model, the constant kerf);
+    ``material``: the foam (None: ``face.kerf`` everywhere)."""
+    from scipy.spatial import cKDTree
+
+    M = wis.n
+    rows = np.flatnonzero(face.mask(M) & wis.inside)
+    error = np.full(M, np.nan)
+    kerf = np.full((M, 2), np.nan)
+    if not rows.size:
+        return FaceError(face.name, error, kerf, float("nan"), -1, float("nan"), face.tolerance)
+    x = wis.chord_points()[rows]  # (R, 2, 3)
+    if material is None or power is None:
+        w = np.full((rows.size, 2), face.kerf)
+    else:
+        p = np.asarray(power, dtype=np.float64)[rows]
+        v = across_speeds(wis.t, wis.ends, wis.fractions())[rows]  # (R, 2)
+        w = _kerf(v, p, material)
+    pts = face.points.reshape(-1, 3)
+    near = min(NEAREST, len(pts))
+    _, k = cKDTree(np.array(pts)).query(np.array(x.reshape(-1, 3)), k=near)  # writable
+    k = k.reshape(*x.shape[:2], near)  # (R, 2, near)
+    s, n = pts[k], face.normals.reshape(-1, 3)[k]
+    with np.errstate(invalid="ignore"):
+        d = np.einsum("rkji,rkji->rkj", x[:, :, None, :] - s, n)
+        e = np.abs(d - 0.5 * w[..., None]).min(axis=2)
+    e = np.where(np.isinf(w), np.inf, e)
+    error[rows] = e.max(axis=1)
+    kerf[rows] = w
+    j = int(rows[np.argmax(error[rows])])
+    return FaceError(face.name, error, kerf, float(error[j]), j, float(wis.t[j]), face.tolerance)
+
+
+def face_errors(
+    wis: WireInStock, power: ArrayLike | None, material: Material | None,
+    faces: tuple[FaceTarget, ...],
+) -> dict[str, FaceError]:
+    """:func:`face_error` per cut name (the passes of one cut joined: the larger error per
+    sample, the kerf where a pass is on its face), in the order of ``faces``."""
+    out: dict[str, FaceError] = {}
+    for f in faces:
+        e = face_error(wis, power, material, f)
+        if f.name in out:
+            a = out[f.name]
+            error = np.fmax(a.error, e.error)
+            kerf = np.where(np.isnan(e.kerf), a.kerf, e.kerf)
+            e = e if not np.isnan(e.worst) and not (e.worst <= a.worst) else a
+            e = FaceError(f.name, error, kerf, e.worst, e.at, e.t, e.tolerance)
+        out[f.name] = e
+    return out
