@@ -108,6 +108,8 @@ def _wires(ax: Any, plan: Plan, runs: list[tuple[str, int, int]]) -> None:
             picks.setdefault(phase, []).append(np.unique(at.round()))
     for phase, chunks in picks.items():
         seg = _clipped(_wire_at(plan, np.concatenate(chunks).astype(np.intp)), reach)
+        if not len(seg):  # (matplotlib refuses an empty 3-D collection)
+            continue
         ax.add_collection3d(Line3DCollection(seg * MM, colors=PHASE_COLOURS[phase],
                                              linewidths=1.0, alpha=0.8, zorder=4))  # fmt: skip
 
