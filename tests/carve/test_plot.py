@@ -10,14 +10,14 @@ import pytest
 
 pytest.importorskip("matplotlib")
 
-from matplotlib.colors import to_rgba  # noqa: E402
-from mpl_toolkits.mplot3d.art3d import Poly3DCollection  # noqa: E402
+from matplotlib.colors import to_rgba
+from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
-from ruledrobot.carve.carved import carve_block  # noqa: E402
-from ruledrobot.carve.measure import surface_distance  # noqa: E402
-from ruledrobot.carve.meshquery import MeshQuery  # noqa: E402
-from ruledrobot.carve.plan_cuts import find_cuts  # noqa: E402
-from ruledrobot.carve.plot import (  # noqa: E402
+from ruledrobot.carve.carved import carve_block
+from ruledrobot.carve.measure import surface_distance
+from ruledrobot.carve.meshquery import MeshQuery
+from ruledrobot.carve.plan_cuts import find_cuts
+from ruledrobot.carve.plot import (
     BLOCK_FACE,
     _carved_colours,
     _part_colours,
@@ -25,10 +25,10 @@ from ruledrobot.carve.plot import (  # noqa: E402
     cut_colours,
     draw,
 )
-from ruledrobot.carve.readers import PartMesh  # noqa: E402
-from ruledrobot.geometry.box import Box  # noqa: E402
+from ruledrobot.carve.readers import PartMesh
+from ruledrobot.geometry.box import Box
 
-from .parts import prism  # noqa: E402
+from .parts import prism
 
 STOCK = Box(np.array([0.5, 0.0, 0.3]), np.array([0.2, 0.2, 0.15]))
 

@@ -80,13 +80,12 @@ def test_faces_are_lit_by_lamberts_law_from_matplotlibs_light():
 
 def test_the_block_and_a_mesh_are_drawn_with_their_colours():
     pytest.importorskip("matplotlib")
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.colors import to_rgba
     from matplotlib.figure import Figure
 
     from ruledrobot.geometry.box import Box
     from ruledrobot.io.axes3d import draw_box, draw_mesh, lambert
-
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
 
     fig = Figure()
     FigureCanvasAgg(fig)

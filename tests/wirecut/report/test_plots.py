@@ -10,19 +10,18 @@ import pytest
 
 pytest.importorskip("matplotlib")
 
-from matplotlib.backends.backend_agg import FigureCanvasAgg  # noqa: E402
-from mpl_toolkits.mplot3d.art3d import Line3DCollection, Poly3DCollection  # noqa: E402
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.colors import to_rgb
+from mpl_toolkits.mplot3d.art3d import Line3DCollection, Poly3DCollection
 
-from ruledrobot.wirecut.job.demo import DEMO_JOB  # noqa: E402
-from ruledrobot.wirecut.job.load import load_job  # noqa: E402
-from ruledrobot.wirecut.plan import make_plan  # noqa: E402
-from ruledrobot.wirecut.report.files import surface_mesh  # noqa: E402
-from ruledrobot.wirecut.report.part_mesh import part_mesh  # noqa: E402
-from matplotlib.colors import to_rgb  # noqa: E402
-
-from ruledrobot.io.axes3d import coarse_mesh  # noqa: E402
-from ruledrobot.wirecut.report.plot3d import PART_COLOUR, PHASE_WORDS, WIRES_PER_PASS  # noqa: E402
-from ruledrobot.wirecut.report.plots import TIME_PANELS, plan_figure, plot_plan  # noqa: E402
+from ruledrobot.io.axes3d import coarse_mesh
+from ruledrobot.wirecut.job.demo import DEMO_JOB
+from ruledrobot.wirecut.job.load import load_job
+from ruledrobot.wirecut.plan import make_plan
+from ruledrobot.wirecut.report.files import surface_mesh
+from ruledrobot.wirecut.report.part_mesh import part_mesh
+from ruledrobot.wirecut.report.plot3d import PART_COLOUR, PHASE_WORDS, WIRES_PER_PASS
+from ruledrobot.wirecut.report.plots import TIME_PANELS, plan_figure, plot_plan
 
 #: the demo's saddle keeping the block below it: a part to draw
 KEPT = DEMO_JOB.replace("kerf = 0.0008", "kerf = 0.0008\nkeep = [0.5, 0.0, 0.2]")
