@@ -13,7 +13,7 @@ import numpy as np
 
 from ...geometry import se3
 from ...geometry.lines import Lines
-from ...geometry.mesh import box_clipped_mesh
+from ...geometry.mesh import Mesh, box_clipped_mesh
 from ...io.atomic import atomic_write_bytes, atomic_write_json
 from ...io.lines import save_lines
 from ...io.mesh import write_stl
@@ -26,7 +26,7 @@ from ..verify import Verification
 from .part_mesh import RESOLUTION, part_mesh, signed_volume
 from .plots import plot_plan
 
-__all__ = ["write_plan"]
+__all__ = ["surface_mesh", "write_plan"]
 
 #: grid step of the part drawn in the video [m] (a lighter mesh than part.stl)
 VIDEO_RESOLUTION = 0.005
@@ -57,12 +57,10 @@ def _with_edge_rulings(frames: np.ndarray, stock) -> np.ndarray:
     return allf[np.argsort(key, kind="stable")]
 
 
-def _surfaces(folder: Path, plan: Plan) -> dict[str, Path]:
-    """``refined.json`` (the wire's rulings and frames of every pass, one after the
-    other) and ``surface.stl`` (the target surfaces inside the stock)."""
-    files: dict[str, Path] = {}
-    F = np.concatenate([cp.frames for cp in plan.passes])
-    files["refined"] = save_lines(folder / "refined.json", _lines_of(F), frames=F)
+def surface_mesh(plan: Plan) -> Mesh | None:
+    """The target surfaces of every pass inside the stock as one mesh [m, base frame]
+    (``surface.stl``, drawn in ``plots.png`` when no cut names its kept side); None when
+    no pass crosses the block."""
     verts, faces, n = [], [], 0
     job = plan.job
     for cp in plan.passes:
@@ -73,9 +71,17 @@ def _surfaces(folder: Path, plan: Plan) -> dict[str, Path]:
             verts.append(mesh.vertices)
             faces.append(mesh.faces + n)
             n += len(mesh.vertices)
-    if verts:
-        files["surface"] = write_stl(folder / "surface.stl", np.concatenate(verts),
-                                     np.concatenate(faces))  # fmt: skip
+    return Mesh(np.concatenate(verts), np.concatenate(faces)) if verts else None
+
+
+def _surfaces(folder: Path, plan: Plan, surface: Mesh | None) -> dict[str, Path]:
+    """``refined.json`` (the wire's rulings and frames of every pass, one after the
+    other) and ``surface.stl`` (``surface``: the target surfaces inside the stock)."""
+    files: dict[str, Path] = {}
+    F = np.concatenate([cp.frames for cp in plan.passes])
+    files["refined"] = save_lines(folder / "refined.json", _lines_of(F), frames=F)
+    if surface is not None:
+        files["surface"] = write_stl(folder / "surface.stl", surface.vertices, surface.faces)
     return files
 
 
@@ -96,7 +102,8 @@ def write_plan(
         if ok:
             files["trajectory"] = write_trajectory(folder / "trajectory.csv", plan.trajectory)
             files["trajectory_meta"] = folder / "trajectory.json"
-        files.update(_surfaces(folder, plan))
+        surface = surface_mesh(plan)
+        files.update(_surfaces(folder, plan, surface))
         part = part_mesh(plan.job, plan.passes)
         if part is not None:
             files["part"] = write_stl(folder / "part.stl", part.vertices, part.faces,
@@ -108,7 +115,7 @@ def write_plan(
                 "triangles": len(part.faces), "grid_step_m": RESOLUTION,
                 "cuts_without_keep": [c.name for c in plan.job.cuts if c.keep is None],
             }  # fmt: skip
-        files["plots"] = plot_plan(folder / "plots.png", plan, part)
+        files["plots"] = plot_plan(folder / "plots.png", plan, part, surface)
         if ver is not None:
             sim = ver.playback.write(folder / "simulation", trajectory=ok)
             files.update({f"simulation_{k}": v for k, v in sim.items()})
