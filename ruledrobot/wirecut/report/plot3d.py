@@ -29,7 +29,7 @@ from ...geometry.ranges import runs_of
 from ...io.axes3d import cube_axes, draw_box, draw_mesh
 from ...robot.motion.trajectory import HEATED_PHASES
 from ...robot.tool import BowTool
-from ...robot.wire.in_stock import wire_ends
+from ...robot.wire.in_stock import flange_wire_ends
 from ..plan import Plan
 
 __all__ = ["PART_COLOUR", "PHASE_COLOURS", "PHASE_WORDS", "SURFACE_COLOUR", "phase_runs",
@@ -80,7 +80,7 @@ def _wire_at(plan: Plan, idx: np.ndarray) -> np.ndarray:
     """The wire's ends (K, 2, 3) [m] at motion samples ``idx`` (K,)."""
     bow = plan.bow if plan.bow is not None else BowTool.of(plan.job.tool)
     flange = plan.model.fk(plan.motion.timed.q[idx])
-    return wire_ends(flange @ bow.wire_frame(), bow.wire_length)
+    return flange_wire_ends(flange, bow)
 
 
 def _clipped(ends: np.ndarray, box: Box) -> np.ndarray:
@@ -99,7 +99,7 @@ def _wires(ax: Any, plan: Plan, runs: list[tuple[str, int, int]]) -> None:
     from mpl_toolkits.mplot3d.art3d import Line3DCollection
 
     stock = plan.job.stock
-    reach = Box(stock.centre, stock.size + 2.0 * WIRE_REACH, stock.rotation)
+    reach = stock.grown(WIRE_REACH)
     picks: dict[str, list[np.ndarray]] = {}
     for phase, a, b in runs:
         n = WIRES_PER_PASS.get(phase, 0)
