@@ -13,8 +13,11 @@ __all__ = ["json_object", "read_user_bytes", "read_user_text", "user_text"]
 def read_user_bytes(
     path: str | os.PathLike[str], kind: str = "file", error: type[ValueError] = ValueError
 ) -> tuple[Path, bytes]:
-    """``(path, bytes)`` of a file; ``error`` (a ValueError) naming the file when it is
-    missing (``"no such <kind>"``) or unreadable."""
+    """The path and the bytes of a user's file.
+
+    ``error`` (a ValueError) names the file when it is missing (``"no such <kind>"``) or
+    unreadable.
+    """
     p = Path(path)
     try:
         return p, p.read_bytes()
@@ -25,8 +28,11 @@ def read_user_bytes(
 
 
 def user_text(path: Path, data: bytes, error: type[ValueError] = ValueError) -> str:
-    """The utf-8 text of the file ``path``'s bytes ``data``, with universal newlines (as
-    ``Path.read_text`` reads it); ``error`` naming the file when it is not utf-8."""
+    """The utf-8 text of a file's bytes, with universal newlines.
+
+    ``data`` are the bytes of the file ``path``, decoded as ``Path.read_text`` reads it;
+    ``error`` names the file when they are not utf-8.
+    """
     try:
         text = data.decode("utf-8")
     except UnicodeDecodeError as exc:
@@ -37,8 +43,11 @@ def user_text(path: Path, data: bytes, error: type[ValueError] = ValueError) -> 
 def read_user_text(
     path: str | os.PathLike[str], kind: str = "file", error: type[ValueError] = ValueError
 ) -> tuple[Path, str]:
-    """``(path, text)`` of a utf-8 file; ``error`` (a ValueError) naming the file when it is
-    missing (``"no such <kind>"``) or unreadable."""
+    """The path and the text of a user's utf-8 file.
+
+    ``error`` (a ValueError) names the file when it is missing (``"no such <kind>"``) or
+    unreadable.
+    """
     p, data = read_user_bytes(path, kind, error)
     return p, user_text(p, data, error)
 

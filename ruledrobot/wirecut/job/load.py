@@ -215,9 +215,12 @@ def _cuts(doc: dict, where: str, base_dir: Path | None) -> tuple[CutSpec, ...]:
 
 
 def parse_job(doc: dict, where: str = "job", base_dir: Path | None = None) -> Job:
-    """Validate a job given as a TOML-like dict (see the module doc) and read every file it
-    names (relative paths from ``base_dir``) into the job: the cut stage gets data, not
-    paths, and a bad file is refused here, naming ``where``, the table and the field."""
+    """Validate a job given as a TOML-like dict and read every file it names.
+
+    The fields are the module doc's; relative paths are taken from ``base_dir``.  Every
+    file's data goes into the job (the cut stage gets data, not paths), and a bad file is
+    refused here, naming ``where``, the table and the field, then the file and its line.
+    """
     known = {"surface", "stock", "robot", "tool", "cut", "material"}
     extra = sorted(set(doc) - known)
     if extra:
@@ -294,11 +297,13 @@ def file_fields(doc: dict) -> list[tuple[tuple[str | int, ...], str]]:
 
 
 def load_job(path: str | os.PathLike[str]) -> Job:
-    """Read and validate a TOML job file and every file it names, once (the surfaces'
-    rulings, the robot's calibration: :func:`parse_job`); ValueError names the job file,
-    the table and the field, then the named file and its line.  The job carries the file's
-    bytes (``Job.source_bytes``) and the data of every file it names: planning it opens no
-    file."""
+    """Read and validate a TOML job file and every file it names, once.
+
+    The surfaces' rulings and the robot's calibration are read by :func:`parse_job`;
+    ValueError names the job file, the table and the field, then the named file and its
+    line.  The job carries the file's bytes (``Job.source_bytes``) and the data of every
+    file it names: planning it opens no file.
+    """
     p, data = read_user_bytes(path, "job file")
     doc = job_document(user_text(p, data), str(p))
     job = parse_job(doc, str(p), base_dir=p.parent)

@@ -68,9 +68,11 @@ class SurfaceSpec:
                              "which read every file it names")  # fmt: skip
 
     def document(self):
-        """The input rulings in the robot base frame and whether they close
-        (:class:`~ruledrobot.io.lines.LinesDocument`); reads no file (the rulings were
-        read when the job was loaded)."""
+        """The input rulings in the robot base frame and whether they close.
+
+        A :class:`~ruledrobot.io.lines.LinesDocument`; no file is read (the rulings were
+        read when the job was loaded).
+        """
         from ...io.lines import LinesDocument
 
         if self.read_lines is not None:
@@ -82,8 +84,10 @@ class SurfaceSpec:
         return LinesDocument(lines.transform(self.pose), closed)
 
     def sample(self) -> tuple[Lines, bool]:
-        """The built-in surface's ``rulings`` sampled over ``u`` in its own frame, and
-        whether they close (a periodic surface over its whole period)."""
+        """The built-in surface's rulings in its own frame, and whether they close.
+
+        ``rulings`` of them over ``u``; closed: a periodic surface over its whole period.
+        """
         from ...geometry.surfaces import sample_surface
 
         if self.builtin is None:
