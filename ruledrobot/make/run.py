@@ -82,8 +82,7 @@ def _plan_setup(setup: Setup, folder: Path, final: Path, steps: StepCounter) -> 
     say = steps.start(f"plan setup {setup.number}")
     try:
         job = load_job(setup.job)
-        job = dataclasses.replace(job, source=final / "job.toml",
-                                  source_bytes=setup.job.read_bytes())  # fmt: skip
+        job = dataclasses.replace(job, source=final / "job.toml")  # its bytes as loaded
         res = plan(job, folder, progress=say)
     except ValueError as exc:  # the planner refused carve's job: the setup cannot be made
         steps.done("refused")

@@ -22,6 +22,7 @@ import numpy as np
 
 from ..geometry import se3
 from ..io.atomic import atomic_write_text
+from ..io.text import user_text
 from ..wirecut.job.spec import Job
 
 if sys.version_info >= (3, 11):
@@ -180,7 +181,9 @@ def write_job_file(
     src = Path(job.source)
     path = Path(path)
     final = Path(check_as) if check_as is not None else path
-    text = src.read_text(encoding="utf-8")
+    # the bytes the job was loaded from (the job file is not read again), else the file
+    text = (user_text(src, job.source_bytes) if job.source_bytes is not None
+            else src.read_text(encoding="utf-8"))  # fmt: skip
     head = "".join(f"# {line}\n" for line in note.splitlines()) if note else ""
     try:
         out = head + _rebase_paths(_edit(text, job, keep_cuts), src, final)

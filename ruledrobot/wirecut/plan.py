@@ -13,7 +13,6 @@ import hashlib
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import numpy as np
 
@@ -99,11 +98,9 @@ class Plan:
 
 
 def job_source_bytes(job: Job) -> bytes | None:
-    """The job file's bytes: the job's own copy, else the file read (None: a job built in
-    memory)."""
-    if job.source is None:
-        return None
-    return job.source_bytes if job.source_bytes is not None else Path(job.source).read_bytes()
+    """The job file's bytes as loaded (:func:`~.job.load.load_job` read them; None: a job
+    built in memory, or without its bytes): the job file is not read again."""
+    return None if job.source is None else job.source_bytes
 
 
 def job_reference(job: Job | Plan) -> dict[str, str] | None:
@@ -255,8 +252,9 @@ def make_plan(
     """Plan every cut of ``job`` (no files, no simulation): see the module doc.
     ``search``: the options of every pass's wire-pose search (default: the planner's).
 
-    Each thing once: the job file is read (and hashed) once, the bow and the clearance
-    cell are built once, each cut's input rulings are read once; all are handed down."""
+    Each thing once: the job file's bytes are hashed once, the bow and the clearance cell
+    are built once, each cut's input rulings (read when the job was loaded) are placed
+    once; all are handed down.  No file is opened here."""
     say = progress or (lambda msg: None)
     t0 = time.perf_counter()
     timings: dict[str, float] = {}

@@ -87,7 +87,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ...io.text import read_user_text
+from ...io.text import read_user_bytes, user_text
 from .sections import (
     FOREIGN_KINDS,
     Section,
@@ -153,14 +153,10 @@ def _keep(c: Section, closed: bool | None) -> str | np.ndarray | None:
     return c.vector("keep", 3)
 
 
-def _cut(c: Section, name: str, surface: SurfaceSpec, surface_title: str = "surface") -> CutSpec:
-    closed = surface.closed
-    if closed is None:  # the rulings decide: a closed file, a periodic built-in surface
-        try:
-            closed = bool(surface.document().closed)
-        except (OSError, ValueError) as exc:  # the surface's table and field, then the file's
-            field_ = "file" if surface.kind in (None, "lines") and surface.file else "builtin"
-            raise ValueError(f"{c.where}: [{surface_title}] {field_}: {exc}") from None
+def _cut(c: Section, name: str, surface: SurfaceSpec) -> CutSpec:
+    # the rulings (read or sampled when the surface was parsed) decide when the table
+    # does not: a closed file, a periodic built-in surface
+    closed = surface.closed if surface.closed is not None else surface.read_closed
     cut = CutSpec(
         name=name,
         surface=surface,
@@ -211,7 +207,7 @@ def _cuts(doc: dict, where: str, base_dir: Path | None) -> tuple[CutSpec, ...]:
             surface = parse_surface(Section(entry, "surface", where, title=f"{title}.surface"),
                                     base_dir)  # fmt: skip
             c.get("surface")
-            cuts.append(_cut(c, name, surface, f"{title}.surface"))
+            cuts.append(_cut(c, name, surface))
         return tuple(cuts)
     surface = parse_surface(Section(doc, "surface", where), base_dir)
     c = Section(doc, "cut", where, required=False)
@@ -219,7 +215,12 @@ def _cuts(doc: dict, where: str, base_dir: Path | None) -> tuple[CutSpec, ...]:
 
 
 def parse_job(doc: dict, where: str = "job", base_dir: Path | None = None) -> Job:
-    """Validate a job given as a TOML-like dict (see the module doc)."""
+    """Validate a job given as a TOML-like dict and read every file it names.
+
+    The fields are the module doc's; relative paths are taken from ``base_dir``.  Every
+    file's data goes into the job (the cut stage gets data, not paths), and a bad file is
+    refused here, naming ``where``, the table and the field, then the file and its line.
+    """
     known = {"surface", "stock", "robot", "tool", "cut", "material"}
     extra = sorted(set(doc) - known)
     if extra:
@@ -296,8 +297,14 @@ def file_fields(doc: dict) -> list[tuple[tuple[str | int, ...], str]]:
 
 
 def load_job(path: str | os.PathLike[str]) -> Job:
-    """Read and validate a TOML job file; ValueError names the file, section and field."""
-    p, text = read_user_text(path, "job file")
-    doc = job_document(text, str(p))
+    """Read and validate a TOML job file and every file it names, once.
+
+    The surfaces' rulings and the robot's calibration are read by :func:`parse_job`;
+    ValueError names the job file, the table and the field, then the named file and its
+    line.  The job carries the file's bytes (``Job.source_bytes``) and the data of every
+    file it names: planning it opens no file.
+    """
+    p, data = read_user_bytes(path, "job file")
+    doc = job_document(user_text(p, data), str(p))
     job = parse_job(doc, str(p), base_dir=p.parent)
-    return dataclasses.replace(job, source=p)
+    return dataclasses.replace(job, source=p, source_bytes=data)

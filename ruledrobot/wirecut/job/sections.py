@@ -8,8 +8,9 @@ and the section, then the field and what was expected, e.g.
 
 from __future__ import annotations
 
+import dataclasses
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -21,6 +22,9 @@ from ...robot.arm.calibration import Calibration
 from ...robot.wire.kerf import Material
 from ...subdivision.schemes import SCHEME_NAMES
 from .spec import HEAT_MODES, HeatSpec, RobotSpec, SurfaceSpec
+
+if TYPE_CHECKING:  # the readers of the field's files are imported when a job names one
+    from ...io.formats import ReadSpec, Rulings
 
 __all__ = ["Section", "parse_heat", "parse_material", "parse_robot", "parse_stock",
            "parse_surface"]
@@ -171,14 +175,11 @@ def parse_surface(s: Section, base_dir: Path | None) -> SurfaceSpec:
                      "docs/formats.md)")  # fmt: skip
     read = None
     if foreign:
-        from ...io.formats import parse_read_spec, read_rulings
+        from ...io.formats import parse_read_spec
 
         kind = foreign[0]
         spec = parse_read_spec(kind, s.get(kind), f"{s.where}: [{s.title}.{kind}]", base_dir)
-        try:
-            read = read_rulings(spec)
-        except ValueError as exc:
-            raise s.fail(kind, str(exc)) from None
+        read = _read_file(s, kind, spec)
         file = str(spec.path)
     params = s.get("params", {})
     if not isinstance(params, dict):
@@ -234,6 +235,10 @@ def parse_surface(s: Section, base_dir: Path | None) -> SurfaceSpec:
     closed = s.get("closed")
     if closed is not None and not isinstance(closed, bool):
         raise s.fail("closed", f"expected true or false, got {closed!r}")
+    if path is not None and read is None:  # a lines file: read now, as the field's files
+        from ...io.formats import ReadSpec
+
+        read = _read_file(s, "file", ReadSpec("lines", path))
     # a foam cutter's moves: the projection algorithm by default, whose geodesic
     # midpoints keep the towers' straight moves (the dh frames swing round a corner
     # of parallel rulings); refined between its corners (docs/formats.md)
@@ -256,7 +261,25 @@ def parse_surface(s: Section, base_dir: Path | None) -> SurfaceSpec:
         kind=foreign[0] if foreign else ("lines" if file is not None else None),
     )
     s.done()
+    if read is None:  # a built-in surface: sampled once, here, as a file is read
+        try:
+            sampled, ends_meet = surface.sample()
+        except ValueError as exc:
+            raise s.fail("builtin", str(exc)) from None
+        surface = dataclasses.replace(surface, read_lines=sampled, read_closed=ends_meet)
     return surface
+
+
+def _read_file(s: Section, key: str, spec: ReadSpec) -> Rulings:
+    """The rulings of the file ``spec`` names, read once when the job is loaded; a missing,
+    unreadable or malformed file is a ValueError naming the job file, the table, the field
+    ``key``, then the file and its line (:func:`~ruledrobot.io.formats.read_rulings`)."""
+    from ...io.formats import read_rulings
+
+    try:
+        return read_rulings(spec)
+    except (OSError, ValueError) as exc:
+        raise s.fail(key, str(exc)) from None
 
 
 def parse_stock(st: Section) -> Box:

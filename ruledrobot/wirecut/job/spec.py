@@ -27,7 +27,13 @@ FACE_TOLERANCE = 1e-4
 
 @dataclass(frozen=True)
 class SurfaceSpec:
-    """Where the rulings come from and how they are refined.
+    """Where the rulings come from, the rulings themselves, and how they are refined.
+
+    The job's loader (:func:`~.sections.parse_surface`) reads the file a surface names
+    -- a lines file or a file of the field -- and samples a built-in surface, once, when
+    the job is loaded: the surface carries its rulings (``read_lines``), and no later
+    stage opens a file (docs/architecture.md, "The job is read whole, once").  ``file``
+    and ``kind`` then only name where they came from, for messages and reports.
 
     ``closed``: None takes the lines file's own flag; a built-in surface is closed when
     it is periodic (hyperboloid, Möbius band) and no ``u`` range is given.
@@ -44,8 +50,10 @@ class SurfaceSpec:
     steps: int | None = 4
     spacing: float | None = None
     closed: bool | None = None
-    #: rulings read from a file of the field (gcode, airfoil, dxf, rhino) when the job
-    #: names one (``file`` is then that file), in the file's frame, and whether they close
+    #: the input rulings as loaded, in the surface's own frame (``pose`` not applied):
+    #: read from ``file`` (a lines file, or a file of the field: gcode, airfoil, dxf,
+    #: rhino) or the built-in surface sampled (:meth:`sample`); and whether they close.
+    #: None only for a built-in surface made in memory (sampled when asked for)
     read_lines: Lines | None = field(default=None, repr=False)
     read_closed: bool = False
     #: the file's two planes its rulings end on (towers, a panel's faces, the profiles'
@@ -53,30 +61,46 @@ class SurfaceSpec:
     read_planes: Any = None
     kind: str | None = None
 
+    def __post_init__(self) -> None:
+        if self.file is not None and self.read_lines is None:
+            raise ValueError(f"{self.file}: a surface named by a file carries the rulings read "
+                             "from it (read_lines); load the job with load_job or parse_job, "
+                             "which read every file it names")  # fmt: skip
+
     def document(self):
-        """The input rulings in the robot base frame and whether they close
-        (:class:`~ruledrobot.io.lines.LinesDocument`)."""
-        from ...io.lines import LinesDocument, read_lines_document
+        """The input rulings in the robot base frame and whether they close.
+
+        A :class:`~ruledrobot.io.lines.LinesDocument`; no file is read (the rulings were
+        read when the job was loaded).
+        """
+        from ...io.lines import LinesDocument
 
         if self.read_lines is not None:
             lines, closed = self.read_lines, self.read_closed
-        elif self.file is not None:
-            doc = read_lines_document(self.file)
-            lines, closed = doc.lines, doc.closed
         else:
-            from ...geometry.surfaces import sample_surface
-
-            lo, hi = self.u if self.u is not None else (None, None)
-            if self.whole_period:  # sampled without its repeated end (u + period is u)
-                sample = sample_surface(self.builtin, n=self.rulings, start=lo, closed=True,
-                                        **self.params)  # fmt: skip
-            else:
-                sample = sample_surface(self.builtin, n=self.rulings, start=lo, stop=hi,
-                                        **self.params)  # fmt: skip
-            lines, closed = sample.lines, sample.closed
+            lines, closed = self.sample()
         if self.closed is not None:
             closed = self.closed
         return LinesDocument(lines.transform(self.pose), closed)
+
+    def sample(self) -> tuple[Lines, bool]:
+        """The built-in surface's rulings in its own frame, and whether they close.
+
+        ``rulings`` of them over ``u``; closed: a periodic surface over its whole period.
+        """
+        from ...geometry.surfaces import sample_surface
+
+        if self.builtin is None:
+            raise ValueError(f"{self.label}: not a built-in surface; its rulings are read "
+                             "from its file when the job is loaded")  # fmt: skip
+        lo, hi = self.u if self.u is not None else (None, None)
+        if self.whole_period:  # sampled without its repeated end (u + period is u)
+            sample = sample_surface(self.builtin, n=self.rulings, start=lo, closed=True,
+                                    **self.params)  # fmt: skip
+        else:
+            sample = sample_surface(self.builtin, n=self.rulings, start=lo, stop=hi,
+                                    **self.params)  # fmt: skip
+        return sample.lines, bool(sample.closed)
 
     @property
     def whole_period(self) -> bool:
@@ -220,9 +244,9 @@ class Job:
     tool, and the cuts in the order they are made.
 
     ``source``: the job file, as the reports name it; ``source_bytes``: its bytes as
-    planned, when the job was read from a copy (a batch worker on another machine):
-    the reports hash them and ``job.toml`` is written from them instead of reading
-    ``source`` again (None: read ``source``)."""
+    loaded (:func:`~.load.load_job` reads them once; a batch worker, a copy's): the
+    reports hash them and ``job.toml`` is written from them, the job file is never read
+    again (None: a job made in memory, without a file)."""
 
     cuts: tuple[CutSpec, ...]
     stock: Box

@@ -10,6 +10,8 @@ from hypothesis import given
 from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
+from ruledrobot.geometry.lines import Lines
+from ruledrobot.io.lines import save_lines
 from ruledrobot.wirecut.job.sections import (
     HEAT_OUTPUTS,
     Section,
@@ -192,9 +194,12 @@ def test_bad_surfaces_name_the_field(table, message):
 
 
 def test_a_lines_file_is_found_next_to_the_job_and_takes_no_builtin_fields(tmp_path):
-    (tmp_path / "r.json").write_text("{}")
+    rulings = Lines.from_point_direction(np.c_[np.linspace(0, 0.1, 5), np.zeros((5, 2))],
+                                         np.tile([0.0, 0.0, 1.0], (5, 1)))  # fmt: skip
+    save_lines(tmp_path / "r.json", rulings)
     s = parse_surface(_sec({"file": "r.json"}, "surface"), tmp_path)
     assert s.file == tmp_path / "r.json" and s.kind == "lines" and s.builtin is None
+    np.testing.assert_allclose(s.read_lines.plucker, rulings.plucker)  # read when parsed
     with pytest.raises(ValueError, match=r"\[surface\] u: only for a builtin surface"):
         parse_surface(_sec({"file": "r.json", "u": [0, 1]}, "surface"), tmp_path)
     with pytest.raises(ValueError, match=r"\[surface\] params: only for a builtin surface"):
