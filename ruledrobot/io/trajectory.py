@@ -138,7 +138,7 @@ def _cut_to_dict(cut: WireCut) -> dict[str, Any]:
                    "tolerance": w.tolerance, "held": [list(r) for r in w.held],
                    "wire_tolerance_m": w.wire_tolerance}
                   for w in cut.feeds],
-        "faces": [{"name": f.name, "points_m": f.points.tolist(), "normals": f.normals.tolist(),
+        "faces": [{"name": f.name, **{k: getattr(f, k).tolist() for k in _FACE_ARRAYS},
                    "ranges": [list(r) for r in f.ranges], "kerf_m": f.kerf,
                    "tolerance_m": f.tolerance} for f in cut.faces],
         "material": None if cut.material is None else {
@@ -148,18 +148,23 @@ def _cut_to_dict(cut: WireCut) -> dict[str, Any]:
     }  # fmt: skip
 
 
+#: a face target's arrays in the sidecar (:class:`FaceTarget`'s fields; m)
+_FACE_ARRAYS = ("origins", "directions", "normal_a", "normal_b", "chord")
+
+
 def _faces(d: _Doc, c: dict) -> tuple[FaceTarget, ...]:
     """The sidecar's ``cut.faces`` (absent in older files: none)."""
     faces = []
     for i, f in enumerate(c.get("faces") or []):
         try:
-            faces.append(FaceTarget(str(f["name"]), np.asarray(f["points_m"], dtype=np.float64),
-                                    np.asarray(f["normals"], dtype=np.float64),
-                                    tuple(tuple(r) for r in f.get("ranges", [])),
-                                    float(f["kerf_m"]), float(f["tolerance_m"])))  # fmt: skip
+            arrays = {k: np.asarray(f[k], dtype=np.float64) for k in _FACE_ARRAYS}
+            faces.append(FaceTarget(str(f["name"]), **arrays,
+                                    ranges=tuple(tuple(r) for r in f.get("ranges", [])),
+                                    kerf=float(f["kerf_m"]),
+                                    tolerance=float(f["tolerance_m"])))  # fmt: skip
         except (KeyError, TypeError, ValueError, AttributeError) as exc:
-            raise d.fail(f"cut.faces[{i}]", "expected {name, points_m, normals, ranges, kerf_m, "
-                         f"tolerance_m}}: {exc}") from None  # fmt: skip
+            raise d.fail(f"cut.faces[{i}]", "expected {name, " + ", ".join(_FACE_ARRAYS)
+                         + f", ranges, kerf_m, tolerance_m}}: {exc}") from None  # fmt: skip
     return tuple(faces)
 
 

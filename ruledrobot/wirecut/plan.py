@@ -26,7 +26,7 @@ from ..robot.tool import BowTool
 from ..robot.wire.cut import FeedWindow, WireCut
 from ..robot.wire.face import FaceTarget
 from .cut.clearance import SINGULAR_MIN
-from .cut.kerf import face_points
+from .cut.kerf import face_rulings
 from .cut.order import check_cut_order
 from .cut.passes import CutPath, cut_paths, job_search
 from .cut.wire_geometry import distance_from_rulings
@@ -144,7 +144,7 @@ def wire_cut(job: Job, motion: Motion, bow: BowTool | None = None) -> WireCut:
     per pass the feed window — the pass's samples, the cut's feed and tolerance, and
     where the feed is held (its cut phase less the corner stops and slits) — and, for a
     cut that names the part's side (``keep``), the face it must leave (``face_error``'s
-    target: the target rulings' chord ends and normals, the samples on the face), and the
+    target: the target rulings' lines and normals, the samples on the face), and the
     job's material.  ``bow``: the job's, when the caller built it."""
     held_all = motion.surface & ~(False if motion.corner_stop is None else motion.corner_stop)
     feeds, faces = [], []
@@ -160,9 +160,9 @@ def wire_cut(job: Job, motion: Motion, bow: BowTool | None = None) -> WireCut:
                                 cut.wire_tolerance))  # fmt: skip
         on_face = runs_of(motion.surface & mask)
         if cut.keep is not None and on_face:  # the part's side is known: its face is judged
-            points, normals = face_points(cp.target_frames, cp.frames, job.stock, cut.keep)
-            faces.append(FaceTarget(cut.name, points, normals, on_face, cut.kerf,
-                                    cut.tolerance))  # fmt: skip
+            lines = face_rulings(cp.target_frames, cp.frames, job.stock, cut.keep, cp.closed)
+            faces.append(FaceTarget(cut.name, **lines, ranges=on_face, kerf=cut.kerf,
+                                    tolerance=cut.tolerance))  # fmt: skip
     bow = BowTool.of(job.tool if bow is None else bow)
     return WireCut(job.stock, bow.wire_length, tuple(feeds), tuple(faces), job.material)
 

@@ -9,10 +9,15 @@ distance from the surface is::
     e = |(x - s) . n - w / 2|
 
 at both chord ends of every sample where the wire is on the face (the cut phase, its
-corner stops included; not the lead-in/out, not a closed cut's slits).  ``s`` and ``n``
-are those of the nearest chord ends of the target rulings (a k-d tree; their tangent
-planes stand for the surface within a ruling interval; the plane nearest the face decides,
-:data:`NEAREST`).  The kerf ``w`` at each
+corner stops included; not the lead-in/out, not a closed cut's slits).  The target is
+the cut's rulings as lines (origin ``o``, unit direction ``z``) with the surface's
+normal field along each, which is exact on a ruled surface: the unnormalised normal
+``z x (o' + t z')`` is affine in the ruling parameter ``t`` (``a + t b``), and the
+ruling lies in every tangent plane along it, so ``s`` is the chord end's foot on the
+ruling and ``(x - s) . n = (x - o) . n``.  The candidate rulings of a chord end are those
+of the nearest sampled points of the target (a k-d tree over :data:`SAMPLES` points per
+chord); the plane nearest the face decides (at a corner of the path the corner ruling's
+normal bisects the faces; a neighbour's plane is the face).  The kerf ``w`` at each
 end: the cut's constant ``kerf`` without a material; with one, ``material.kerf(v, p)``
 with ``v`` the end's speed across the wire (:func:`.in_stock.across_speeds` in time)
 and ``p`` the wire's power (:func:`.kerf.wire_power` of the set-points).  A wire that
@@ -40,10 +45,11 @@ from .kerf import Material
 
 __all__ = ["FaceError", "FaceTarget", "face_error", "face_errors"]
 
-#: the target chord ends whose tangent planes stand for the surface near a chord end: the
-#: nearest of them decides (at a corner of the path the corner ruling's normal bisects
-#: the faces; a neighbour's plane is the face)
-NEAREST = 3
+#: sampled points per target chord (ends included) that find a chord end's rulings
+SAMPLES = 5
+#: the nearest sampled points whose rulings are a chord end's candidates: the plane
+#: nearest the face decides (module doc)
+NEAREST = 12
 #: m/s: a hot wire slower than this stands still and burns: the melt then grows with the
 #: time it stays, which the energy balance does not describe (a sampled stop never reaches
 #: exactly 0)
@@ -57,30 +63,39 @@ MELT_SLACK = 1e-9
 class FaceTarget:
     """The part's surface one cut's pass must leave (module doc).
 
-    ``name``: the cut; ``points`` (K, 2, 3) m: the chord ends of its target rulings in the
-    block; ``normals`` (K, 2, 3): unit normals of the surface there, into the waste;
-    ``ranges``: the half-open sample ranges with the wire on the face; ``kerf`` m: the
-    cut's constant kerf (used without a material); ``tolerance`` m: how far the face may
-    lie from the surface."""
+    ``name``: the cut; per target ruling that crosses the block (K of them): ``origins``
+    (K, 3) m and unit ``directions`` (K, 3), the ruling's line; ``normal_a``, ``normal_b``
+    (K, 3): the surface's normal into the waste along it, ``a + t b`` unnormalised at ``t``
+    m along the direction from the origin; ``chord`` (K, 2) m: the chord's ends in the block
+    as such ``t``; ``ranges``: the half-open sample ranges with the wire on the face;
+    ``kerf`` m: the cut's constant kerf (used without a material); ``tolerance`` m: how far
+    the face may lie from the surface."""
 
     name: str
-    points: FloatArray = field(repr=False)
-    normals: FloatArray = field(repr=False)
+    origins: FloatArray = field(repr=False)
+    directions: FloatArray = field(repr=False)
+    normal_a: FloatArray = field(repr=False)
+    normal_b: FloatArray = field(repr=False)
+    chord: FloatArray = field(repr=False)
     ranges: tuple[tuple[int, int], ...] = ()
     kerf: float = 0.0
     tolerance: float = 1e-4
 
     def __post_init__(self) -> None:
-        p = np.asarray(self.points, dtype=np.float64).reshape(-1, 2, 3)
-        n = np.asarray(self.normals, dtype=np.float64).reshape(-1, 2, 3)
-        if p.shape != n.shape or not (np.isfinite(p).all() and np.isfinite(n).all()):
-            raise ValueError(f"face {self.name!r}: points {p.shape} and normals {n.shape} must "
-                             "be finite (K, 2, 3) arrays of one shape")  # fmt: skip
-        norm = np.linalg.norm(n, axis=-1, keepdims=True)
+        arrays = {k: np.asarray(getattr(self, k), dtype=np.float64)
+                  for k in ("origins", "directions", "normal_a", "normal_b", "chord")}  # fmt: skip
+        K = len(arrays["origins"])
+        for k, a in arrays.items():
+            shape = (K, 2) if k == "chord" else (K, 3)
+            if a.shape != shape or not np.isfinite(a).all():
+                raise ValueError(f"face {self.name!r}: {k} must be a finite {shape} array, got "
+                                 f"{a.shape}")  # fmt: skip
+        norm = np.linalg.norm(arrays["directions"], axis=1, keepdims=True)
         if np.any(norm <= 0.0):
-            raise ValueError(f"face {self.name!r}: a normal is zero")
-        object.__setattr__(self, "points", p)
-        object.__setattr__(self, "normals", n / norm)
+            raise ValueError(f"face {self.name!r}: a ruling's direction is zero")
+        arrays["directions"] = arrays["directions"] / norm
+        for k, a in arrays.items():
+            object.__setattr__(self, k, a)
         ranges = checked_ranges(self.ranges, f"face {self.name!r} ranges")
         object.__setattr__(self, "ranges", ranges)
         if not (np.isfinite(self.kerf) and self.kerf >= 0.0):
@@ -94,13 +109,27 @@ class FaceTarget:
         """(n,) bool: sample k is on the face."""
         return ranges_mask(self.ranges, n)
 
+    def samples(self) -> FloatArray:
+        """(K, SAMPLES, 3) m: points evenly along each chord, its ends included."""
+        u = np.linspace(0.0, 1.0, SAMPLES)
+        t = self.chord[:, :1] + u * (self.chord[:, 1:] - self.chord[:, :1])
+        return self.origins[:, None, :] + t[..., None] * self.directions[:, None, :]
+
+    def normals(self, k: np.ndarray, t: FloatArray) -> FloatArray:
+        """Unit normals (..., 3) into the waste on rulings ``k`` (...) at ``t`` (...) m."""
+        n = self.normal_a[k] + t[..., None] * self.normal_b[k]
+        norm = np.linalg.norm(n, axis=-1, keepdims=True)
+        return n / np.where(norm > 0.0, norm, 1.0)
+
     def shifted(self, start: int, stop: int) -> FaceTarget | None:
-        """The target on samples ``start:stop`` renumbered from 0 (None when no range is
-        left)."""
+        """The target on samples ``start:stop`` renumbered from 0.
+
+        None when no range is left."""
         ranges = shifted_ranges(self.ranges, start, stop)
         if not ranges:
             return None
-        return FaceTarget(self.name, self.points, self.normals, ranges, self.kerf,
+        return FaceTarget(self.name, self.origins, self.directions, self.normal_a,
+                          self.normal_b, self.chord, ranges, self.kerf,
                           self.tolerance)  # fmt: skip
 
 
@@ -189,13 +218,14 @@ def face_error(
         p = np.asarray(power, dtype=np.float64)[rows]
         v = across_speeds(wis.t, wis.ends, wis.fractions())[rows]  # (R, 2)
         w = _kerf(v, p, material)
-    pts = face.points.reshape(-1, 3)
+    pts = face.samples().reshape(-1, 3)
     near = min(NEAREST, len(pts))
-    _, k = cKDTree(np.array(pts)).query(np.array(x.reshape(-1, 3)), k=near)  # writable
-    k = k.reshape(*x.shape[:2], near)  # (R, 2, near)
-    s, n = pts[k], face.normals.reshape(-1, 3)[k]
+    _, idx = cKDTree(pts).query(np.array(x.reshape(-1, 3)), k=near)  # writable copy
+    k = (np.asarray(idx).reshape(*x.shape[:2], near) // SAMPLES)  # (R, 2, near) rulings
+    rel = x[:, :, None, :] - face.origins[k]
+    t = np.einsum("rjni,rjni->rjn", rel, face.directions[k])
     with np.errstate(invalid="ignore"):
-        d = np.einsum("rkji,rkji->rkj", x[:, :, None, :] - s, n)
+        d = np.einsum("rjni,rjni->rjn", rel, face.normals(k, t))
         e = np.abs(d - 0.5 * w[..., None]).min(axis=2)
     e = np.where(np.isinf(w), np.inf, e)
     error[rows] = e.max(axis=1)

@@ -51,7 +51,7 @@ from ...robot.wire.kerf import Material
 from ..job.spec import CutSpec, HeatSpec
 from .wire_geometry import chords
 
-__all__ = ["KerfOffsets", "cut_offsets", "face_points", "held_kerf", "kept_surface_error",
+__all__ = ["KerfOffsets", "cut_offsets", "face_rulings", "held_kerf", "kept_surface_error",
            "kerf_offsets", "on_power", "point_kerf_offsets", "ruling_normals", "waste_sign"]
 
 #: points per chord at which the normals are sampled
@@ -317,23 +317,29 @@ def cut_offsets(
     return point_kerf_offsets(frames, stock, cut, heat, material, closed)
 
 
-def face_points(
-    target: FloatArray, wire: FloatArray, stock: Box, keep: str | FloatArray
-) -> tuple[FloatArray, FloatArray]:
-    """The part's surface along a pass (``face_error``'s target): the chord ends (K, 2, 3)
-    [m] of the target rulings ``target`` (M, 4, 4) that cross the stock and the unit
-    normals (K, 2, 3) there into the waste.  Each ruling's normals point the way its wire
-    (``wire`` (M, 4, 4), the compensated rulings) is moved off it -- a pass that goes
-    out and back along a loop turns its normals round halfway -- and by ``keep``
-    (:func:`waste_sign`) where the wire is not moved."""
+def face_rulings(
+    target: FloatArray, wire: FloatArray, stock: Box, keep: str | FloatArray, closed: bool = False
+) -> dict[str, FloatArray]:
+    """The part's surface along a pass (``face_error``'s target, :class:`FaceTarget`'s fields).
+
+    Of the target rulings ``target`` (M, 4, 4) that cross the stock (K of them): their
+    lines (``origins``, ``directions`` (K, 3)), the normal field along each into the waste,
+    ``z x (o' + t z') = normal_a + t normal_b`` (:func:`ruling_normals`, unnormalised), and
+    the chord in the block (``chord`` (K, 2) m along ``z``).  Each ruling's normals point
+    the way its wire (``wire`` (M, 4, 4), the compensated rulings) is moved off it at the
+    chord's middle -- a pass that goes out and back along a loop turns its normals round
+    halfway -- and by ``keep`` (:func:`waste_sign`) where the wire is not moved."""
     c0, c1, hit = chords(target, stock)
-    S, W = target[hit], wire[hit]
-    t = np.stack([c0[hit], c1[hit]], axis=1)
-    n = ruling_normals(target, np.stack([np.nan_to_num(c0), np.nan_to_num(c1)], axis=1))[hit]
-    off = np.einsum("ki,kji->kj", W[:, :3, 3] - S[:, :3, 3], n)  # (K, 2)
-    moved = np.abs(off) > 1e-12
-    if not moved.all():
-        fallback = waste_sign(target, stock, keep)
-        off = np.where(moved, off, fallback)
-    points = S[:, None, :3, 3] + t[..., None] * S[:, None, :3, 2]
-    return points, np.sign(off)[..., None] * n
+    o, z = target[:, :3, 3], target[:, :3, 2]
+    a = np.cross(z, _derivative(o, closed))
+    b = np.cross(z, _derivative(z, closed))
+    mid = 0.5 * (np.nan_to_num(c0) + np.nan_to_num(c1))
+    n_mid = a + mid[:, None] * b
+    off = np.einsum("ki,ki->k", wire[:, :3, 3] - o, n_mid)
+    moved = np.abs(off) > 1e-12 * np.maximum(np.linalg.norm(n_mid, axis=1), 1e-300)
+    sign = np.sign(off)
+    if not moved[hit].all():
+        sign = np.where(moved, sign, waste_sign(target, stock, keep, closed))
+    return {"origins": o[hit], "directions": z[hit], "normal_a": (sign[:, None] * a)[hit],
+            "normal_b": (sign[:, None] * b)[hit],
+            "chord": np.stack([c0[hit], c1[hit]], axis=1)}  # fmt: skip
