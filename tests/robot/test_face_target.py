@@ -1,0 +1,68 @@
+"""face_error on a twisted surface where the wire's chord ends lie mid-way along the
+target rulings (the block narrower than the rulings): the wire built from the closed-form
+normal half a kerf off the surface at its ends is judged as the closed form says, at
+chord ends 170 mm from the rulings' ends (a first version looked at those only)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from ruledrobot.geometry.box import Box
+from ruledrobot.robot.wire.face import FaceTarget, face_error
+from ruledrobot.robot.wire.in_stock import wire_in_stock
+
+C, KERF = 0.4, 0.0008  # z = x y / C; the cut's kerf
+
+
+def _point(u, y):
+    u, y = np.broadcast_arrays(u, y)
+    return np.stack([u, y, u * y / C], axis=-1)
+
+
+def _normal(u, y):  # closed form: grad(z - x y / C), the waste above the saddle
+    u, y = np.broadcast_arrays(u, y)
+    n = np.stack([-y / C, -u / C, np.ones_like(y)], axis=-1)
+    return n / np.linalg.norm(n, axis=-1, keepdims=True)
+
+
+def _target(us: np.ndarray, samples: int) -> FaceTarget:
+    d = np.stack([np.zeros_like(us), np.ones_like(us), us / C], axis=1)
+    norm = np.linalg.norm(d, axis=1)
+    # n(t) ∝ (0, -u/C, 1) + y (-1/C, 0, 0), y = t / |d| along the unit direction
+    a = np.stack([np.zeros_like(us), -us / C, np.ones_like(us)], axis=1)
+    b = np.stack([-1.0 / (C * norm), np.zeros_like(us), np.zeros_like(us)], axis=1)
+    chord = np.stack([-0.15 * norm, 0.15 * norm], axis=1)  # the rulings run past the block
+    return FaceTarget("saddle", _point(us, 0 * us), d / norm[:, None], a, b, chord,
+                      ranges=((0, samples),), kerf=KERF)  # fmt: skip
+
+
+@pytest.mark.parametrize("extra", [0.0, 0.0002])
+def test_chord_ends_mid_ruling_are_judged_on_their_ruling(extra):
+    u = np.linspace(-0.05, 0.05, 201)  # the wire sweeps across the rulings
+    y = np.array([-0.2, 0.2])
+    off = 0.5 * KERF + extra
+    ends = _point(u[:, None], y[None, :]) + off * _normal(u[:, None], y[None, :])
+    # a wire through the surface's points half a kerf off at y = -0.2, 0.2 is a line, but
+    # the surface twists: measure where it crosses a block 60 mm deep in y, mid-ruling
+    stock = Box(np.array([0.0, 0.0, 0.0]), np.array([0.2, 0.06, 0.2]))
+    wis = wire_in_stock(np.arange(u.size) * 0.01, ends, stock)
+    target = _target(np.linspace(-0.06, 0.06, 121), u.size)
+    e = face_error(wis, None, None, target)
+    # independent truth at the chord ends: the distance along the closed-form normal of
+    # the surface point below the wire's chord end, less half the kerf
+    x = wis.chord_points()
+    yy = x[..., 1]
+    uu = x[..., 0] + 0 * yy
+    for _ in range(20):  # the foot: the surface point whose normal line passes through x
+        p = _point(uu, yy)
+        n = _normal(uu, yy)
+        d = np.einsum("...i,...i->...", x - p, n)
+        q = x - d[..., None] * n
+        uu, yy = q[..., 0], q[..., 1]
+    truth = np.abs(d - 0.5 * KERF).max(axis=1)
+    ok = ~np.isnan(e.error)
+    assert ok.all()
+    np.testing.assert_allclose(e.error[ok], truth[ok], atol=2e-6)
+    assert e.worst == pytest.approx(truth.max(), abs=2e-6)
+    assert (e.worst > 1e-4) == (extra > 0)  # the wire 0.2 mm further off fails 0.1 mm
