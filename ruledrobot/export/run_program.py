@@ -48,7 +48,7 @@ def run_slice(traj: Trajectory, start: int, speed_scale: float = 1.0) -> Traject
                                  w.held, w.wire_tolerance) for w in cut.feeds)  # fmt: skip
         cut = WireCut(cut.stock, cut.wire_length, feeds)
     t = part.t / float(speed_scale)  # the heat windows: renumbered by Trajectory.sliced
-    return Trajectory(t, part.q, part.tcp, meta.replace(cut=cut))
+    return part.with_samples(t, part.q, part.tcp, meta.replace(cut=cut))
 
 
 def _move_samples(part: Trajectory, ops: tuple[Op, ...]) -> list[int]:

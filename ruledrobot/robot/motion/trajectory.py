@@ -153,8 +153,18 @@ class Phase:
 
 #: heat output kinds and how many outputs of each a UR controller has
 HEAT_OUTPUT_KINDS = {"standard": 8, "configurable": 8, "tool": 2, "analog": 2}
-#: how the wire's heat follows the plan (docs/kerf.md)
+#: how the wire's power is scheduled (docs/kerf.md): switched on and off, held at a power,
+#: or following the speed so that the kerf stays the cut's
 HEAT_MODES = ("on_off", "constant", "constant_kerf")
+
+
+def _seconds_or_watts(name: str, value: object, positive: bool = False) -> float:
+    """``value`` as a finite float ``>= 0`` (``> 0`` when ``positive``), else ValueError."""
+    x = float(value)  # type: ignore[arg-type]
+    if not np.isfinite(x) or x < 0.0 or (positive and x == 0.0):
+        raise ValueError(f"heat.{name}: expected a finite number {'> 0' if positive else '>= 0'}"
+                         f", got {value!r}")  # fmt: skip
+    return x
 
 
 @dataclass(frozen=True)
@@ -166,10 +176,14 @@ class Heat:
     its range; off = 0); ``windows``: half-open sample ranges ``(start, stop)`` with the
     heat on — from the start of a pre-heat dwell to the end of a lead-out; ``preheat``:
     the seconds the wire heats before it moves into the stock (a run resumed inside a
-    window heats that long before it moves).  The heat model (docs/kerf.md): ``mode``
-    ``"on_off"``, ``"constant"`` or ``"constant_kerf"``; ``full_scale`` W/m at an analog
-    output's 1.0 (None: not given); ``lag`` s, the wire's thermal delay the trajectory's
-    ``heat_power`` set-points lead the motion by.
+    window heats that long before it moves).
+
+    The heat model (docs/kerf.md): ``mode`` one of :data:`HEAT_MODES` (``"on_off"`` by
+    default: today's switching); ``full_scale`` the wire power [W/m] at an analog output's
+    1.0 (required for an analog output in the modes ``constant`` and ``constant_kerf``
+    when the trajectory carries ``heat_power``: its set-points are written as
+    ``heat_power / full_scale``); ``lag`` [s] the wire's thermal delay, by which the
+    ``heat_power`` set-points already lead the motion.
     """
 
     kind: str
@@ -206,11 +220,25 @@ class Heat:
         if self.mode not in HEAT_MODES:
             raise ValueError(f"heat.mode: expected one of {', '.join(HEAT_MODES)}, got "
                              f"{self.mode!r}")  # fmt: skip
-        if self.full_scale is not None and not float(self.full_scale) > 0.0:
-            raise ValueError(f"heat.full_scale: expected W/m > 0, got {self.full_scale!r}")
-        if not (np.isfinite(float(self.lag)) and float(self.lag) >= 0.0):
-            raise ValueError(f"heat.lag: expected seconds >= 0, got {self.lag!r}")
-        object.__setattr__(self, "lag", float(self.lag))
+        if self.full_scale is not None:
+            fs = _seconds_or_watts("full_scale", self.full_scale, positive=True)
+            object.__setattr__(self, "full_scale", fs)
+        object.__setattr__(self, "lag", _seconds_or_watts("lag", self.lag))
+
+    def ratio(self, power: ArrayLike) -> FloatArray:
+        """The analog set-point (broadcast shape) in [0, 1] for wire ``power`` [W/m]:
+        ``power / full_scale``, clipped to the output's range."""
+        if self.full_scale is None:
+            raise ValueError(f"heat.full_scale: the {self.output} output has no full scale "
+                             "(W/m at 1.0) to turn a power into a set-point")  # fmt: skip
+        return np.clip(np.asarray(power, dtype=np.float64) / self.full_scale, 0.0, 1.0)
+
+    @property
+    def schedules_power(self) -> bool:
+        """The output follows a trajectory's ``heat_power`` (an analog output in mode
+        ``constant`` or ``constant_kerf``); otherwise it switches on (at ``value``) and
+        off by ``windows``, and a ``heat_power`` column is the power that assumes."""
+        return self.kind == "analog" and self.mode != "on_off"
 
     @property
     def output(self) -> str:
@@ -328,8 +356,9 @@ class Trajectory:
 
     ``t`` (M,) s from the start, strictly increasing; ``q`` (M, 6) rad; ``tcp``
     (M, 6) UR pose vectors of the TCP in the robot base frame; ``meta``;
-    ``heat_power`` (M,) W/m or None: the wire's power set-point per sample when the job
-    has a heat model (docs/kerf.md; led by ``meta.heat.lag``).
+    ``heat_power`` (M,) W/m or None: the wire power set-point per sample (docs/kerf.md),
+    already led by the heat's ``lag``; where the heat schedules it (``Heat.schedules_power``)
+    it needs ``meta.heat.full_scale``.
     """
 
     t: FloatArray
@@ -353,12 +382,6 @@ class Trajectory:
             raise ValueError(f"t[{k}]: times must increase strictly")
         for name, arr in (("t", t), ("q", q), ("tcp", tcp)):
             object.__setattr__(self, name, readonly(arr))
-        if self.heat_power is not None:
-            hp = as_array(self.heat_power, "heat_power")
-            if hp.shape != t.shape or np.any(hp < 0.0):
-                raise ValueError(f"heat_power: expected {t.size} set-points >= 0 W/m, got "
-                                 f"shape {hp.shape}")  # fmt: skip
-            object.__setattr__(self, "heat_power", readonly(hp))
         m = t.size
         for p in self.meta.phases:
             if p.stop > m:
@@ -366,6 +389,36 @@ class Trajectory:
         for a, b in self.meta.in_stock:
             if b > m:
                 raise ValueError(f"in_stock: range [{a}, {b}) beyond the {m} samples")
+        if self.heat_power is not None:
+            object.__setattr__(self, "heat_power", readonly(self._heat_power(m)))
+
+    def _heat_power(self, m: int) -> FloatArray:
+        """The validated ``heat_power`` column (M,): finite (``as_array``), >= 0, one per
+        sample, with a full scale when the heat goes to an analog output."""
+        p = as_array(self.heat_power, "heat_power")
+        if p.shape != (m,):
+            raise ValueError(f"heat_power: expected one set-point per sample ({m},), got "
+                             f"shape {p.shape}")  # fmt: skip
+        bad = np.flatnonzero(p < 0.0)
+        if bad.size:
+            raise ValueError(f"heat_power[{bad[0]}]: expected a finite power >= 0 W/m, got "
+                             f"{p[bad[0]]}")  # fmt: skip
+        heat = self.meta.heat
+        if heat is not None and heat.schedules_power and heat.full_scale is None:
+            raise ValueError(f"heat.full_scale: the heat_power column on {heat.output} "
+                             f"({heat.mode}) needs the output's full scale (W/m at 1.0)")  # fmt: skip
+        return p
+
+    def with_samples(self, t: ArrayLike, q: ArrayLike, tcp: ArrayLike,
+                     meta: TrajectoryMeta | None = None,
+                     rows: ArrayLike | slice | None = None) -> Trajectory:  # fmt: skip
+        """A trajectory of new samples that keeps this one's ``heat_power`` at ``rows``
+        (indices or a slice of this one's samples; default: all) and ``meta`` (default:
+        this one's): what every method that re-cuts or re-times the samples returns."""
+        power = self.heat_power
+        if power is not None and rows is not None:
+            power = power[rows]
+        return Trajectory(t, q, tcp, self.meta if meta is None else meta, power)
 
     @classmethod
     def from_joints(
@@ -475,9 +528,9 @@ class Trajectory:
             windows = tuple(c for a, b in heat.windows if (c := clip(a, b)))
             heat = dataclasses.replace(heat, windows=windows)
         meta = self.meta.replace(phases=phases, in_stock=stock, cut=cut, heat=heat)
-        hp = None if self.heat_power is None else self.heat_power[start:stop]
-        return Trajectory(self.t[start:stop] - self.t[start], self.q[start:stop],
-                          self.tcp[start:stop], meta, hp)  # fmt: skip
+        rows = slice(start, stop)
+        return self.with_samples(self.t[rows] - self.t[start], self.q[rows], self.tcp[rows],
+                                 meta, rows)  # fmt: skip
 
 
 def phases_from_labels(labels: ArrayLike) -> tuple[Phase, ...]:
