@@ -3,7 +3,10 @@
 ``trajectory.csv`` — header ``t,q1,q2,q3,q4,q5,q6,x,y,z,rx,ry,rz`` on the first
 line, then one row per controller period, and nothing else (``csv.reader`` and
 ``pandas.read_csv`` read it as it is).  Time from the start (s), joint positions
-(rad), the TCP pose in the robot base frame as a UR pose vector (m, rad).
+(rad), the TCP pose in the robot base frame as a UR pose vector (m, rad).  A
+trajectory with a heat schedule (docs/kerf.md) has a 14th column ``heat_power``: the
+wire power set-point per sample (W/m, already led by the heat's ``lag``); a file
+without it reads as before.
 
 ``trajectory.json`` — the sidecar, same stem, required by every reader::
 
@@ -18,7 +21,8 @@ line, then one row per controller period, and nothing else (``csv.reader`` and
      "in_stock": [[1200, 9800]],
      "max_acceleration_rad_s2": [2.5, 2.5, 2.5, 2.5, 2.5, 2.5],   # or null: the default
      "heat": {"output": "standard:0", "value": 1.0, "preheat_s": 2.0,
-              "windows": [[1100, 9900]]},                # or null
+              "windows": [[1100, 9900]], "mode": "on_off",
+              "full_scale_w_m": null, "lag_s": 0.0},     # or null
      "cut": {"stock": {"centre": [...], "size": [...], "rotvec": [...]},   # or null
              "wire_length_m": 0.4,
              "feeds": [{"name": "cut", "start": 1858, "stop": 13406, "speed_m_s": 0.01,
@@ -63,6 +67,7 @@ from .text import read_user_text
 
 __all__ = [
     "HEADER",
+    "HEAT_POWER",
     "META_FORMAT",
     "TCP_TOLERANCE",
     "TRAJECTORY_FORMAT",
@@ -76,6 +81,8 @@ __all__ = [
 ]
 
 HEADER = ["t", "q1", "q2", "q3", "q4", "q5", "q6", "x", "y", "z", "rx", "ry", "rz"]
+#: the optional last column: the wire power set-point per sample [W/m]
+HEAT_POWER = "heat_power"
 META_FORMAT = "ruledrobot.trajectory-meta/1"
 #: Format of a whole trajectory in one JSON file (``ruledrobot export --format json``).
 TRAJECTORY_FORMAT = "ruledrobot.trajectory/1"
@@ -119,6 +126,8 @@ def meta_to_dict(meta: TrajectoryMeta) -> dict[str, Any]:
         "heat": None if meta.heat is None else {
             "output": meta.heat.output, "value": meta.heat.value,
             "preheat_s": meta.heat.preheat, "windows": [list(w) for w in meta.heat.windows],
+            "mode": meta.heat.mode, "full_scale_w_m": meta.heat.full_scale,
+            "lag_s": meta.heat.lag,
         },
         "max_acceleration_rad_s2": None if meta.max_acceleration is None
         else meta.max_acceleration.tolist(),
@@ -227,9 +236,12 @@ def _heat(d: _Doc) -> Heat | None:
         raise d.fail("heat.windows", f"expected [[start, stop], ...] sample indices, got {wins!r}")
     if not index.isdigit():
         raise d.fail("heat.output", f"expected KIND:N, got {h['output']!r}")
+    full_scale = h.get("full_scale_w_m")
     try:
         return Heat(kind, int(index), float(h.get("value", 1.0)), tuple(map(tuple, wins)),
-                    float(h.get("preheat_s", 0.0)))
+                    float(h.get("preheat_s", 0.0)), str(h.get("mode", "on_off")),
+                    None if full_scale is None else float(full_scale),
+                    float(h.get("lag_s", 0.0)))  # fmt: skip
     except (TypeError, ValueError) as exc:
         raise d.fail("heat", str(exc)) from None
 
@@ -348,16 +360,24 @@ def meta_from_dict(doc: Any, where: str = "trajectory metadata") -> TrajectoryMe
 _CSV_BLOCK = 256
 
 
+def _header(traj: Trajectory) -> list[str]:
+    """The CSV columns of ``traj``: :data:`HEADER`, and ``heat_power`` when it has one."""
+    return HEADER if traj.heat_power is None else [*HEADER, HEAT_POWER]
+
+
 def csv_text(traj: Trajectory) -> str:
     """The CSV of ``traj``: the header line, then one row per sample (``%.10g`` each,
     the text ``numpy.savetxt`` writes, formatted ``_CSV_BLOCK`` rows at a time)."""
-    data = np.concatenate([traj.t[:, None], traj.q, traj.tcp], axis=1)
+    cols = [traj.t[:, None], traj.q, traj.tcp]
+    if traj.heat_power is not None:
+        cols.append(traj.heat_power[:, None])
+    data = np.concatenate(cols, axis=1)
     row = ",".join(["%.10g"] * data.shape[1]) + "\n"
     full = len(data) - len(data) % _CSV_BLOCK
     blocks = data[:full].reshape(-1, _CSV_BLOCK * data.shape[1]).tolist()
     text = [(row * _CSV_BLOCK) % tuple(b) for b in blocks]
     text.append((row * (len(data) - full)) % tuple(data[full:].ravel().tolist()))
-    return ",".join(HEADER) + "\n" + "".join(text)
+    return ",".join(_header(traj)) + "\n" + "".join(text)
 
 
 def write_trajectory(path: str | os.PathLike[str], traj: Trajectory) -> Path:
@@ -382,7 +402,8 @@ def write_trajectory(path: str | os.PathLike[str], traj: Trajectory) -> Path:
 def write_trajectory_json(path: str | os.PathLike[str], traj: Trajectory) -> Path:
     """Write ``traj`` as one JSON document (atomically): ``{"format":
     "ruledrobot.trajectory/1", "units": {...}, "meta": {sidecar fields}, "header": [...],
-    "t": [...], "q": [[...]], "tcp": [[...]]}``.  Refuses a name whose ``.csv`` sibling
+    "t": [...], "q": [[...]], "tcp": [[...]]}`` (and ``"heat_power": [...]`` W/m when
+    the trajectory has one).  Refuses a name whose ``.csv`` sibling
     exists (the JSON would take the place of that CSV's sidecar)."""
     p = Path(path)
     if p.with_suffix(".csv").exists():
@@ -390,33 +411,40 @@ def write_trajectory_json(path: str | os.PathLike[str], traj: Trajectory) -> Pat
                          "beside it; choose another name")  # fmt: skip
     doc = {
         "format": TRAJECTORY_FORMAT,
-        "units": {"t": "s", "q": "rad", "tcp": "m, rad (UR pose vector, robot base frame)"},
+        "units": {"t": "s", "q": "rad", "tcp": "m, rad (UR pose vector, robot base frame)",
+                  HEAT_POWER: "W/m"},
         "meta": meta_to_dict(traj.meta),
-        "header": HEADER,
+        "header": _header(traj),
         "t": traj.t.tolist(),
         "q": traj.q.tolist(),
         "tcp": traj.tcp.tolist(),
     }
+    if traj.heat_power is not None:
+        doc[HEAT_POWER] = traj.heat_power.tolist()
     return atomic_write_json(p, doc, compact=True)
 
 
 def write_trajectory_npz(path: str | os.PathLike[str], traj: Trajectory) -> Path:
-    """Write ``traj`` as a compressed NPZ (atomically): arrays ``t``, ``q``, ``tcp`` and
-    ``meta`` (the sidecar fields as JSON text)."""
+    """Write ``traj`` as a compressed NPZ (atomically): arrays ``t``, ``q``, ``tcp``,
+    ``heat_power`` (when the trajectory has one) and ``meta`` (the sidecar fields as JSON
+    text)."""
     buf = io.BytesIO()
+    extra = {} if traj.heat_power is None else {HEAT_POWER: traj.heat_power}
     np.savez_compressed(buf, t=traj.t, q=traj.q, tcp=traj.tcp,
-                        meta=np.array(json.dumps(meta_to_dict(traj.meta))))  # fmt: skip
+                        meta=np.array(json.dumps(meta_to_dict(traj.meta))), **extra)  # fmt: skip
     return atomic_write_bytes(path, buf.getvalue())
 
 
 def _parse_csv(p: Path, text: str) -> np.ndarray:
+    """The samples (M, 13), or (M, 14) with the ``heat_power`` column; ValueError names
+    the file and line."""
     lines = text.splitlines()
     if not lines or not lines[0].strip():
         raise ValueError(f"{p}: line 1: expected the header {','.join(HEADER)}")
     head = [c.strip().lower() for c in lines[0].split(",")]
-    if head != HEADER:
-        raise ValueError(f"{p}: line 1: expected the header {','.join(HEADER)}, got "
-                         f"{lines[0][:80]!r}")  # fmt: skip
+    if head not in (HEADER, [*HEADER, HEAT_POWER]):
+        raise ValueError(f"{p}: line 1: expected the header {','.join(HEADER)} (and "
+                         f"optionally {HEAT_POWER}), got {lines[0][:80]!r}")  # fmt: skip
     body = [s for s in lines[1:] if s.strip()]
     if not body:
         raise ValueError(f"{p}: no samples after the header")
@@ -424,14 +452,14 @@ def _parse_csv(p: Path, text: str) -> np.ndarray:
         data = np.loadtxt(io.StringIO("\n".join(body)), delimiter=",", ndmin=2)
     except ValueError:
         data = None
-    if data is None or data.shape[1] != len(HEADER):
+    if data is None or data.shape[1] != len(head):
         # find the offending line for the message
         for lineno, s in enumerate(lines[1:], start=2):
             if not s.strip():
                 continue
             cells = s.split(",")
-            if len(cells) != len(HEADER):
-                raise ValueError(f"{p}: line {lineno}: expected {len(HEADER)} values, "
+            if len(cells) != len(head):
+                raise ValueError(f"{p}: line {lineno}: expected {len(head)} values, "
                                  f"got {len(cells)}")  # fmt: skip
             try:
                 [float(c) for c in cells]
@@ -479,6 +507,7 @@ def _read_bundle(p: Path, check_tcp: bool) -> Trajectory:
         try:
             with np.load(p, allow_pickle=False) as z:
                 arrays = {k: z[k] for k in ("t", "q", "tcp", "meta")}
+                power = z[HEAT_POWER] if HEAT_POWER in z.files else None
         except (OSError, ValueError, KeyError) as exc:
             raise ValueError(f"{p}: not a ruledrobot trajectory NPZ (t, q, tcp, meta): {exc}"
                              ) from None  # fmt: skip
@@ -500,10 +529,11 @@ def _read_bundle(p: Path, check_tcp: bool) -> Trajectory:
             if key not in doc:
                 raise ValueError(f"{p}: field {key!r} missing")
         meta_doc, t, q, tcp = doc["meta"], doc["t"], doc["q"], doc["tcp"]
+        power = doc.get(HEAT_POWER)
     meta = meta_from_dict(meta_doc, f"{p}: meta")
     try:
         traj = Trajectory(np.asarray(t, float), np.asarray(q, float), np.asarray(tcp, float),
-                          meta)  # fmt: skip
+                          meta, None if power is None else np.asarray(power, float))  # fmt: skip
     except (ValueError, TypeError) as exc:
         raise ValueError(f"{p}: {exc}") from None
     if check_tcp:
@@ -543,7 +573,8 @@ def read_trajectory(path: str | os.PathLike[str], check_tcp: bool = True) -> Tra
     _check_manifest(p, text.encode())
     data = _parse_csv(p, text)
     try:
-        traj = Trajectory(data[:, 0], data[:, 1:7], data[:, 7:], meta)
+        power = data[:, 13] if data.shape[1] > 13 else None
+        traj = Trajectory(data[:, 0], data[:, 1:7], data[:, 7:13], meta, power)
     except ValueError as exc:
         raise ValueError(f"{p} with {sp.name}: {exc}") from None
     if check_tcp:
