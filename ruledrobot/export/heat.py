@@ -3,7 +3,11 @@ does it.
 
 A trajectory's :class:`~ruledrobot.robot.motion.trajectory.Heat` names the output (standard,
 configurable or tool digital output, or a standard analog output at a fraction of its
-range) and the sample ranges with the heat on.
+range) and the sample ranges with the heat on.  A trajectory with a ``heat_power`` column
+on an analog output (docs/kerf.md) sets the output along the motion instead:
+:func:`heat_levels` are its set-points (``heat_power / full_scale``), and
+:func:`written_levels` the ones a program or a run writes (where they change by more
+than :data:`HEAT_STEP`).
 
 * :func:`urscript_heat` — the URScript statement (``set_standard_digital_out(0,
   True)`` ...), for exported programs and for the secondary program that turns the
@@ -11,7 +15,9 @@ range) and the sample ranges with the heat on.
 * :func:`set_heat_rtde` — the same through ur_rtde's ``RTDEIOInterface`` during a
   streamed run;
 * :func:`send_heat_off` — the secondary program above, sent to a controller;
-* :func:`heat_from_outputs` — the heat's state read back from a run's recorded outputs.
+* :func:`heat_from_outputs` — the heat's state read back from a run's recorded outputs,
+  :func:`heat_power_from_outputs` its power (an analog output's fraction times its full
+  scale).
 """
 
 from __future__ import annotations
@@ -22,17 +28,47 @@ from typing import Any
 import numpy as np
 
 from ..protocol.primary import SECONDARY_PORT
-from ..robot.motion.trajectory import Heat
+from ..robot.motion.trajectory import Heat, Trajectory
 
-__all__ = ["heat_from_outputs", "heat_off_program", "send_heat_off", "set_heat_rtde",
-           "urscript_heat"]
+__all__ = ["HEAT_STEP", "heat_from_outputs", "heat_levels", "heat_off_program",
+           "heat_power_from_outputs", "send_heat_off", "set_heat_rtde", "urscript_heat",
+           "written_levels"]
+
+#: the smallest change of an analog heat set-point that a program or a run writes, as a
+#: fraction of the output's range (0.2 %: the wire's power follows it within 0.2 % of full
+#: scale, a few statements per second on a speed ramp)
+HEAT_STEP = 0.002
 
 
-def urscript_heat(heat: Heat, on: bool) -> str:
-    """The URScript statement that switches ``heat`` on or off (no indent, no newline)."""
+def heat_levels(traj: Trajectory) -> np.ndarray | None:
+    """(M,) the analog set-point of each sample, ``heat_power / full_scale`` clipped to
+    [0, 1] (:meth:`Heat.ratio`); None unless the heat goes to an analog output and the
+    trajectory has a ``heat_power`` column (a digital output switches on and off)."""
+    heat = traj.meta.heat
+    if heat is None or heat.kind != "analog" or traj.heat_power is None:
+        return None
+    return heat.ratio(traj.heat_power)
+
+
+def written_levels(levels: np.ndarray, step: float = HEAT_STEP) -> np.ndarray:
+    """(M,) the set-points as written: ``levels[k]`` at each sample where its band of width
+    ``step`` changes (zero is a band of its own: off and on are always written), held
+    until the next: within ``step`` of ``levels`` everywhere."""
+    lv = np.asarray(levels, dtype=np.float64)
+    if lv.size == 0:
+        return lv.copy()
+    band = np.where(lv > 0.0, np.floor(lv / step) + 1.0, 0.0)
+    change = np.r_[True, band[1:] != band[:-1]]
+    return lv[np.flatnonzero(change)][np.cumsum(change) - 1]
+
+
+def urscript_heat(heat: Heat, on: bool, value: float | None = None) -> str:
+    """The URScript statement that switches ``heat`` on or off (no indent, no newline);
+    an analog output goes to ``value`` (a set-point of :func:`heat_levels`) when given,
+    else to ``heat.value`` when on and 0 when off."""
     if heat.kind == "analog":
-        value = heat.value if on else 0.0
-        return f"set_standard_analog_out({heat.index}, {value:.6g})"
+        level = value if value is not None else (heat.value if on else 0.0)
+        return f"set_standard_analog_out({heat.index}, {level:.6g})"
     return f"set_{heat.kind}_digital_out({heat.index}, {'True' if on else 'False'})"
 
 
@@ -48,6 +84,16 @@ def heat_from_outputs(heat: Heat, outputs: np.ndarray) -> np.ndarray:
     return ((bits >> bit) & 1).astype(bool)
 
 
+def heat_power_from_outputs(heat: Heat, outputs: np.ndarray) -> np.ndarray | None:
+    """(M,) the wire power set-point [W/m] in recorded outputs (M, 3) (as
+    :func:`heat_from_outputs`): the analog output's fraction times ``heat.full_scale``
+    (NaN rows: 0); None unless the heat is an analog output with a full scale."""
+    if heat.kind != "analog" or heat.full_scale is None:
+        return None
+    o = np.asarray(outputs, dtype=float).reshape(-1, 3)
+    return np.nan_to_num(o[:, 1 + heat.index], nan=0.0) * heat.full_scale
+
+
 def heat_off_program(heat: Heat) -> str:
     """A secondary program (runs beside whatever program runs, stops nothing) that turns
     the heat off: sent to the primary/secondary port when a run ends without its client
@@ -55,8 +101,9 @@ def heat_off_program(heat: Heat) -> str:
     return f"sec ruledrobot_heat_off():\n  {urscript_heat(heat, False)}\nend\n"
 
 
-def set_heat_rtde(io: Any, heat: Heat, on: bool) -> bool:
-    """Switch ``heat`` through an ``rtde_io.RTDEIOInterface``; ur_rtde's return value."""
+def set_heat_rtde(io: Any, heat: Heat, on: bool, value: float | None = None) -> bool:
+    """Switch ``heat`` through an ``rtde_io.RTDEIOInterface`` (an analog output to ``value``
+    when given, as :func:`urscript_heat`); ur_rtde's return value."""
     n = heat.index
     if heat.kind == "standard":
         return bool(io.setStandardDigitalOut(n, on))
@@ -64,7 +111,8 @@ def set_heat_rtde(io: Any, heat: Heat, on: bool) -> bool:
         return bool(io.setConfigurableDigitalOut(n, on))
     if heat.kind == "tool":
         return bool(io.setToolDigitalOut(n, on))
-    return bool(io.setAnalogOutputCurrent(n, heat.value if on else 0.0))
+    level = value if value is not None else (heat.value if on else 0.0)
+    return bool(io.setAnalogOutputCurrent(n, float(level)))
 
 
 def send_heat_off(host: str, heat: Heat, timeout: float = 2.0) -> str:

@@ -106,16 +106,18 @@ def _motion(s: Session, m: dict) -> None:
         s.link.stage("connecting IO", m["connect_timeout"])
         s.connect_io(Heat(heat["kind"], heat["index"], heat["value"]))
         hot = np.asarray(heat["hot"], dtype=bool)
+    levels = None if heat is None or heat.get("levels") is None else np.asarray(heat["levels"])
     approach(s, q_grid[0], m["approach_speed"], m["approach_acceleration"], m["heartbeat"])
     if hot is not None and hot[0]:  # entering a cut where it stopped: heat before moving
-        preheat(s, float(heat["preheat"]), m["heartbeat"])
+        preheat(s, float(heat["preheat"]), m["heartbeat"],
+                None if levels is None else float(levels[0]))  # fmt: skip
     if m["mode"] == "forward":
         settings = ForwardSettings(1.0 / s.frequency, m["buffer"], m["stop_time"],
                                    m["lookahead"], m["gain"])  # fmt: skip
         hv = None if heat is None else Heat(heat["kind"], heat["index"], heat["value"])
-        forward(s, q_grid, hot, settings, hv, m["heartbeat"], m["connect_timeout"])
+        forward(s, q_grid, hot, settings, hv, m["heartbeat"], m["connect_timeout"], levels)
     elif m["mode"] == "servoj":
-        stream(s, q_grid, m["lookahead"], m["gain"], m["heartbeat"], hot)
+        stream(s, q_grid, m["lookahead"], m["gain"], m["heartbeat"], hot, levels)
     else:  # the path program switches the heat where the plan does
         run_program(s, q_grid, m["program"], m["heartbeat"])
         s.set_heat(False)

@@ -67,10 +67,10 @@ def approach(
             raise Stop("command_failed", "approach moveJ did not reach the first sample in time")
 
 
-def preheat(s: Session, seconds: float, heartbeat: float) -> None:
-    """Heat the wire and hold still ``seconds`` (a run that starts inside a heat window:
-    the resume of a cut), monitored."""
-    s.set_heat(True)
+def preheat(s: Session, seconds: float, heartbeat: float, level: float | None = None) -> None:
+    """Heat the wire (an analog output to the set-point ``level`` when given) and hold still
+    ``seconds`` (a run that starts inside a heat window: the resume of a cut), monitored."""
+    s.set_heat(True, level)
     s.link.stage("preheat", heartbeat)
     deadline = time.monotonic() + seconds
     while time.monotonic() < deadline:
@@ -87,9 +87,12 @@ def stream(
     gain: float,
     heartbeat: float,
     hot: np.ndarray | None = None,
+    levels: np.ndarray | None = None,
 ) -> None:
     """servoJ every controller period, monitored, then hold the last sample until settled.
-    ``hot`` (K,): the wire's heat at each grid sample (switched where it changes).
+    ``hot`` (K,): the wire's heat at each grid sample (switched where it changes);
+    ``levels`` (K,): an analog output's set-points as written (:func:`~.heat.written_levels`
+    of a scheduled power; set where they change), instead.
 
     The stream keeps the plan's schedule on the wall clock: sample ``k`` goes out at
     ``k`` periods after the start.  A period that overran (a switch of the heat, the
@@ -102,6 +105,7 @@ def stream(
     dt = 1.0 / s.frequency
     K = q_grid.shape[0]
     rows = q_grid.tolist()
+    lv = None if levels is None else np.asarray(levels, dtype=float).tolist()
     s.link.stage("streaming", heartbeat)
     s.start_recording()
     s.start_clock()
@@ -114,7 +118,10 @@ def stream(
         start = time.monotonic()
         k = 0
         while k < K:
-            if hot is not None and bool(hot[k]) != s.hot:
+            if lv is not None:
+                if lv[k] != s.level:
+                    s.set_heat(lv[k] > 0.0, lv[k])
+            elif hot is not None and bool(hot[k]) != s.hot:
                 s.set_heat(bool(hot[k]))
             if not c.servoJ(rows[k], 0.0, 0.0, dt, lookahead, gain):
                 raise s.classify(f"servoJ of grid sample {k}")
@@ -130,8 +137,8 @@ def stream(
     finally:
         gc.enable()
         gc.unfreeze()
-    if hot is not None and s.hot:  # a heat window that ends with the plan ends here, on
-        s.set_heat(False)  # the schedule, not after the final hold (0.7 s and more later)
+    if (hot is not None or lv is not None) and s.hot:  # a heat window that ends with the
+        s.set_heat(False)  # plan ends here, on the schedule, not after the final hold (0.7 s+)
     # hold the final target until the filter has converged
     last = rows[-1]
     deadline = time.monotonic() + 10.0 * lookahead + 0.5
@@ -173,11 +180,11 @@ def _play_path(s: Session, q_grid: np.ndarray, block: list[tuple], heartbeat: fl
     c = s.c
     entry = rtde_control.PathEntry
     path = rtde_control.Path()
-    switches: list[tuple[int, bool]] = []  # (index of the move the switch precedes, on)
+    switches: list[tuple] = []  # (index of the move the switch precedes, on, set-point)
     moves = 0
     for op in block:
         if op[0] == "heat":
-            switches.append((moves, bool(op[1])))
+            switches.append((moves, bool(op[1]), op[2]))
             continue
         _, joint, target, v, a, r, _grid, _q = op
         kind, where = ((entry.MoveJ, entry.PositionJoints) if joint
@@ -214,7 +221,7 @@ def _play_path(s: Session, q_grid: np.ndarray, block: list[tuple], heartbeat: fl
         prog = c.getAsyncOperationProgress()
         started = started or prog >= 0
         while switches and (prog >= switches[0][0] or (prog < 0 and started)):
-            s.set_heat(switches.pop(0)[1])
+            s.set_heat(*switches.pop(0)[1:])
         now = time.monotonic()
         if prog < 0 and (started or now - t_start > 0.5):
             if float(np.max(np.abs(qa - q_end))) < 1e-3:
@@ -242,7 +249,7 @@ def run_program(s: Session, q_grid: np.ndarray, ops: list[tuple], heartbeat: flo
     while i < n:
         op = ops[i]
         if op[0] == "heat":
-            s.set_heat(bool(op[1]))
+            s.set_heat(bool(op[1]), op[2])
             i += 1
         elif op[0] == "sleep":
             j = i + 1

@@ -118,7 +118,8 @@ class PathRun:
         """The statements for the streaming child: ``("move", joint, target, v, a, r,
         grid, q_end)`` (``grid``: the controller-period grid sample of the move's end,
         ``grid_of(sample of part)``; ``q_end``: the plan's joints there), ``("sleep",
-        seconds, grid)`` (grid: where the hold ends) and ``("heat", on)``."""
+        seconds, grid)`` (grid: where the hold ends) and ``("heat", on, value)`` (value: an
+        analog set-point of a scheduled power, or None)."""
         out: list[tuple] = []
         samples = iter(self.samples)
         k = 0
@@ -133,7 +134,7 @@ class PathRun:
                 end = int(np.searchsorted(self.part.t, self.part.t[k] + op.seconds - 1e-9))
                 out.append(("sleep", float(op.seconds), int(grid_of(min(end, q.shape[0] - 1)))))
             else:
-                out.append(("heat", bool(op.on)))
+                out.append(("heat", bool(op.on), op.value))
         return out
 
 

@@ -108,6 +108,7 @@ class Session:
         self.io: Any = None  # rtde_io.RTDEIOInterface when the run switches the wire's heat
         self.heat: Heat | None = None
         self.hot = False
+        self.level = 0.0  # the analog set-point last written (a scheduled power)
         self.max_dev = 0.0
         self.k_match = 0
         self.k_high = 0  # the furthest plan sample matched so far
@@ -186,14 +187,17 @@ class Session:
         self.heat = heat
         self.set_heat(False)
 
-    def set_heat(self, on: bool) -> None:
-        """Switch the wire's heat (no-op without heat); a refusal stops the run."""
+    def set_heat(self, on: bool, value: float | None = None) -> None:
+        """Switch the wire's heat (no-op without heat), an analog output to the set-point
+        ``value`` when given (a scheduled power); a refusal stops the run."""
         if self.heat is None or self.io is None:
             return
-        if not set_heat_rtde(self.io, self.heat, on):
-            raise Stop("command_failed", f"the controller refused to switch the heat "
-                       f"({self.heat.output}) {'on' if on else 'off'}")  # fmt: skip
+        if not set_heat_rtde(self.io, self.heat, on, value):
+            what = f"to {value:.4g}" if value is not None else ("on" if on else "off")
+            raise Stop("command_failed", f"the controller refused to set the heat "
+                       f"({self.heat.output}) {what}")  # fmt: skip
         self.hot = on
+        self.level = (value if value is not None else 0.0) if on else 0.0
 
     def arm_watchdog(self) -> None:
         """The control script stops the program when no command arrives for 1/watchdog s."""
@@ -451,7 +455,7 @@ class Session:
         if self.hot or self.heat is not None:  # the heat first: a still wire burns the foam
             try:
                 set_heat_rtde(self.io, self.heat, False)
-                self.hot = False
+                self.hot, self.level = False, 0.0
             except Exception:
                 pass
         if mode == "forward":  # the program is ours (it stops along the path on request)

@@ -47,7 +47,13 @@ from ..robot.motion.trajectory import Trajectory
 from ..robot.verdict import Check, Verdict
 from . import settings  # the defaults a run shares with the exported program
 from .forward import ForwardSettings
-from .heat import heat_from_outputs, send_heat_off
+from .heat import (
+    heat_from_outputs,
+    heat_levels,
+    heat_power_from_outputs,
+    send_heat_off,
+    written_levels,
+)
 from .limits import check_trajectory
 from .run_checks import controller_checks, kinematics_check, query_dashboard, readiness_check
 from .run_plan import Entry, inside_mask, plan_entry, recording_path_for, resample, stop_place
@@ -490,9 +496,12 @@ def _move(
                            deviation_limit=o["deviation_limit"], speed_scale=speed_scale,
                            wire_tolerance=o["wire_tolerance"])  # fmt: skip
     result.measures, result.run_verdict = measures, measures.verdict
-    if rec is not None:  # the recording measures itself with the cut carried over to it
+    if rec is not None:  # the recording measures itself with the cut carried over to it;
+        # its heat_power: the analog output the controller reported, times its full scale
+        power = None if heat is None else heat_power_from_outputs(
+            heat, np.concatenate([c[4] for c in out.chunks]))  # fmt: skip
         rec = Trajectory(rec.t, rec.q, rec.tcp,
-                         rec.meta.replace(cut=measures.cut, in_stock=measures.in_stock))
+                         rec.meta.replace(cut=measures.cut, in_stock=measures.in_stock), power)
     result.actual = rec
     if rec is not None:
         if o["actual_path"] is not None:
@@ -528,13 +537,17 @@ def _write_run(path: Path, result: RunResult, measures: RunMeasures, source: Pat
 
 
 def _heat_message(traj: Trajectory, k0: int, grid_to_input: np.ndarray) -> dict | None:
-    """The heat the child switches: the output and, per grid sample, on or off."""
+    """The heat the child switches: the output and, per grid sample, on or off, and with
+    a scheduled power on an analog output the set-points as written (``levels``)."""
     heat = traj.meta.heat
     if heat is None:
         return None
-    on = heat.on(traj.n)[k0 + grid_to_input]
+    levels = heat_levels(traj)
+    written = None if levels is None else written_levels(levels[k0 + grid_to_input])
+    on = heat.on(traj.n)[k0 + grid_to_input] if written is None else written > 0.0
     return {"kind": heat.kind, "index": heat.index, "value": heat.value,
-            "preheat": heat.preheat, "hot": on.tolist()}  # fmt: skip
+            "preheat": heat.preheat, "hot": on.tolist(),
+            "levels": None if written is None else written.tolist()}  # fmt: skip
 
 
 def _recording(

@@ -19,7 +19,12 @@ node must call (``docs/rtde.md``).
 
 A trajectory with a heated wire (``meta.heat``) switches the heat output off at the
 start, on where a heat window begins (the pre-heat dwell before a lead-in) and off
-where it ends (after the lead-out) and at the end (:mod:`.heat`).
+where it ends (after the lead-out) and at the end (:mod:`.heat`).  With a ``heat_power``
+column on an analog output the program sets the output along the motion instead
+(``set_standard_analog_out(n, heat_power / full_scale)``, the set-points already led
+by the heat's ``lag``): a servoj program before each sample where the set-point changes
+by more than :data:`~.heat.HEAT_STEP`; a path program before each run of blended moves
+(a statement inside a blended run would stop the arm), at the run's mean set-point.
 
 Every mode sets the TCP and the payload from the trajectory's metadata, so the
 poses of ``movel``/``movep`` (the trajectory's TCP column) are the controller's
@@ -54,7 +59,7 @@ from ..robot import model_for
 from ..robot.motion.trajectory import HEATED_PHASES, Trajectory
 from ..robot.wire.cut import WIRE_TOLERANCE
 from .decimate import path_steps
-from .heat import urscript_heat
+from .heat import HEAT_STEP, heat_levels, urscript_heat, written_levels
 from .limits import check_trajectory
 from .settings import (
     APPROACH_ACCELERATION,
@@ -145,6 +150,9 @@ def path_program(
     n = traj.n
     wire_tolerance = plan_wire_tolerance(traj, wire_tolerance)
     heat = meta.heat.on(n) if meta.heat is not None else None
+    levels = heat_levels(traj)
+    if levels is not None:  # the scheduled power: on where its set-point is above zero
+        heat = levels > 0.0
     bounds = [x for p in meta.phases for x in (p.start, p.stop)]
     bounds += [x for r in meta.in_stock for x in r]
     strict = np.zeros(n, dtype=bool) if meta.phases else np.ones(n, dtype=bool)
@@ -163,8 +171,15 @@ def path_program(
     ops: list[Op] = []
     hot = False  # the program switched the heat off before its first move
     tcp, p = traj.tcp, traj.tcp[:, :3]
-    for s in steps:
-        if heat is not None and s.heat != hot:
+    group = _group_levels(steps, levels) if levels is not None else {}
+    level = 0.0
+    for i, s in enumerate(steps):
+        if i in group:  # the scheduled power: one set-point per run of blended moves
+            x = group[i]
+            if (x > 0.0) != (level > 0.0) or abs(x - level) > HEAT_STEP:
+                ops.append(Switch(x > 0.0, x))
+                level = x
+        elif heat is not None and levels is None and s.heat != hot:
             ops.append(Switch(s.heat))
             hot = s.heat
         if s.kind == "dwell":
@@ -178,6 +193,22 @@ def path_program(
             ops.append(Move(tcp[s.stop].copy(), acceleration, float(np.clip(v, 1e-5, 3.0)),
                             s.r))  # fmt: skip
     return ops
+
+
+def _group_levels(steps: tuple, levels: np.ndarray) -> dict[int, float]:
+    """The analog set-point of each run of blended path steps (a statement between two
+    blended moves would end the blend: the arm would stop there), keyed by the run's first
+    step: the mean of the samples' set-points over the run (their time mean: the plan's
+    samples are evenly spaced)."""
+    out: dict[int, float] = {}
+    first = 0
+    for i, s in enumerate(steps):
+        if s.r > 0.0 and i + 1 < len(steps):
+            continue  # blended into the next step: the same run
+        a, b = steps[first].start, s.stop
+        out[first] = float(np.mean(levels[a:b])) if b > a else float(levels[a])
+        first = i + 1
+    return out
 
 
 def program_size_note(motion_lines: int, size: int) -> str | None:
@@ -263,8 +294,15 @@ def urscript_program(
         dts = np.append(np.diff(t), settle) if t.size > 1 else np.array([settle])
         la, g = _num(lookahead, digits), _num(gain, digits)
         was = False
+        levels = heat_levels(traj)
+        written = None if levels is None else written_levels(levels)
+        level = 0.0  # the program set the output to 0 first
         for k, (qk, dt) in enumerate(zip(q, dts, strict=True)):
-            if heat is not None and on[k] != was:
+            if written is not None:
+                if written[k] != level:
+                    level = float(written[k])
+                    w(f"  {urscript_heat(heat, level > 0.0, level)}\n")  # type: ignore[arg-type]
+            elif heat is not None and on[k] != was:
                 w(f"  {urscript_heat(heat, bool(on[k]))}\n")
                 was = bool(on[k])
             w(f"  servoj({_vec(qk, digits)}, t={_num(dt, digits)}, lookahead_time={la}, "
@@ -281,7 +319,7 @@ def urscript_program(
             verified = f"verified (its motion, generated at the control period): {check.summary()}"
         for op in ops:
             if isinstance(op, Switch):
-                w(f"  {urscript_heat(heat, op.on)}\n")  # type: ignore[arg-type]
+                w(f"  {urscript_heat(heat, op.on, op.value)}\n")  # type: ignore[arg-type]
             elif isinstance(op, Sleep):
                 w(f"  sleep({_num(op.seconds, digits)})\n")
             else:

@@ -79,9 +79,11 @@ class Sleep:
 
 @dataclass(frozen=True)
 class Switch:
-    """The heat output switched on or off (takes no time)."""
+    """The heat output switched on or off (takes no time); ``value``: an analog output's
+    set-point (a fraction of its range) when the plan schedules the wire's power."""
 
     on: bool
+    value: float | None = None
 
 
 Op = Move | Sleep | Switch

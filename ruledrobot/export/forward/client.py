@@ -47,16 +47,20 @@ def _send_program(host: str, text: str, timeout: float) -> None:
 
 
 def forward(s: Session, q_grid: np.ndarray, hot: np.ndarray | None, settings: ForwardSettings,
-            heat: object, heartbeat: float, connect_timeout: float) -> None:  # fmt: skip
+            heat: object, heartbeat: float, connect_timeout: float,
+            levels: np.ndarray | None = None) -> None:  # fmt: skip
     """Play ``q_grid`` (K, 6) on the controller's clock (module doc); ``hot`` (K,) the heat
-    per sample or None.  Returns when the program reports ``DONE``; raises :class:`Stop`
-    otherwise (after the program's controlled stop when it still runs)."""
+    per sample or None; ``levels`` (K,) the analog set-points as written (a scheduled
+    power, :func:`~..heat.written_levels`) or None.  Returns when the program reports
+    ``DONE``; raises :class:`Stop` otherwise (after the program's controlled stop when it
+    still runs)."""
     K = q_grid.shape[0]
     me = local_address(s.host)
     server = socket.create_server((me, 0))
     server.settimeout(connect_timeout)
     port = server.getsockname()[1]
-    program = forward_program(me, port, settings, heat, connect_timeout)  # type: ignore[arg-type]
+    program = forward_program(me, port, settings, heat, connect_timeout,  # type: ignore[arg-type]
+                              levels is not None)
     s.link.stage("forwarding: program", connect_timeout + 1.0)
     if s.c is not None:
         with contextlib.suppress(Exception):
@@ -74,15 +78,21 @@ def forward(s: Session, q_grid: np.ndarray, hot: np.ndarray | None, settings: Fo
     with conn:
         conn.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
         conn.settimeout(2.0)
-        _play(s, conn, q_grid, hot, settings, heartbeat, K)
+        _play(s, conn, q_grid, hot, levels, settings, heartbeat, K)
 
 
 def _play(s: Session, conn: socket.socket, q_grid: np.ndarray, hot: np.ndarray | None,
-          settings: ForwardSettings, heartbeat: float, K: int) -> None:  # fmt: skip
+          levels: np.ndarray | None, settings: ForwardSettings, heartbeat: float,
+          K: int) -> None:  # fmt: skip
+
+    def part(a: int, b: int) -> bytes:
+        return sample_messages(q_grid[a:b], None if hot is None else hot[a:b], a,
+                               None if levels is None else levels[a:b])  # fmt: skip
+
     r = s.r
     ahead = settings.ahead
     sent = min(K, ahead)
-    conn.sendall(sample_messages(q_grid[:sent], None if hot is None else hot[:sent], 0))
+    conn.sendall(part(0, sent))
     if sent == K:
         conn.sendall(end_message(K))
     # the program connected: wait for the controller's data to say it runs (the newest
@@ -122,8 +132,7 @@ def _play(s: Session, conn: socket.socket, q_grid: np.ndarray, hot: np.ndarray |
         if playing >= 0 and sent < K:
             upto = min(K, playing + 1 + ahead)
             if upto > sent:
-                part = None if hot is None else hot[sent:upto]
-                conn.sendall(sample_messages(q_grid[sent:upto], part, sent))
+                conn.sendall(part(sent, upto))
                 s.sent = upto - 1
                 sent = upto
                 if sent == K:

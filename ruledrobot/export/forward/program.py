@@ -14,12 +14,15 @@ decelerates *along the path*: the path parameter's rate falls linearly from one 
 period to zero over ``stop_time`` s, through the samples it holds; then it holds, reports
 the sample where it stopped and ends.  The same controlled stop follows a stop request.
 
-Messages (PC to controller) are 8 big-endian int32 (URScript
-``socket_read_binary_integer(8, ...)``): ``[kind, k, q1..q6]`` with the joint angles in
-micro-radians (:data:`MICRO`); ``kind`` :data:`SAMPLE_COLD` or :data:`SAMPLE_HOT` (a
+Messages (PC to controller) are 9 big-endian int32 (URScript
+``socket_read_binary_integer(9, ...)``): ``[kind, k, level, q1..q6]`` with the joint angles
+in micro-radians (:data:`MICRO`); ``kind`` :data:`SAMPLE_COLD` or :data:`SAMPLE_HOT` (a
 sample, the heat off or on), :data:`END` (no sample follows), :data:`STOP` (stop along the
-path now).  The program reports through RTDE output registers: :data:`REG_SAMPLE` the last
-sample it commanded (``-1`` before the first), :data:`REG_STATE` one of :class:`State`.
+path now); ``level`` the heat's analog set-point at the sample in millionths of the
+output's range (a scheduled power, :func:`~..heat.written_levels`; 0 otherwise): a program
+made with ``levels`` sets the analog output where it changes, as it plays the sample.
+The program reports through RTDE output registers: :data:`REG_SAMPLE` the last sample
+it commanded (``-1`` before the first), :data:`REG_STATE` one of :class:`State`.
 """
 
 from __future__ import annotations
@@ -56,7 +59,7 @@ SAMPLE_COLD, SAMPLE_HOT, END, STOP = 1, 2, 3, 4
 #: RTDE output int registers the program reports through (in ur_rtde's receive recipe)
 REG_SAMPLE, REG_STATE = 12, 13
 #: int32 values per message
-WORDS = 8
+WORDS = 9
 #: messages the program reads per control period at most (it refills 3 samples a
 #: period faster than it plays them)
 READS_PER_PERIOD = 4
@@ -119,60 +122,58 @@ class ForwardSettings:
         return self.ahead + READS_PER_PERIOD + 2
 
 
-def sample_messages(q: np.ndarray, hot: np.ndarray | None, k0: int) -> bytes:
-    """Messages of samples ``k0, k0 + 1, ...``: ``q`` (n, 6) [rad], ``hot`` (n,) or None."""
+def sample_messages(q: np.ndarray, hot: np.ndarray | None, k0: int,
+                    levels: np.ndarray | None = None) -> bytes:  # fmt: skip
+    """Messages of samples ``k0, k0 + 1, ...``: ``q`` (n, 6) [rad], ``hot`` (n,) or None,
+    ``levels`` (n,) analog set-points in [0, 1] or None."""
     q = np.asarray(q, dtype=float).reshape(-1, 6)
     n = q.shape[0]
     out = np.empty((n, WORDS), dtype=">i4")
     out[:, 0] = SAMPLE_COLD if hot is None else np.where(np.asarray(hot, bool), SAMPLE_HOT,
                                                           SAMPLE_COLD)  # fmt: skip
     out[:, 1] = np.arange(k0, k0 + n)
+    out[:, 2] = 0 if levels is None else np.rint(np.clip(levels, 0.0, 1.0) * MICRO)
     micro = np.rint(q * MICRO)
     if np.any(np.abs(micro) >= 2**31):
         raise ValueError("forward: a joint angle beyond +-2147 rad cannot be sent")
-    out[:, 2:] = micro
+    out[:, 3:] = micro
     return out.tobytes()
 
 
 def end_message(k: int) -> bytes:
     """The message that says no sample follows sample ``k - 1``."""
-    return struct.pack(">8i", END, int(k), 0, 0, 0, 0, 0, 0)
+    return struct.pack(f">{WORDS}i", END, int(k), *([0] * (WORDS - 2)))
 
 
 def stop_message() -> bytes:
     """The message that asks for a controlled stop along the path."""
-    return struct.pack(">8i", STOP, 0, 0, 0, 0, 0, 0, 0)
+    return struct.pack(f">{WORDS}i", STOP, *([0] * (WORDS - 1)))
 
 
-def forward_program(host: str, port: int, settings: ForwardSettings, heat: Heat | None,
-                    connect_timeout: float = 10.0) -> str:  # fmt: skip
-    """The URScript program of a forwarded run (module doc): it connects to ``host:port``
-    (the runner), fills its buffer, plays the samples, stops along the path when they run
-    short or on request, and reports in :data:`REG_SAMPLE` / :data:`REG_STATE`."""
-    s = settings
+def _heat_set(heat: Heat | None, levels: bool) -> str:
+    """The program's ``heat_set(on, l)``: switches the heat where ``on`` changes, or with
+    ``levels`` (an analog output with a scheduled power) sets the output to ``l`` (0 when
+    not ``on``) where that changes."""
+    if levels and heat is not None and heat.kind == "analog":
+        return f"""  def heat_set(on, l):
+    global heat
+    global level
+    v = 0.0
+    if on:
+      v = l
+    end
+    if v != level:
+      set_standard_analog_out({heat.index}, v)
+      level = v
+    end
+    heat = on
+  end
+"""
     if heat is not None:
         on, off = urscript_heat(heat, True), urscript_heat(heat, False)
     else:
         on = off = "sync()  # no heat output"
-    ring = s.ring
-    prefill = s.ahead
-    fill_periods = math.ceil(connect_timeout / s.period)
-    hold_periods = math.ceil((10.0 * s.lookahead + 0.5) / s.period)
-    servo = f"t={s.period!r}, lookahead_time={s.lookahead!r}, gain={s.gain!r}"
-    zeros6 = ", ".join(["0.0"] * (6 * ring))
-    falses = ", ".join(["False"] * ring)
-    return f"""def rr_forward():
-  # ruledrobot forwarded run: the plan's samples arrive ahead of time from {host}:{port}
-  # and play on this controller's clock, one per period (docs/rtde.md)
-  global RING = {ring}
-  global buf = [{zeros6}]
-  global hot = [{falses}]
-  global head = 0
-  global tail = 0
-  global ended = False
-  global asked = False
-  global heat = False
-  def heat_set(on):
+    return f"""  def heat_set(on, l):
     global heat
     if on != heat:
       if on:
@@ -183,7 +184,38 @@ def forward_program(host: str, port: int, settings: ForwardSettings, heat: Heat 
       heat = on
     end
   end
-  def receive():
+"""
+
+
+def forward_program(host: str, port: int, settings: ForwardSettings, heat: Heat | None,
+                    connect_timeout: float = 10.0, levels: bool = False) -> str:  # fmt: skip
+    """The URScript program of a forwarded run (module doc): it connects to ``host:port``
+    (the runner), fills its buffer, plays the samples, stops along the path when they run
+    short or on request, and reports in :data:`REG_SAMPLE` / :data:`REG_STATE`; with
+    ``levels`` it sets ``heat``'s analog output to each sample's set-point."""
+    s = settings
+    ring = s.ring
+    prefill = s.ahead
+    fill_periods = math.ceil(connect_timeout / s.period)
+    hold_periods = math.ceil((10.0 * s.lookahead + 0.5) / s.period)
+    servo = f"t={s.period!r}, lookahead_time={s.lookahead!r}, gain={s.gain!r}"
+    zeros6 = ", ".join(["0.0"] * (6 * ring))
+    falses = ", ".join(["False"] * ring)
+    zeros1 = ", ".join(["0.0"] * ring)
+    return f"""def rr_forward():
+  # ruledrobot forwarded run: the plan's samples arrive ahead of time from {host}:{port}
+  # and play on this controller's clock, one per period (docs/rtde.md)
+  global RING = {ring}
+  global buf = [{zeros6}]
+  global hot = [{falses}]
+  global lvl = [{zeros1}]
+  global head = 0
+  global tail = 0
+  global ended = False
+  global asked = False
+  global heat = False
+  global level = 0.0
+{_heat_set(heat, levels)}  def receive():
     global tail
     global ended
     global asked
@@ -201,10 +233,11 @@ def forward_program(host: str, port: int, settings: ForwardSettings, heat: Heat 
         j = (tail % RING) * 6
         i = 0
         while i < 6:
-          buf[j + i] = m[3 + i] / {float(MICRO)!r}
+          buf[j + i] = m[4 + i] / {float(MICRO)!r}
           i = i + 1
         end
         hot[tail % RING] = m[1] == {SAMPLE_HOT}
+        lvl[tail % RING] = m[3] / {float(MICRO)!r}
         tail = tail + 1
       end
       n = n + 1
@@ -260,7 +293,7 @@ def forward_program(host: str, port: int, settings: ForwardSettings, heat: Heat 
   while head < tail or not ended:
     receive()
     if asked or (not ended and tail - head < {s.reserve}):
-      heat_set(False)
+      heat_set(False, 0.0)
       s = head - 1.0
       rate = 1.0
       while rate > 0:
@@ -291,13 +324,13 @@ def forward_program(host: str, port: int, settings: ForwardSettings, heat: Heat 
       socket_close("rr_fwd")
       halt
     end
-    heat_set(hot[head % RING])
+    heat_set(hot[head % RING], lvl[head % RING])
     last = sample(head, 0)
     servoj(last, {servo})
     write_output_integer_register({REG_SAMPLE}, head)
     head = head + 1
   end
-  heat_set(False)
+  heat_set(False, 0.0)
   settle(last)
   write_output_integer_register({REG_STATE}, {State.DONE.value})
   socket_close("rr_fwd")
