@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .trajectory import HEADER, META_FORMAT, TRAJECTORY_FORMAT, sidecar_path
+from .trajectory import HEADER, HEAT_POWER, META_FORMAT, TRAJECTORY_FORMAT, sidecar_path
 
 __all__ = ["WouldReplace", "check_export_targets", "export_targets", "file_kind"]
 
@@ -70,7 +70,7 @@ def file_kind(path: Path) -> str | None:
         return None
     text = head.decode("utf-8", errors="replace")
     first = text.splitlines()[:2]
-    if first and first[0].strip() == ",".join(HEADER):
+    if first and first[0].strip() in (",".join(HEADER), ",".join([*HEADER, HEAT_POWER])):
         return "csv"
     if len(first) == 2 and first[0].startswith("def ") and \
             first[1].strip().startswith("# ruledrobot trajectory program"):  # fmt: skip

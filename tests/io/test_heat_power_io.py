@@ -95,3 +95,11 @@ def test_an_analog_heat_power_without_full_scale_is_refused_by_the_reader(tmp_pa
     side.write_text(json.dumps(doc))
     with pytest.raises(ValueError, match=r"t\.csv with t\.json: heat\.full_scale"):
         read_trajectory(p)
+
+
+def test_an_export_with_heat_power_is_known_as_a_csv_export(tmp_path):
+    """An export replaces an earlier export of its own kind: the 14-column CSV is one."""
+    from ruledrobot.io.export_targets import file_kind
+
+    assert file_kind(write_trajectory(tmp_path / "a.csv", _traj())) == "csv"
+    assert file_kind(write_trajectory(tmp_path / "b.csv", _traj(False))) == "csv"
