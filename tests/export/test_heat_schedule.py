@@ -158,3 +158,13 @@ def test_heat_levels_only_for_an_analog_schedule():
     plain = smooth_trajectory()
     assert heat_levels(plain) is None
     assert load("ur5e") is not None
+
+
+def test_a_path_run_sends_the_set_points_to_the_child():
+    from ruledrobot.export.run_program import plan_path_run
+
+    traj = _heated()
+    ops = plan_path_run(traj, 0, wire_tolerance=0.0005).child_ops(lambda k: k)
+    heat = [op for op in ops if op[0] == "heat"]
+    assert heat and all(len(op) == 3 and op[1] == (op[2] > 0.0) for op in heat)
+    assert max(op[2] for op in heat) > 0.1 and heat[-1][2] == 0.0

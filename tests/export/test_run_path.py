@@ -190,7 +190,7 @@ def test_the_child_gets_the_programs_moves_sleeps_and_heat_switches() -> None:
     assert part.meta.heat.windows == ((0, traj.n - 100 - 600),)
     assert part.duration == pytest.approx(2.0 * (traj.t[-1] - traj.t[600]))
     later = plan_path_run(traj, 600, speed_scale=0.5, wire_tolerance=0.0005)
-    assert later.child_ops(lambda k: k)[0] == ("heat", True)
+    assert later.child_ops(lambda k: k)[0] == ("heat", True, None)
     fast = {op[6]: op[3] for op in moves}
     slow = [op for op in later.child_ops(lambda k: k + 600) if op[0] == "move"]
     common = [(fast[op[6]], op[3]) for op in slow if op[6] in fast]
