@@ -4,7 +4,8 @@ does it.
 A trajectory's :class:`~ruledrobot.robot.motion.trajectory.Heat` names the output (standard,
 configurable or tool digital output, or a standard analog output at a fraction of its
 range) and the sample ranges with the heat on.  A trajectory with a ``heat_power`` column
-on an analog output (docs/kerf.md) sets the output along the motion instead:
+on an analog output in mode ``constant`` or ``constant_kerf`` (docs/kerf.md) sets the
+output along the motion instead:
 :func:`heat_levels` are its set-points (``heat_power / full_scale``), and
 :func:`written_levels` the ones a program or a run writes (where they change by more
 than :data:`HEAT_STEP`).
@@ -42,10 +43,12 @@ HEAT_STEP = 0.002
 
 def heat_levels(traj: Trajectory) -> np.ndarray | None:
     """(M,) the analog set-point of each sample, ``heat_power / full_scale`` clipped to
-    [0, 1] (:meth:`Heat.ratio`); None unless the heat goes to an analog output and the
-    trajectory has a ``heat_power`` column (a digital output switches on and off)."""
+    [0, 1] (:meth:`Heat.ratio`); None unless the heat schedules the power
+    (:attr:`Heat.schedules_power`: an analog output in mode ``constant`` or
+    ``constant_kerf``) and the trajectory has a ``heat_power`` column (otherwise the
+    output switches on and off by the heat windows)."""
     heat = traj.meta.heat
-    if heat is None or heat.kind != "analog" or traj.heat_power is None:
+    if heat is None or not heat.schedules_power or traj.heat_power is None:
         return None
     return heat.ratio(traj.heat_power)
 

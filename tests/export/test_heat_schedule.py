@@ -103,6 +103,15 @@ def test_a_digital_output_keeps_switching_on_and_off():
     assert names.count("set_standard_digital_out") == 3  # off first, on, off at the end
 
 
+def test_an_analog_output_on_off_switches_to_its_value():
+    """mode on_off: the column is the power the plan assumes; the output goes to value."""
+    traj = _heated(mode="on_off")
+    sets = [c for c in _body(urscript_program(traj, mode="servoj"))
+            if c.name == "set_standard_analog_out"]  # fmt: skip
+    assert [c.args[1] for c in sets] == [0.0, 1.0, 0.0]
+    assert heat_levels(traj) is None
+
+
 @pytest.mark.parametrize("mode", ["movel", "movep"])
 def test_a_path_program_sets_each_blended_run_to_its_mean(mode):
     traj = _heated()

@@ -406,7 +406,7 @@ class Trajectory:
         heat = self.meta.heat
         if heat is not None and heat.schedules_power and heat.full_scale is None:
             raise ValueError(f"heat.full_scale: the heat_power column on {heat.output} "
-                             f"({heat.mode}) needs the output's full scale (W/m at 1.0)")  # fmt: skip
+                             f"({heat.mode}) needs the output's full scale (W/m at 1.0)")
         return p
 
     def with_samples(self, t: ArrayLike, q: ArrayLike, tcp: ArrayLike,
