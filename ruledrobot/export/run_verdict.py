@@ -30,6 +30,16 @@ the same way, nearest in joint space near the last match).  From them:
   its plan's own (the corner stops) plus 0.1 s: a wire that waits hot in the foam burns
   it — what a stall of the PC did to a streamed cut, and what a forwarded run's controlled
   stop prevents by switching the heat off as it decelerates;
+* **face error** (``face_error``, per cut that names the part's face; issue 33): the
+  predicted cut face of the actual wire — its chord ends moved by half the kerf the
+  model predicts from their recorded speeds and the wire's power — against the part's
+  surface (:func:`~ruledrobot.robot.wire.face.face_errors`, the plan's own check) over
+  the recorded samples matched onto the face, against the cut's ``tolerance``.  The
+  power: the analog output the controller reported times its ``full_scale`` where the
+  heat schedules it (:attr:`~ruledrobot.robot.motion.trajectory.Heat.schedules_power`),
+  else the plan's ``heat_power`` at the matched sample where the recorded output was on;
+  delayed by the heat's ``lag`` (:func:`~ruledrobot.robot.wire.kerf.wire_power`).  A
+  stop with the heat on is a burn (inf); a resume's ramp is left out (its mark);
 * **motion** (the run completed) and the **joint deviation** (the live monitor's largest).
 
 A trajectory without ``meta.cut`` (files from before the planner wrote it) has no feed
@@ -39,6 +49,7 @@ the sidecar's ``in_stock`` ranges, gate the run.
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -56,7 +67,9 @@ from ..robot.wire.cut import (
     feed_measures,
     hot_dwell,
 )
+from ..robot.wire.face import FaceError, face_errors
 from ..robot.wire.in_stock import WireInStock, largest_line_distance, wire_ends
+from ..robot.wire.kerf import wire_power
 from .run_plan import inside_mask
 from .urscript import plan_wire_tolerance
 
@@ -110,14 +123,17 @@ def recording_cut(cut: WireCut, plan_index: np.ndarray, speed_scale: float = 1.0
     """The trajectory's cut for the recorded samples.
 
     Each feed window (and its held ranges) carried over to the recorded samples whose plan
-    sample ``plan_index`` (R,) lies in it, the set speed times ``speed_scale``."""
+    sample ``plan_index`` (R,) lies in it, the set speed times ``speed_scale``; each face
+    target's ranges likewise; the material kept."""
     feeds = []
     for w in cut.feeds:
         held = tuple(r for a, b in w.held for r in _runs_in(plan_index, a, b))
         for a, b in _runs_in(plan_index, w.start, w.stop):
             feeds.append(FeedWindow(w.name, a, b, w.speed * speed_scale, w.tolerance, held,
                                     w.wire_tolerance))  # fmt: skip
-    return WireCut(cut.stock, cut.wire_length, tuple(feeds))
+    faces = tuple(dataclasses.replace(f, ranges=tuple(
+        r for a, b in f.ranges for r in _runs_in(plan_index, a, b))) for f in cut.faces)
+    return WireCut(cut.stock, cut.wire_length, tuple(feeds), faces, cut.material)
 
 
 @dataclass(frozen=True, eq=False)
@@ -130,7 +146,8 @@ class RunMeasures:
     the block; ``feeds``: per cut, on the recording (sample indices are recorded ones);
     ``wire_deviation`` m (NaN when not measured) at plan sample ``wire_deviation_at``;
     ``skipped_in_stock``: skipped samples with the planned wire in the block, as plan
-    sample ranges ``skipped_in_stock_ranges``.
+    sample ranges ``skipped_in_stock_ranges``; ``faces``: the face error per cut on the
+    recording (sample indices are recorded ones).
     """
 
     verdict: Verdict
@@ -144,6 +161,7 @@ class RunMeasures:
     skipped_in_stock: int = 0
     skipped_in_stock_ranges: tuple[tuple[int, int], ...] = ()
     max_slip: float = 0.0
+    faces: tuple[FaceError, ...] = field(default=(), repr=False)
 
     def as_dict(self) -> dict[str, Any]:
         """The measures and the verdict, JSON-ready (the recording's sidecar, ``"run"``)."""
@@ -165,6 +183,9 @@ class RunMeasures:
             "skipped_in_stock": self.skipped_in_stock,
             "skipped_in_stock_ranges": [list(r) for r in self.skipped_in_stock_ranges],
             "max_slip_s": self.max_slip,
+            "face_errors": [{"name": f.name, "max_mm": num(1e3 * f.worst), "burn": f.burn,
+                             "at_sample": int(idx[f.at]) if f.at >= 0 else None,
+                             "tolerance_mm": 1e3 * f.tolerance} for f in self.faces],
             "in_stock_recorded": [list(r) for r in self.in_stock],
             "plan_sample_first_last": [int(idx[0]), int(idx[-1])] if idx.size else None,
         }  # fmt: skip
@@ -192,7 +213,50 @@ def _without_resume_ramp(rcut: WireCut, wis: WireInStock) -> tuple[WireCut, int]
         held = tuple((max(a, ramp), b) for a, b in f.held if b > max(a, ramp))
         feeds.append(FeedWindow(f.name, f.start, f.stop, f.speed, f.tolerance, held,
                                 f.wire_tolerance))  # fmt: skip
-    return WireCut(rcut.stock, rcut.wire_length, tuple(feeds)), ramp
+    faces = tuple(dataclasses.replace(f, ranges=tuple(
+        (max(a, ramp), b) for a, b in f.ranges if b > max(a, ramp))) for f in rcut.faces)
+    return dataclasses.replace(rcut, feeds=tuple(feeds), faces=faces), ramp
+
+
+def recorded_power(traj: Trajectory, idx: np.ndarray, power: np.ndarray | None,
+                   hot: np.ndarray | None) -> np.ndarray | None:  # fmt: skip
+    """(R,) the wire's power set-point [W/m] at each recorded sample (module doc): the
+    recorded analog output times its full scale (``power``) where the heat schedules it,
+    else the plan's ``heat_power`` at the matched plan sample ``idx`` where the recorded
+    output was on (``hot``; all on when not recorded); None without a power model."""
+    heat = traj.meta.heat
+    if heat is not None and heat.schedules_power and power is not None:
+        return np.asarray(power, dtype=float)[: idx.size]
+    if traj.heat_power is None:
+        return None
+    planned = traj.heat_power[idx]
+    if heat is None or hot is None:
+        return planned
+    return np.where(np.asarray(hot, dtype=bool)[: idx.size], planned, 0.0)
+
+
+def _face_checks(traj: Trajectory, faces: dict[str, FaceError],
+                 idx: np.ndarray) -> list[Check]:  # fmt: skip
+    """``face_error`` (``face_error:NAME`` when several cuts) per cut: gating where the
+    actual wire cut the face, information where it never did."""
+    out = []
+    of = len(faces) > 1
+    for name, fe in faces.items():
+        key, label = (f"face_error:{name}", f" ({name})") if of else ("face_error", "")
+        label = "predicted cut face of the actual wire from the part's surface" + label
+        if np.isnan(fe.worst):
+            out.append(Check.info(key, label, "not measured: the actual wire never cut the "
+                                  "part's face"))  # fmt: skip
+            continue
+        k = int(idx[fe.at])
+        where = f"plan sample {k} (t = {traj.t[k]:.3f} s, {traj.phase_at(k)})"
+        detail = (f"burn at {where}: the wire stood in the foam with the heat above its "
+                  "threshold" if fe.burn else
+                  f"{1e3 * fe.worst:.3f} mm at {where}, the predicted kerf there "
+                  f"{1e3 * fe.kerf[fe.at, 0]:.3f} / {1e3 * fe.kerf[fe.at, 1]:.3f} mm at the "
+                  "wire's start / end side")  # fmt: skip
+        out.append(Check.at_most(key, label, 1e3 * fe.worst, 1e3 * fe.tolerance, "mm", detail))
+    return out
 
 
 def _dwell_check(traj: Trajectory, wis: WireInStock, hot: np.ndarray | None,
@@ -241,6 +305,7 @@ def measure_run(
     wire_tolerance: float | None = None,
     hot: np.ndarray | None = None,
     entry_in_block: float | None = None,
+    power: np.ndarray | None = None,
 ) -> RunMeasures:
     """The run's verdict and measures (module doc).
 
@@ -254,7 +319,9 @@ def measure_run(
     from rest with the wire in the block (a resume that continues in the kerf), None otherwise
     — its **resume mark** is allowed: the ramp from rest to the feed (at most
     :data:`RESUME_RAMP` s) is left out of ``feed_min`` and the pre-heat added to the hot
-    dwell's limit, both said in the checks' details."""
+    dwell's limit, both said in the checks' details (and the ramp left out of the face
+    error); ``power`` (R,): the recorded analog output times its full scale [W/m]
+    (:func:`~.heat.heat_power_from_outputs`; None: not recorded), for the face error."""
     wire_tolerance = plan_wire_tolerance(traj, wire_tolerance)
     checks = [
         Check("motion", "the motion ran to the end", status, "completed", "", "==",
@@ -326,6 +393,11 @@ def measure_run(
             f"block: its ramp to the feed ({ramp} recorded samples, at most {RESUME_RAMP:g} s) "
             f"is left out of feed_min, its pre-heat ({entry_in_block:g} s) and ramp are added "
             "to the hot dwell's limit"))  # fmt: skip
+    p = recorded_power(traj, idx, power, hot)
+    lag = 0.0 if traj.meta.heat is None else traj.meta.heat.lag
+    faces = face_errors(wis, None if p is None else wire_power(wis.t, p, lag), rcut.material,
+                        rcut.faces)  # fmt: skip
+    checks.extend(_face_checks(traj, faces, idx))
     feeds = feed_measures(wis, rcut)
     mark = (f"; a resume in the kerf: its ramp from rest ({ramp} recorded samples, "
             f"{float(wis.t[min(ramp, wis.n - 1)] - wis.t[0]):.3f} s) left out: the resume mark"
@@ -345,4 +417,5 @@ def measure_run(
             f"{1e3 * f.speed:.2f} mm/s -{100 * f.tolerance:g} %: a wider kerf "
             f"there{mark}")))  # fmt: skip
     return RunMeasures(Verdict(tuple(checks)), idx, rcut, wis.runs(), feeds, wdev, wat,
-                       skipped, n_bad, tuple(bad_runs), max_slip)  # fmt: skip
+                       skipped, n_bad, tuple(bad_runs), max_slip,
+                       tuple(faces.values()))  # fmt: skip

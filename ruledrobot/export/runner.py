@@ -482,8 +482,10 @@ def _move(
         plan_index = np.zeros(0, dtype=np.int64)
     heat = traj.meta.heat
     hot_rec = None  # the heat as the controller's outputs reported it, per recorded sample
+    power = None  # its power [W/m]: the analog output times its full scale
     if rec is not None and heat is not None:
-        hot_rec = heat_from_outputs(heat, np.concatenate([c[4] for c in out.chunks]))
+        outputs = np.concatenate([c[4] for c in out.chunks])
+        hot_rec, power = heat_from_outputs(heat, outputs), heat_power_from_outputs(heat, outputs)
     # a run that entered from rest with the wire in the block (a resume in the kerf): its
     # resume mark (ramp, pre-heat) is allowed and said (run_verdict.measure_run)
     in_block = entry.kind == "continue" and bool(inside_mask(traj)[entry.sample])
@@ -494,12 +496,10 @@ def _move(
                            max_slip=result.max_slip, max_latency=o["max_latency"],
                            max_deviation=result.max_deviation,
                            deviation_limit=o["deviation_limit"], speed_scale=speed_scale,
-                           wire_tolerance=o["wire_tolerance"])  # fmt: skip
+                           wire_tolerance=o["wire_tolerance"], power=power)  # fmt: skip
     result.measures, result.run_verdict = measures, measures.verdict
     if rec is not None:  # the recording measures itself with the cut carried over to it;
         # its heat_power: the analog output the controller reported, times its full scale
-        power = None if heat is None else heat_power_from_outputs(
-            heat, np.concatenate([c[4] for c in out.chunks]))  # fmt: skip
         rec = Trajectory(rec.t, rec.q, rec.tcp,
                          rec.meta.replace(cut=measures.cut, in_stock=measures.in_stock), power)
     result.actual = rec
