@@ -18,7 +18,8 @@ than :data:`HEAT_STEP`).
 * :func:`send_heat_off` — the secondary program above, sent to a controller;
 * :func:`heat_from_outputs` — the heat's state read back from a run's recorded outputs,
   :func:`heat_power_from_outputs` its power (an analog output's fraction times its full
-  scale).
+  scale), and :func:`motion_power` the power along any motion of the plan (a recording, a
+  program's generated motion) for the face error.
 """
 
 from __future__ import annotations
@@ -32,8 +33,8 @@ from ..protocol.primary import SECONDARY_PORT
 from ..robot.motion.trajectory import Heat, Trajectory
 
 __all__ = ["HEAT_STEP", "heat_from_outputs", "heat_levels", "heat_off_program",
-           "heat_power_from_outputs", "send_heat_off", "set_heat_rtde", "urscript_heat",
-           "written_levels"]
+           "heat_power_from_outputs", "motion_power", "send_heat_off", "set_heat_rtde",
+           "urscript_heat", "written_levels"]
 
 #: the smallest change of an analog heat set-point that a program or a run writes, as a
 #: fraction of the output's range (0.2 %: the wire's power follows it within 0.2 % of full
@@ -95,6 +96,25 @@ def heat_power_from_outputs(heat: Heat, outputs: np.ndarray) -> np.ndarray | Non
         return None
     o = np.asarray(outputs, dtype=float).reshape(-1, 3)
     return np.nan_to_num(o[:, 1 + heat.index], nan=0.0) * heat.full_scale
+
+
+def motion_power(traj: Trajectory, idx: np.ndarray, power: np.ndarray | None,
+                 hot: np.ndarray | None) -> np.ndarray | None:  # fmt: skip
+    """(R,) the wire's power set-point [W/m] at each sample of a motion of ``traj`` (a run's
+    recording, a program's generated motion) matched to plan samples ``idx`` (R,): its
+    analog output times the full scale (``power``, :func:`heat_power_from_outputs`) where
+    the heat schedules it (:attr:`Heat.schedules_power`), else the plan's ``heat_power`` at
+    the matched sample where the output was on (``hot`` (R,); all on when None); None
+    without a power model (the cut's constant kerf is judged then)."""
+    heat = traj.meta.heat
+    if heat is not None and heat.schedules_power and power is not None:
+        return np.asarray(power, dtype=float)[: idx.size]
+    if traj.heat_power is None:
+        return None
+    planned = traj.heat_power[idx]
+    if heat is None or hot is None:
+        return planned
+    return np.where(np.asarray(hot, dtype=bool)[: idx.size], planned, 0.0)
 
 
 def heat_off_program(heat: Heat) -> str:

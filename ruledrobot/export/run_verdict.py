@@ -70,8 +70,10 @@ from ..robot.wire.cut import (
 from ..robot.wire.face import FaceError, face_errors
 from ..robot.wire.in_stock import WireInStock, largest_line_distance, wire_ends
 from ..robot.wire.kerf import wire_power
+from .heat import motion_power
 from .run_plan import inside_mask
 from .urscript import plan_wire_tolerance
+from .verify_program import carried_faces
 
 __all__ = [
     "DEVIATION_LIMIT",
@@ -131,9 +133,8 @@ def recording_cut(cut: WireCut, plan_index: np.ndarray, speed_scale: float = 1.0
         for a, b in _runs_in(plan_index, w.start, w.stop):
             feeds.append(FeedWindow(w.name, a, b, w.speed * speed_scale, w.tolerance, held,
                                     w.wire_tolerance))  # fmt: skip
-    faces = tuple(dataclasses.replace(f, ranges=tuple(
-        r for a, b in f.ranges for r in _runs_in(plan_index, a, b))) for f in cut.faces)
-    return WireCut(cut.stock, cut.wire_length, tuple(feeds), faces, cut.material)
+    return WireCut(cut.stock, cut.wire_length, tuple(feeds), carried_faces(cut.faces, plan_index),
+                   cut.material)  # fmt: skip
 
 
 @dataclass(frozen=True, eq=False)
@@ -216,23 +217,6 @@ def _without_resume_ramp(rcut: WireCut, wis: WireInStock) -> tuple[WireCut, int]
     faces = tuple(dataclasses.replace(f, ranges=tuple(
         (max(a, ramp), b) for a, b in f.ranges if b > max(a, ramp))) for f in rcut.faces)
     return dataclasses.replace(rcut, feeds=tuple(feeds), faces=faces), ramp
-
-
-def recorded_power(traj: Trajectory, idx: np.ndarray, power: np.ndarray | None,
-                   hot: np.ndarray | None) -> np.ndarray | None:  # fmt: skip
-    """(R,) the wire's power set-point [W/m] at each recorded sample (module doc): the
-    recorded analog output times its full scale (``power``) where the heat schedules it,
-    else the plan's ``heat_power`` at the matched plan sample ``idx`` where the recorded
-    output was on (``hot``; all on when not recorded); None without a power model."""
-    heat = traj.meta.heat
-    if heat is not None and heat.schedules_power and power is not None:
-        return np.asarray(power, dtype=float)[: idx.size]
-    if traj.heat_power is None:
-        return None
-    planned = traj.heat_power[idx]
-    if heat is None or hot is None:
-        return planned
-    return np.where(np.asarray(hot, dtype=bool)[: idx.size], planned, 0.0)
 
 
 def _face_checks(traj: Trajectory, faces: dict[str, FaceError],
@@ -393,7 +377,7 @@ def measure_run(
             f"block: its ramp to the feed ({ramp} recorded samples, at most {RESUME_RAMP:g} s) "
             f"is left out of feed_min, its pre-heat ({entry_in_block:g} s) and ramp are added "
             "to the hot dwell's limit"))  # fmt: skip
-    p = recorded_power(traj, idx, power, hot)
+    p = motion_power(traj, idx, power, hot)
     lag = 0.0 if traj.meta.heat is None else traj.meta.heat.lag
     faces = face_errors(wis, None if p is None else wire_power(wis.t, p, lag), rcut.material,
                         rcut.faces)  # fmt: skip

@@ -21,16 +21,24 @@ block (:meth:`WireCut.measure <ruledrobot.robot.wire.cut.WireCut.measure>`,
   the stock, against ``wire_tolerance``.  Its resolution is half the plan's step along
   the path (0.01 mm at 10 mm/s and 500 Hz).
 
-A program that breaks either is refused (:class:`ProgramRefused`, with the numbers).
+* **face error** (issue 33), for cuts that name the part's face: the predicted cut face
+  of the program's wire (:func:`~ruledrobot.robot.wire.face.face_errors`, the plan's own
+  check) with the power the program sets — its analog set-points times the full scale
+  where the heat schedules the power, else the plan's ``heat_power`` where the program
+  has the heat on (:func:`~.heat.motion_power`), delayed by the heat's lag — against
+  each cut's ``tolerance``.
+
+A program that breaks any is refused (:class:`ProgramRefused`, with the numbers).
 A trajectory without a cut (``meta.cut`` None: no block, no feed) is measured on its
 TCP alone: the TCP's distance from the nearest plan TCP, against ``wire_tolerance``.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -39,7 +47,10 @@ from ..robot.motion.arm_kinematics import ArmKinematics
 from ..robot.motion.trajectory import Trajectory, model_for
 from ..robot.motion.ur_motion import PathMotion, Segment, joint_segment, linear_segment
 from ..robot.wire.cut import WIRE_TOLERANCE, FeedMeasure, FeedWindow, WireCut, feed_measures
-from ..robot.wire.in_stock import largest_line_distance, wire_ends
+from ..robot.wire.face import FaceError, FaceTarget, face_errors
+from ..robot.wire.in_stock import WireInStock, largest_line_distance, wire_ends
+from ..robot.wire.kerf import wire_power
+from .heat import motion_power
 
 __all__ = [
     "MATCH_WINDOW",
@@ -48,6 +59,7 @@ __all__ = [
     "ProgramRefused",
     "Sleep",
     "Switch",
+    "carried_faces",
     "check_path_program",
     "measure_motion",
     "refuse_unless_ok",
@@ -106,7 +118,8 @@ class ProgramCheck:
     ``feeds``: per cut the feed figures on the program's motion (empty without a cut);
     ``wire_deviation`` m (largest, in the stock; of the TCP without a cut) at program
     time ``at_deviation`` s; ``wire_tolerance`` m; ``duration`` / ``planned_duration`` s;
-    ``samples`` of the program's motion.
+    ``samples`` of the program's motion; ``faces``: the face error per cut on it (empty
+    when the plan names no face).
     """
 
     feeds: tuple[FeedMeasure, ...]
@@ -117,6 +130,7 @@ class ProgramCheck:
     planned_duration: float
     samples: int
     times: np.ndarray
+    faces: tuple[FaceError, ...] = field(default=(), repr=False)
 
     @property
     def deviation_ok(self) -> bool:
@@ -125,10 +139,11 @@ class ProgramCheck:
 
     @property
     def ok(self) -> bool:
-        """Whether the program passes: the wire deviation and every cut's feed within
-        tolerance.
+        """Whether the program passes: the wire deviation, every cut's feed and every cut's
+        face (where the wire is on it) within tolerance.
         """
-        return self.deviation_ok and all(f.max_ok and f.min_ok for f in self.feeds)
+        return (self.deviation_ok and all(f.max_ok and f.min_ok for f in self.feeds)
+                and all(f.ok or np.isnan(f.worst) for f in self.faces))  # fmt: skip
 
     def failures(self) -> list[str]:
         """What fails, in words with the numbers (empty when the program passes)."""
@@ -143,6 +158,11 @@ class ProgramCheck:
                 out.append(f"{what}: feed {f.lowest * 1e3:.2f} mm/s at t = "
                            f"{self._t(f.at_lowest):.2f} s, below "
                            f"{f.speed * (1 - f.tolerance) * 1e3:.2f} mm/s")  # fmt: skip
+        for f in self.faces:
+            if not (f.ok or np.isnan(f.worst)):
+                how = "burns" if f.burn else f"lies {f.worst * 1e3:.3f} mm from the part"
+                out.append(f"cut {f.name!r}: the predicted face {how} at t = "
+                           f"{self._t(f.at):.2f} s, beyond {f.tolerance * 1e3:.3g} mm")
         if not self.deviation_ok:
             what = "wire" if self.feeds else "TCP"
             out.append(f"{what} {self.wire_deviation * 1e3:.2f} mm from the plan's at t = "
@@ -161,6 +181,8 @@ class ProgramCheck:
         what = "wire" if self.feeds else "TCP"
         parts.append(f"{what} within {self.wire_deviation * 1e3:.3f} mm of the plan "
                      f"(<= {self.wire_tolerance * 1e3:.3g} mm)")  # fmt: skip
+        parts += [f"{f.name} face within {f.worst * 1e3:.3f} mm of the part (<= "
+                  f"{f.tolerance * 1e3:.3g} mm)" for f in self.faces if not np.isnan(f.worst)]
         parts.append(f"{self.duration:.2f} s (plan {self.planned_duration:.2f} s)")
         return "; ".join(parts)
 
@@ -173,13 +195,24 @@ def simulate_path_program(
     the controller generates them: consecutive moves with ``r > 0`` form one blended
     path (:class:`~ruledrobot.robot.motion.ur_motion.PathMotion`), a move with ``r = 0`` or any
     other statement ends it; a sleep holds for whole periods."""
+    t, q, _ = _simulate(traj, ops, q0)
+    return t, q
+
+
+def _simulate(traj: Trajectory, ops: Sequence[Op], q0: np.ndarray | None = None
+              ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:  # fmt: skip
+    """:func:`simulate_path_program` and the heat at each setpoint (N,): the analog
+    set-point of the last :class:`Switch` with a value, else 1.0 / 0.0 for on / off (0
+    before the first)."""
     model = model_for(traj.meta)
     kin = ArmKinematics(model)
     period = float(model.control_period)
     q = np.asarray(traj.q[0] if q0 is None else q0, dtype=float).copy()
     out = [q.copy()]
+    level, levels = 0.0, [0.0]
     n = 0
     while n < len(ops):
+        levels.extend([level] * (len(out) - len(levels)))
         op = ops[n]
         if isinstance(op, Move):
             segs: list[Segment] = []
@@ -202,8 +235,11 @@ def simulate_path_program(
         if isinstance(op, Sleep):
             ticks = max(1, math.ceil(op.seconds / period - 1e-9))
             out.extend([q.copy()] * ticks)
+        elif isinstance(op, Switch):
+            level = op.value if op.value is not None else (1.0 if op.on else 0.0)
+    levels.extend([level] * (len(out) - len(levels)))
     qa = np.asarray(out)
-    return period * np.arange(qa.shape[0]), qa
+    return period * np.arange(qa.shape[0]), qa, np.asarray(levels)
 
 
 def _match(plan_t: np.ndarray, plan_x: np.ndarray, t: np.ndarray, x: np.ndarray,
@@ -229,6 +265,14 @@ def _match(plan_t: np.ndarray, plan_x: np.ndarray, t: np.ndarray, x: np.ndarray,
     return out
 
 
+def carried_faces(faces: tuple[FaceTarget, ...], match: np.ndarray) -> tuple[FaceTarget, ...]:
+    """The face targets carried to the samples of another motion: each range becomes the
+    runs of samples whose plan sample ``match`` (N,) lies in it."""
+    return tuple(dataclasses.replace(f, ranges=tuple(
+        r for a, b in f.ranges for r in runs_of((match >= a) & (match < b))))
+        for f in faces)  # fmt: skip
+
+
 def _carried(cut: WireCut, match: np.ndarray) -> WireCut:
     """The plan's feed windows carried to the program's samples by ``match``."""
     feeds = []
@@ -252,10 +296,12 @@ def measure_motion(
     *,
     wire_tolerance: float = WIRE_TOLERANCE,
     window: float = MATCH_WINDOW,
+    level: np.ndarray | None = None,
 ) -> ProgramCheck:
     """Measure a joint motion ``(t, q)`` of ``traj``'s robot and TCP — a program's
     generated motion, or what a controller recorded, ``t`` from the start of the plan's
-    first sample — against the plan (module doc)."""
+    first sample — against the plan (module doc); ``level`` (N,): the heat output at each
+    sample (an analog fraction, or 1 / 0 for on / off; None: the plan's power)."""
     t = np.asarray(t, dtype=float)
     robot = model_for(traj.meta)
     poses = robot.fk(np.asarray(q, dtype=float))
@@ -280,8 +326,24 @@ def measure_motion(
             a, b = plan_ends[m, 0], plan_ends[m, 1]
             dev[inside] = largest_line_distance(chord, a, b - a)
     k = int(np.argmax(dev))
+    faces = () if cut is None else _faces(traj, wis, match, level)
     return ProgramCheck(feeds, float(dev[k]), float(t[k]), float(wire_tolerance),
-                        float(t[-1] - t[0]), float(plan_t[-1]), int(t.size), t)  # fmt: skip
+                        float(t[-1] - t[0]), float(plan_t[-1]), int(t.size), t,
+                        faces)  # fmt: skip
+
+
+def _faces(traj: Trajectory, wis: WireInStock, match: np.ndarray,
+           level: np.ndarray | None) -> tuple[FaceError, ...]:  # fmt: skip
+    """The face error per cut of a motion (module doc)."""
+    cut, heat = traj.meta.cut, traj.meta.heat
+    if cut is None or not cut.faces:
+        return ()
+    full = None if heat is None or heat.full_scale is None or level is None else heat.full_scale
+    p = motion_power(traj, match, None if full is None else level * full,
+                     None if level is None else level > 0.0)  # fmt: skip
+    lag = 0.0 if heat is None else heat.lag
+    power = None if p is None else wire_power(wis.t, p, lag)
+    return tuple(face_errors(wis, power, cut.material, carried_faces(cut.faces, match)).values())
 
 
 def check_path_program(
@@ -294,8 +356,9 @@ def check_path_program(
     """Generate the motion of ``ops`` (:func:`simulate_path_program`) and measure it
     against ``traj`` (:func:`measure_motion`).  Returns the figures; raises nothing (see
     :meth:`ProgramCheck.failures`)."""
-    t, q = simulate_path_program(traj, ops)
-    return measure_motion(traj, t, q, wire_tolerance=wire_tolerance, window=window)
+    t, q, level = _simulate(traj, ops)
+    return measure_motion(traj, t, q, wire_tolerance=wire_tolerance, window=window,
+                          level=level)  # fmt: skip
 
 
 def refuse_unless_ok(check: ProgramCheck, mode: str) -> None:

@@ -3,13 +3,16 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 
-from ruledrobot.export.run_verdict import measure_run, recorded_power
+from ruledrobot.export.heat import motion_power
+from ruledrobot.export.run_verdict import measure_run
 from ruledrobot.wirecut.job.load import load_job
 from ruledrobot.wirecut.plan import make_plan
-from tests.wirecut.kerf.panel import write_corner
+from tests.wirecut.kerf.panel import write_corner, write_panel
 
 HEAT = ('heat = { output = "analog:0", mode = "constant_kerf", full_scale = 200.0, '
         "lag = 0.05, preheat = 0.3 }")
@@ -53,8 +56,47 @@ def test_without_a_recorded_output_the_planned_power_counts_where_the_output_was
     """No analog reading: the plan's power where the recorded heat was on, 0 elsewhere."""
     idx = np.arange(corner.n)
     on = corner.heat_power > 0.0
-    np.testing.assert_array_equal(recorded_power(corner, idx, None, on), corner.heat_power)
-    off = recorded_power(corner, idx, None, np.zeros(corner.n, dtype=bool))
+    np.testing.assert_array_equal(motion_power(corner, idx, None, on), corner.heat_power)
+    off = motion_power(corner, idx, None, np.zeros(corner.n, dtype=bool))
     assert not off.any()
     cold = _verdict(corner, None, np.zeros(corner.n, dtype=bool)).verdict["face_error"]
     assert not cold.ok  # a cold wire melts only its own width: the face stays proud
+
+
+
+def _path_check(traj, value=None):
+    """The movel program of ``traj`` measured (its motion generated), with every heat-on
+    set-point replaced by ``value`` when given."""
+    from ruledrobot.export.urscript import path_program
+    from ruledrobot.export.verify_program import Switch, check_path_program
+
+    ops = path_program(traj)
+    assert any(isinstance(op, Switch) and op.value for op in ops)
+    if value is not None:
+        ops = [dataclasses.replace(op, value=value) if isinstance(op, Switch) and op.on
+               else op for op in ops]  # fmt: skip
+    return check_path_program(traj, ops, wire_tolerance=0.0005)
+
+
+def test_a_path_program_is_verified_with_the_set_points_it_writes(tmp_path_factory):
+    """The tapered panel (no stop in the block): its movel program, one set-point for its
+    blended run, cuts the face within tolerance; the same program with its output at a
+    fifth of that set-point leaves the face proud (only the wire's own width melted)."""
+    job = write_panel(tmp_path_factory.mktemp("panel"), HEAT)
+    traj = make_plan(load_job(job)).trajectory
+    good = _path_check(traj)
+    (fe,) = good.faces
+    assert good.ok and fe.ok and "cut face within" in good.summary()
+    assert fe.worst == pytest.approx(traj.face_errors()["cut"].worst, abs=5e-5)
+    cold = _path_check(traj, 0.2 * max(traj.heat_power) / 200.0)
+    assert not cold.ok and not cold.faces[0].ok
+    assert any("from the part" in f for f in cold.failures())
+
+
+def test_a_path_program_that_holds_the_power_through_a_corner_stop_is_refused(corner):
+    """A statement between blended moves would stop the arm, so a path program holds one
+    set-point per blended run: into the corner stop it holds the run's mean, the wire
+    stands hot at the stop and the verification refuses the program (stream it)."""
+    check = _path_check(corner)
+    assert not check.ok and check.faces[0].burn
+    assert any("burns" in f for f in check.failures())
