@@ -12,7 +12,8 @@ the same way, nearest in joint space near the last match).  From them:
 * **feed** (``feed_max:NAME``, ``feed_min:NAME``): :func:`~ruledrobot.robot.wire.cut.feed_measures`
   of the actual wire against the trajectory's cut (``meta.cut``), whose feed windows
   (plan samples) are carried over to the recorded samples matched into them; the set
-  speed scales with the run's ``speed_scale``;
+  speed scales with the run's ``speed_scale``; information (the time law's target) for a
+  cut whose face error is measured: the face decides, as in the plan's verdict;
 * **wire deviation** (``wire_deviation``): where the actual wire is in the block, the
   distance of its chord's two ends from the planned wire (the line) at the matched
   plan sample — the largest distance of a chord point, since the distance of a point
@@ -392,14 +393,18 @@ def measure_run(
         scaled = f" at speed scale {speed_scale:g}" if speed_scale != 1.0 else ""
         at_hi = int(idx[f.at_highest]) if f.at_highest >= 0 else -1
         at_lo = int(idx[f.at_lowest]) if f.at_lowest >= 0 else -1
-        checks.extend(f.checks(key, (
+        pair = f.checks(key, (
             f"highest feed of the actual wire in the block{name}{scaled}",
             f"lowest feed of the actual wire in the block{name}{scaled}"), (
             f"{1e3 * f.highest:.2f} mm/s at plan sample {at_hi} against "
             f"{1e3 * f.speed:.2f} mm/s +{100 * f.tolerance:g} %: the wire drags",
             f"{1e3 * f.lowest:.2f} mm/s at plan sample {at_lo} against "
             f"{1e3 * f.speed:.2f} mm/s -{100 * f.tolerance:g} %: a wider kerf "
-            f"there{mark}")))  # fmt: skip
+            f"there{mark}"))  # fmt: skip
+        face = faces.get(f.name)
+        if face is not None and not np.isnan(face.worst):  # the face decides (as the plan's)
+            pair = tuple(dataclasses.replace(c, gating=False) for c in pair)
+        checks.extend(pair)
     return RunMeasures(Verdict(tuple(checks)), idx, rcut, wis.runs(), feeds, wdev, wat,
                        skipped, n_bad, tuple(bad_runs), max_slip,
                        tuple(faces.values()))  # fmt: skip

@@ -28,7 +28,9 @@ block (:meth:`WireCut.measure <ruledrobot.robot.wire.cut.WireCut.measure>`,
   has the heat on (:func:`~.heat.motion_power`), delayed by the heat's lag — against
   each cut's ``tolerance``.
 
-A program that breaks any is refused (:class:`ProgramRefused`, with the numbers).
+A program that breaks any is refused (:class:`ProgramRefused`, with the numbers); a cut
+whose face error is measured is judged by its face, its feed is information (the time
+law's target), as in the plan's verdict.
 A trajectory without a cut (``meta.cut`` None: no block, no feed) is measured on its
 TCP alone: the TCP's distance from the nearest plan TCP, against ``wire_tolerance``.
 """
@@ -139,16 +141,25 @@ class ProgramCheck:
 
     @property
     def ok(self) -> bool:
-        """Whether the program passes: the wire deviation, every cut's feed and every cut's
-        face (where the wire is on it) within tolerance.
+        """Whether the program passes: the wire deviation, every cut's face (where the wire
+        is on it) and the feed of every cut without a measured face within tolerance.
         """
-        return (self.deviation_ok and all(f.max_ok and f.min_ok for f in self.feeds)
+        return (self.deviation_ok
+                and all(f.max_ok and f.min_ok for f in self.feeds if f.name not in self._faced)
                 and all(f.ok or np.isnan(f.worst) for f in self.faces))  # fmt: skip
+
+    @property
+    def _faced(self) -> set[str]:
+        """The cuts whose face error is measured: their face decides, their feed informs
+        (the time law's target), as in the plan's verdict."""
+        return {f.name for f in self.faces if not np.isnan(f.worst)}
 
     def failures(self) -> list[str]:
         """What fails, in words with the numbers (empty when the program passes)."""
         out = []
         for f in self.feeds:
+            if f.name in self._faced:
+                continue
             what = f"cut {f.name!r} ({f.speed * 1e3:.4g} mm/s ± {f.tolerance * 100:.3g} %)"
             if not f.max_ok:
                 out.append(f"{what}: feed {f.highest * 1e3:.2f} mm/s at t = "

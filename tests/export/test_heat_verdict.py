@@ -42,6 +42,8 @@ def test_a_recording_with_the_planned_power_passes_as_the_plan_does(corner):
     assert check.value == pytest.approx(1e3 * plan.worst, rel=1e-9)
     (fe,) = m.faces
     assert m.as_dict()["face_errors"][0]["max_mm"] == pytest.approx(1e3 * fe.worst)
+    # the face decides; the feed window informs (as in the plan's verdict)
+    assert not m.verdict["feed_min"].gating and not m.verdict["feed_max"].gating
 
 
 def test_an_output_held_at_the_cut_power_burns_at_the_corner_stop(corner):
