@@ -43,8 +43,10 @@ HEAT_STEP = 0.002
 
 
 def heat_levels(traj: Trajectory) -> np.ndarray | None:
-    """(M,) the analog set-point of each sample, ``heat_power / full_scale`` clipped to
-    [0, 1] (:meth:`Heat.ratio`); None unless the heat schedules the power
+    """The analog set-point (M,) of each sample of ``traj``, or None.
+
+    ``heat_power / full_scale`` clipped to [0, 1] (:meth:`Heat.ratio`); None unless the
+    heat schedules the power
     (:attr:`Heat.schedules_power`: an analog output in mode ``constant`` or
     ``constant_kerf``) and the trajectory has a ``heat_power`` column (otherwise the
     output switches on and off by the heat windows)."""
@@ -55,9 +57,11 @@ def heat_levels(traj: Trajectory) -> np.ndarray | None:
 
 
 def written_levels(levels: np.ndarray, step: float = HEAT_STEP) -> np.ndarray:
-    """(M,) the set-points as written: ``levels[k]`` at each sample where its band of width
-    ``step`` changes (zero is a band of its own: off and on are always written), held
-    until the next: within ``step`` of ``levels`` everywhere."""
+    """The set-points (M,) as a program or a run writes them.
+
+    ``levels[k]`` at each sample where its band of width ``step`` changes (zero is a band
+    of its own: off and on are always written), held until the next: within ``step`` of
+    ``levels`` everywhere."""
     lv = np.asarray(levels, dtype=np.float64)
     if lv.size == 0:
         return lv.copy()
@@ -67,8 +71,9 @@ def written_levels(levels: np.ndarray, step: float = HEAT_STEP) -> np.ndarray:
 
 
 def urscript_heat(heat: Heat, on: bool, value: float | None = None) -> str:
-    """The URScript statement that switches ``heat`` on or off (no indent, no newline);
-    an analog output goes to ``value`` (a set-point of :func:`heat_levels`) when given,
+    """The URScript statement that switches ``heat`` on or off (no indent, no newline).
+
+    An analog output goes to ``value`` (a set-point of :func:`heat_levels`) when given,
     else to ``heat.value`` when on and 0 when off."""
     if heat.kind == "analog":
         level = value if value is not None else (heat.value if on else 0.0)
@@ -89,8 +94,10 @@ def heat_from_outputs(heat: Heat, outputs: np.ndarray) -> np.ndarray:
 
 
 def heat_power_from_outputs(heat: Heat, outputs: np.ndarray) -> np.ndarray | None:
-    """(M,) the wire power set-point [W/m] in recorded outputs (M, 3) (as
-    :func:`heat_from_outputs`): the analog output's fraction times ``heat.full_scale``
+    """The wire power set-point (M,) [W/m] in recorded outputs (M, 3), or None.
+
+    As :func:`heat_from_outputs` reads them: the analog output's fraction times
+    ``heat.full_scale``
     (NaN rows: 0); None unless the heat is an analog output with a full scale."""
     if heat.kind != "analog" or heat.full_scale is None:
         return None
@@ -100,8 +107,10 @@ def heat_power_from_outputs(heat: Heat, outputs: np.ndarray) -> np.ndarray | Non
 
 def motion_power(traj: Trajectory, idx: np.ndarray, power: np.ndarray | None,
                  hot: np.ndarray | None) -> np.ndarray | None:  # fmt: skip
-    """(R,) the wire's power set-point [W/m] at each sample of a motion of ``traj`` (a run's
-    recording, a program's generated motion) matched to plan samples ``idx`` (R,): its
+    """The wire's power set-point (R,) [W/m] along a motion of ``traj``, or None.
+
+    The motion (a run's recording, a program's generated motion) is matched to plan
+    samples ``idx`` (R,); the power: its
     analog output times the full scale (``power``, :func:`heat_power_from_outputs`) where
     the heat schedules it (:attr:`Heat.schedules_power`), else the plan's ``heat_power`` at
     the matched sample where the output was on (``hot`` (R,); all on when None); None
@@ -125,8 +134,9 @@ def heat_off_program(heat: Heat) -> str:
 
 
 def set_heat_rtde(io: Any, heat: Heat, on: bool, value: float | None = None) -> bool:
-    """Switch ``heat`` through an ``rtde_io.RTDEIOInterface`` (an analog output to ``value``
-    when given, as :func:`urscript_heat`); ur_rtde's return value."""
+    """Switch ``heat`` through an ``rtde_io.RTDEIOInterface``; ur_rtde's return value.
+
+    An analog output goes to ``value`` when given, as :func:`urscript_heat`."""
     n = heat.index
     if heat.kind == "standard":
         return bool(io.setStandardDigitalOut(n, on))

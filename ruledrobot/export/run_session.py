@@ -188,8 +188,9 @@ class Session:
         self.set_heat(False)
 
     def set_heat(self, on: bool, value: float | None = None) -> None:
-        """Switch the wire's heat (no-op without heat), an analog output to the set-point
-        ``value`` when given (a scheduled power); a refusal stops the run."""
+        """Switch the wire's heat (no-op without heat); a refusal stops the run.
+
+        An analog output goes to the set-point ``value`` when given (a scheduled power)."""
         if self.heat is None or self.io is None:
             return
         if not set_heat_rtde(self.io, self.heat, on, value):

@@ -93,8 +93,10 @@ class Sleep:
 
 @dataclass(frozen=True)
 class Switch:
-    """The heat output switched on or off (takes no time); ``value``: an analog output's
-    set-point (a fraction of its range) when the plan schedules the wire's power."""
+    """The heat output switched on or off (takes no time).
+
+    ``value``: an analog output's set-point (a fraction of its range) when the plan
+    schedules the wire's power."""
 
     on: bool
     value: float | None = None
@@ -277,8 +279,9 @@ def _match(plan_t: np.ndarray, plan_x: np.ndarray, t: np.ndarray, x: np.ndarray,
 
 
 def carried_faces(faces: tuple[FaceTarget, ...], match: np.ndarray) -> tuple[FaceTarget, ...]:
-    """The face targets carried to the samples of another motion: each range becomes the
-    runs of samples whose plan sample ``match`` (N,) lies in it."""
+    """The face targets carried to the samples of another motion.
+
+    Each range becomes the runs of samples whose plan sample ``match`` (N,) lies in it."""
     return tuple(dataclasses.replace(f, ranges=tuple(
         r for a, b in f.ranges for r in runs_of((match >= a) & (match < b))))
         for f in faces)  # fmt: skip

@@ -124,8 +124,10 @@ class ForwardSettings:
 
 def sample_messages(q: np.ndarray, hot: np.ndarray | None, k0: int,
                     levels: np.ndarray | None = None) -> bytes:  # fmt: skip
-    """Messages of samples ``k0, k0 + 1, ...``: ``q`` (n, 6) [rad], ``hot`` (n,) or None,
-    ``levels`` (n,) analog set-points in [0, 1] or None."""
+    """The messages of samples ``k0, k0 + 1, ...``.
+
+    ``q`` (n, 6) [rad], ``hot`` (n,) or None, ``levels`` (n,) analog set-points in [0, 1]
+    or None."""
     q = np.asarray(q, dtype=float).reshape(-1, 6)
     n = q.shape[0]
     out = np.empty((n, WORDS), dtype=">i4")

@@ -226,7 +226,8 @@ class Heat:
         object.__setattr__(self, "lag", _seconds_or_watts("lag", self.lag))
 
     def ratio(self, power: ArrayLike) -> FloatArray:
-        """The analog set-point (broadcast shape) in [0, 1] for wire ``power`` [W/m]:
+        """The analog set-point (broadcast shape) in [0, 1] for wire ``power`` [W/m].
+
         ``power / full_scale``, clipped to the output's range."""
         if self.full_scale is None:
             raise ValueError(f"heat.full_scale: the {self.output} output has no full scale "
@@ -235,9 +236,11 @@ class Heat:
 
     @property
     def schedules_power(self) -> bool:
-        """The output follows a trajectory's ``heat_power`` (an analog output in mode
-        ``constant`` or ``constant_kerf``); otherwise it switches on (at ``value``) and
-        off by ``windows``, and a ``heat_power`` column is the power that assumes."""
+        """Whether the output follows a trajectory's ``heat_power``.
+
+        It does on an analog output in mode ``constant`` or ``constant_kerf``; otherwise it
+        switches on (at ``value``) and off by ``windows``, and a ``heat_power`` column is the
+        power that assumes."""
         return self.kind == "analog" and self.mode != "on_off"
 
     @property
@@ -412,9 +415,11 @@ class Trajectory:
     def with_samples(self, t: ArrayLike, q: ArrayLike, tcp: ArrayLike,
                      meta: TrajectoryMeta | None = None,
                      rows: ArrayLike | slice | None = None) -> Trajectory:  # fmt: skip
-        """A trajectory of new samples that keeps this one's ``heat_power`` at ``rows``
-        (indices or a slice of this one's samples; default: all) and ``meta`` (default:
-        this one's): what every method that re-cuts or re-times the samples returns."""
+        """A trajectory of new samples with this one's ``heat_power`` at ``rows``.
+
+        ``rows``: indices or a slice of this one's samples (default: all); ``meta``
+        default: this one's.  What every method that re-cuts or re-times the samples
+        returns."""
         power = self.heat_power
         if power is not None and rows is not None:
             power = power[rows]
