@@ -174,7 +174,7 @@ def read_triangles(path: Path) -> tuple[FloatArray, np.ndarray, str | None]:
 
 
 def check_size(vertices: FloatArray, spec: PartSpec, stock: Box, where: str) -> None:
-    """Raise ValueError when another unit makes the part fit the block far better.
+    """Raise ValueError when the part's size against the block points to another unit.
 
     Naming the sizes and the unit that fits, when the part, ``vertices`` (V, 3) in the
     file's units read as ``spec.units``, is :data:`SIZE_RATIO` times smaller across than the

@@ -128,7 +128,7 @@ def _between(o: FloatArray, d: FloatArray, fine: Lines, closed: bool, reach: flo
 
 def refine_rulings(p: FloatArray, d: FloatArray, closed: bool, reach: float, eps: float = EPS
                    ) -> tuple[FloatArray, FloatArray]:  # fmt: skip
-    """Refine rulings by the four-point scheme on the manifold of lines until they are dense.
+    """Refine rulings by the four-point scheme on the manifold of lines to within ``eps``.
 
     The rulings through ``p`` (N, 3) along ``d`` (N, 3) [block frame, m], refined until the
     strips between neighbours lie within ``eps`` [m] of the rulings a further step would put
