@@ -163,10 +163,12 @@ def _read(path: Path) -> bytes | None:
 
 
 def read_content(entry: JobEntry, code: str | None = None, keep: bool = False) -> JobContent:
-    """Read ``entry``'s job file and every input file it names, apply its overrides, and
-    hash them with ``code`` (default: this process's :func:`code_identity`).  ``keep``:
-    keep the input files' bytes (to send them; a batch reads them again at dispatch
-    rather than holding every job's inputs from the start)."""
+    """Read ``entry``'s job file and every input file it names, apply its overrides, hash them.
+
+    Hashed with ``code`` (default: this process's :func:`code_identity`).  ``keep``: keep
+    the input files' bytes (to send them; a batch reads them again at dispatch rather than
+    holding every job's inputs from the start).
+    """
     code = code_identity().id if code is None else code
     path = entry.path
     job_path = Path(os.path.abspath(path))

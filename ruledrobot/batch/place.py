@@ -44,10 +44,12 @@ def _score(ev: Evaluator, T: np.ndarray) -> Scores:
 
 
 class DistributedEvaluator:
-    """An :class:`~ruledrobot.wirecut.reach.evaluate.Evaluator` whose calls score the
-    candidates on the workers of ``engine`` (an open :class:`.engine.Engine`); every
-    other attribute is the evaluator's own.  ``notes`` collects what went wrong on the
-    way (chunks scored here instead)."""
+    """An :class:`~ruledrobot.wirecut.reach.evaluate.Evaluator` that scores on Dask workers.
+
+    Its calls score the candidates on the workers of ``engine`` (an open
+    :class:`.engine.Engine`); every other attribute is the evaluator's own.  ``notes``
+    collects what went wrong on the way (chunks scored here instead).
+    """
 
     def __init__(self, ev: Evaluator, engine: Engine, notes: list[str] | None = None,
                  _shared: Any = None) -> None:  # fmt: skip

@@ -324,8 +324,10 @@ def run_batch(
     timeout: float = 10.0,
     quiet: bool = True,
 ) -> BatchResult:
-    """Plan every job of ``jobs`` (arguments for :func:`~.jobs.find_jobs`, or entries)
-    into ``out/<name>/`` and write ``out/batch.json`` and ``out/batch.csv``.
+    """Plan every job of ``jobs`` into ``out/<name>/`` and write the batch's summaries.
+
+    ``jobs``: arguments for :func:`~.jobs.find_jobs`, or entries; the summaries are
+    ``out/batch.json`` and ``out/batch.csv``.
 
     ``workers``: processes of the local cluster (default: sized to the machine);
     ``scheduler``: the address of a Dask scheduler to use instead; ``force``: replan

@@ -151,8 +151,11 @@ def _part(raw: object, where: str, base_dir: Path | None) -> PartSpec:
 
 
 def absolute_paths(tables: dict[str, Any], base_dir: Path | None) -> dict[str, Any]:
-    """The job tables with the files they name (``[robot] calibration``) made absolute, so
-    that a job written in another folder names the same files."""
+    """Return the job tables with the files they name made absolute.
+
+    The files named by ``[robot] calibration``, so that a job written in another folder
+    names the same files.
+    """
     out = copy.deepcopy(tables)
     robot = out.get("robot")
     if isinstance(robot, dict) and isinstance(robot.get("calibration"), str):

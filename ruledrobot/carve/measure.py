@@ -30,8 +30,10 @@ STEP = 0.002
 
 
 def chord_samples(lines: Lines, stock: Box, step: float = STEP) -> tuple[FloatArray, np.ndarray]:
-    """Points (P, 3) along the rulings' chords in the block, every ``step`` [m], and the
-    ruling (P,) each belongs to."""
+    """Return points (P, 3) along the rulings' chords in the block and the ruling of each.
+
+    Points every ``step`` [m], and the ruling (P,) each belongs to.
+    """
     p, d = lines.point, lines.direction
     t0, t1, hit = stock.clip_lines(p, d)
     pts, owner = [], []

@@ -47,10 +47,13 @@ _FACE, _VA, _VB, _VC, _EAB, _EBC, _ECA = range(7)
 
 def closest_on_triangles(p: FloatArray, a: FloatArray, b: FloatArray,
                          c: FloatArray) -> tuple[FloatArray, np.ndarray]:  # fmt: skip
-    """The closest points ``q`` (..., 3) on triangles ``a, b, c`` (..., 3) to points ``p``
-    (..., 3) (broadcast), exact, and their feature (...) int: 0 the face's interior,
-    1-3 the vertex a, b, c, 4-6 the edge ab, bc, ca (Ericson, Real-Time Collision
-    Detection 5.1.5: the first region that holds)."""
+    """Return the exact closest points on triangles to points ``p``, and their feature.
+
+    The closest points ``q`` (..., 3) on triangles ``a, b, c`` (..., 3) to points ``p``
+    (..., 3) (broadcast), and their feature (...) int: 0 the face's interior, 1-3 the vertex
+    a, b, c, 4-6 the edge ab, bc, ca (Ericson, Real-Time Collision Detection 5.1.5: the
+    first region that holds).
+    """
     ab, ac, ap = b - a, c - a, p - a
     d1, d2 = np.einsum("...i,...i", ab, ap), np.einsum("...i,...i", ac, ap)
     bp = p - b
@@ -83,8 +86,10 @@ def closest_on_triangles(p: FloatArray, a: FloatArray, b: FloatArray,
 
 def point_triangle_distance(p: FloatArray, a: FloatArray, b: FloatArray,
                             c: FloatArray) -> FloatArray:  # fmt: skip
-    """Distance [m] from points ``p`` (..., 3) to triangles ``a, b, c`` (..., 3) (broadcast),
-    exact (:func:`closest_on_triangles`)."""
+    """Return the exact distance [m] from points ``p`` (..., 3) to triangles ``a, b, c``.
+
+    Triangles (..., 3), broadcast; by :func:`closest_on_triangles`.
+    """
     q, _ = closest_on_triangles(p, a, b, c)
     return np.linalg.norm(p - q, axis=-1)
 

@@ -126,8 +126,11 @@ def _frame(ax: Any, stock: Box, title: str) -> None:
 
 def carve_figure(part: PartMesh, plan: CutPlan, carved, stock: Box,
                  report: dict[str, Any]) -> Any:  # fmt: skip
-    """The picture (module doc) as a matplotlib Figure on an Agg canvas (no pyplot
-    state); ``carved`` the carved block's mesh or None, ``report`` carve's (volumes)."""
+    """Return the picture (module doc) as a matplotlib Figure on an Agg canvas.
+
+    No pyplot state; ``carved`` the carved block's mesh or None, ``report`` carve's
+    (volumes).
+    """
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 

@@ -79,9 +79,11 @@ class Fit:
         return float(r[np.argmin(np.abs(r - nearest))])
 
     def line_directions(self, p: FloatArray, normal: FloatArray) -> FloatArray:
-        """The unit directions (2, 3) of the lines on the surface through ``p`` (3,) (the
-        same twice on a developable, a plane's: its tangent basis); NaN when none.
-        ``normal``: the outward normal there, orienting the tangent basis."""
+        """Return the unit directions (2, 3) of the lines on the surface through ``p`` (3,).
+
+        The same twice on a developable, a plane's: its tangent basis; NaN when none.
+        ``normal``: the outward normal there, orienting the tangent basis.
+        """
         _, g = self.value_grad(p[None])
         n = g[0] / np.linalg.norm(g[0])
         if n @ normal < 0.0:

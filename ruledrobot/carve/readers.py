@@ -69,16 +69,21 @@ class PartMesh:
 
 
 def edge_counts(faces: np.ndarray) -> tuple[int, int]:
-    """``(boundary, non_manifold)``: how many undirected edges of ``faces`` (F, 3) lie in
-    one triangle only, and in three or more."""
+    """Return how many undirected edges lie in one triangle only, and in three or more.
+
+    ``(boundary, non_manifold)`` of the edges of ``faces`` (F, 3).
+    """
     e = np.sort(np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]]), axis=1)
     _, counts = np.unique(e, axis=0, return_counts=True)
     return int(np.sum(counts == 1)), int(np.sum(counts > 2))
 
 
 def misoriented_edges(faces: np.ndarray) -> int:
-    """How many edges two triangles run the same way (their orientations disagree; a
-    closed manifold whose faces agree runs every edge once each way)."""
+    """Return how many edges two triangles run the same way.
+
+    Their orientations disagree; a closed manifold whose faces agree runs every edge once
+    each way.
+    """
     e = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]])
     _, counts = np.unique(e, axis=0, return_counts=True)
     return int(np.sum(counts > 1))
@@ -134,8 +139,11 @@ def _read_3dm(path: Path) -> tuple[FloatArray, np.ndarray, str | None]:
 
 
 def read_triangles(path: Path) -> tuple[FloatArray, np.ndarray, str | None]:
-    """Vertices (file units), faces (equal vertices merged) and the unit the file states
-    (3DM only; None otherwise)."""
+    """Read the vertices, faces and stated unit of a mesh file.
+
+    Vertices (file units), faces (equal vertices merged) and the unit the file states (3DM
+    only; None otherwise).
+    """
     suffix = path.suffix.lower()
     if suffix == ".3dm":
         v, f, units = _read_3dm(path)
@@ -166,10 +174,13 @@ def read_triangles(path: Path) -> tuple[FloatArray, np.ndarray, str | None]:
 
 
 def check_size(vertices: FloatArray, spec: PartSpec, stock: Box, where: str) -> None:
-    """ValueError naming the sizes and the unit that fits when the part, ``vertices``
-    (V, 3) in the file's units read as ``spec.units``, is :data:`SIZE_RATIO` times
-    smaller across than the block ``stock``, or five times larger, and another unit
-    makes it fit the block (its sides against the block's, largest to largest)."""
+    """Raise ValueError when the part's size against the block points to another unit.
+
+    Naming the sizes and the unit that fits, when the part, ``vertices`` (V, 3) in the
+    file's units read as ``spec.units``, is :data:`SIZE_RATIO` times smaller across than the
+    block ``stock``, or five times larger, and another unit makes it fit the block (its
+    sides against the block's, largest to largest).
+    """
     ext = np.sort(np.ptp(vertices, axis=0))[::-1]  # file units, largest first
     block = np.sort(stock.size)[::-1]  # m
     across, size = float(ext[0]) * spec.scale, float(block[0])

@@ -94,10 +94,12 @@ def near_vertex_labels(vertices: FloatArray, distance: float) -> np.ndarray:
 
 
 def facet_orientation(faces: np.ndarray) -> tuple[np.ndarray, bool]:
-    """(F,) bool: the facets to turn so that every edge of two facets is run once each
-    way (in each connected piece, the smaller of its two orientation classes; of two
-    alike, the one without the piece's first facet), and whether some piece has no
-    consistent orientation.  Only edges of exactly two facets join facets."""
+    """Return the facets to turn so that every shared edge is run once each way.
+
+    (F,) bool, and whether some piece has no consistent orientation.  The facets turned are,
+    in each connected piece, the smaller of its two orientation classes (of two alike, the
+    one without the piece's first facet).  Only edges of exactly two facets join facets.
+    """
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import breadth_first_order, connected_components
 
@@ -182,10 +184,12 @@ def _vertices(n: int) -> str:
 
 def defects_message(defects: MeshDefects, vertices: FloatArray, faces: np.ndarray,
                     units: str, merge: float, repaired: bool = False) -> str:  # fmt: skip
-    """What is wrong with the mesh and where (facet indices, centres in the file's
-    ``units``), in words, and what mends it: ``repair = true`` in ``[part]`` when merging
-    vertices within ``merge`` (file units) or turning facets would (``repaired``: the mesh
-    is the repair's, and what is left it cannot mend)."""
+    """Return in words what is wrong with the mesh, where, and what mends it.
+
+    Where: facet indices, centres in the file's ``units``.  What mends it: ``repair = true``
+    in ``[part]`` when merging vertices within ``merge`` (file units) or turning facets
+    would (``repaired``: the mesh is the repair's, and what is left it cannot mend).
+    """
     shape = []
     if len(defects.boundary):
         where = _where(defects.boundary, vertices, faces, units)

@@ -128,11 +128,13 @@ def _between(o: FloatArray, d: FloatArray, fine: Lines, closed: bool, reach: flo
 
 def refine_rulings(p: FloatArray, d: FloatArray, closed: bool, reach: float, eps: float = EPS
                    ) -> tuple[FloatArray, FloatArray]:  # fmt: skip
-    """The rulings through ``p`` (N, 3) along ``d`` (N, 3) [block frame, m] refined by the
-    four-point scheme on the manifold of lines until the strips between neighbours lie
-    within ``eps`` [m] of the rulings a further step would put between them
-    (:func:`_between` over ``reach`` [m]), or :data:`MAX_STEPS`; points (M, 3) nearest the
-    origin and unit directions (M, 3)."""
+    """Refine rulings by the four-point scheme on the manifold of lines to within ``eps``.
+
+    The rulings through ``p`` (N, 3) along ``d`` (N, 3) [block frame, m], refined until the
+    strips between neighbours lie within ``eps`` [m] of the rulings a further step would put
+    between them (:func:`_between` over ``reach`` [m]), or :data:`MAX_STEPS`.  Returns
+    points (M, 3) nearest the origin and unit directions (M, 3).
+    """
     from ..subdivision import subdivide
 
     lines = Lines.from_point_direction(p, d)
@@ -149,8 +151,11 @@ def refine_rulings(p: FloatArray, d: FloatArray, closed: bool, reach: float, eps
 
 def planar(p: FloatArray, d: FloatArray, reach: float, tol: float = 1e-7
            ) -> tuple[FloatArray, float] | None:  # fmt: skip
-    """The plane ``(n (3,), n . x)`` of rulings through ``p`` (N, 3) along ``d`` (N, 3)
-    when all their points within ``reach`` [m] lie on one within ``tol`` [m], else None."""
+    """Return the plane ``(n (3,), n . x)`` of rulings when they lie on one, else None.
+
+    Rulings through ``p`` (N, 3) along ``d`` (N, 3) whose points within ``reach`` [m] all
+    lie on one plane within ``tol`` [m].
+    """
     o = nearest_points(p, d)
     pts = np.concatenate([o - reach * d, o + reach * d])
     c = pts.mean(axis=0)
@@ -310,9 +315,11 @@ def _apron(o: FloatArray, d: FloatArray, half: FloatArray, length: float, end: i
 
 def slab(p: FloatArray, d: FloatArray, keep: FloatArray, half: FloatArray, eps: float = EPS
          ) -> CutSolid:  # fmt: skip
-    """The open cut of rulings ``p``, ``d`` (N, 3) [block frame] as the slab on the side of
-    ``keep`` (3,) (module doc); NotASolid when the strip is no graph along its mean normal
-    or does not cover the block's shadow."""
+    """Return the open cut of rulings ``p``, ``d`` as the slab on the side of ``keep``.
+
+    ``p``, ``d`` (N, 3) [block frame], ``keep`` (3,) (module doc); NotASolid when the strip
+    is no graph along its mean normal or does not cover the block's shadow.
+    """
     reach = float(np.linalg.norm(half)) + MARGIN
     o = nearest_points(p, d)
     # the apron: the strip's first and last rulings continued in their plane
@@ -426,12 +433,14 @@ def to_manifold(vertices: FloatArray, faces: np.ndarray) -> Any:
 
 
 def convex_cell(normals: FloatArray, offsets: FloatArray, half: FloatArray) -> Any:
-    """The block ``|x_k| <= half_k`` (block frame, m) cut to the half-spaces ``normals . x
-    >= offsets`` ((P, 3), (P,)) as a ``manifold3d.Manifold``: a convex polytope, its
-    vertices the half-spaces' intersection (scipy's qhull) and manifold3d's hull of them,
-    in one step where manifold3d's ``trim_by_plane`` takes one per plane (0.9 s for a
-    roughing's 384 planes, against 4 ms).  An empty Manifold when nothing is left;
-    ``trim_by_plane`` in turn when qhull fails."""
+    """Return the block cut to half-spaces as a ``manifold3d.Manifold`` (a convex polytope).
+
+    The block ``|x_k| <= half_k`` (block frame, m) cut to the half-spaces ``normals . x >=
+    offsets`` ((P, 3), (P,)): its vertices the half-spaces' intersection (scipy's qhull) and
+    manifold3d's hull of them, in one step where manifold3d's ``trim_by_plane`` takes one
+    per plane (0.9 s for a roughing's 384 planes, against 4 ms).  An empty Manifold when
+    nothing is left; ``trim_by_plane`` in turn when qhull fails.
+    """
     import manifold3d as m3d
     from scipy.optimize import linprog
     from scipy.spatial import HalfspaceIntersection, QhullError

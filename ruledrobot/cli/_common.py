@@ -31,9 +31,12 @@ err = Console(stderr=True, soft_wrap=True, width=_width(__import__("sys").stderr
 
 
 def literal(text: str) -> str:
-    """Help text shown as written: typer renders help as rich markup, where ``[part]``,
-    ``[m]`` or ``[default: ...]`` is a style tag and vanishes ("... and the , , , of a
-    job"); square brackets that would read as tags are escaped."""
+    """Return help text shown as written, its square brackets escaped.
+
+    Typer renders help as rich markup, where ``[part]``, ``[m]`` or ``[default: ...]`` is a
+    style tag and vanishes ("... and the , , , of a job"); square brackets that would read
+    as tags are escaped.
+    """
     from rich.markup import escape
 
     return escape(text)

@@ -27,8 +27,10 @@ def batch(
     force: bool = typer.Option(False, "--force", help="Replan every job, also those whose "
                                "results (same content hash) are already there."),
 ) -> None:
-    """Plan many jobs in parallel, each into its own folder, with a manifest of every
-    job's result (feasible, infeasible and why, bad input, crashed).
+    """Plan many jobs in parallel, each into its own folder, with a manifest of the results.
+
+    The manifest holds every job's result (feasible, infeasible and why, bad input,
+    crashed).
 
     A rerun keeps the results whose jobs did not change (resume after a crash or a
     Ctrl-C).  Exits 0 when every job is feasible, 1 when some job is not (they are

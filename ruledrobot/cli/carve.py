@@ -18,11 +18,13 @@ def carve(
         "[stock], [robot], [tool], [cut] of a job.")),
     out: Path = typer.Option(Path("out/carve"), "--out", "-o", help="Output folder."),
 ) -> None:
-    """Turn a part (a closed STL, OBJ, PLY mesh or a 3DM model) into the ruled cuts that
-    make it from the block: its ruled faces cut exactly along their own rulings, the rest
-    roughed by loops that never enter it (compared with the visual hull of as many
+    """Turn a part (a closed STL, OBJ, PLY mesh or 3DM model) into the ruled cuts that make it.
+
+    The cuts make it from the block: its ruled faces cut exactly along their own rulings,
+    the rest roughed by loops that never enter it (compared with the visual hull of as many
     parallel directions).  Writes job.toml (or setupN/job.toml) with its lines files,
-    carve.json, carved.stl and carve.png.  Exits 1 when a check fails, 2 on bad input."""
+    carve.json, carved.stl and carve.png.  Exits 1 when a check fails, 2 on bad input.
+    """
     from ..carve import carve as run_carve
 
     try:
@@ -90,8 +92,11 @@ FACES_LISTED = 8
 
 
 def print_faces(faces: dict[str, str]) -> set[str]:
-    """One line of what became of the part's faces (regions) and, for each face left to
-    the roughing loops, why (at most :data:`FACES_LISTED`); the reasons printed."""
+    """Print one line of what became of the part's faces (regions), and why for those left.
+
+    For each face left to the roughing loops, why (at most :data:`FACES_LISTED`); the
+    reasons printed.
+    """
     from ..io.words import counted
 
     kinds = {"exact": 0, "block face": 0}

@@ -143,9 +143,12 @@ def convert_cmd(
                                          "does not say: lines, gcode, airfoil, dxf, rhino."),
     **options: Any,
 ) -> None:
-    """Convert rulings between formats: foam-cutter G-code, airfoil .dat pairs, DXF, Rhino
-    3DM and lines files (and a mesh to 3DM).  Options of the input are plain, options of
-    the output start with --out-.  Lengths in metres, angles in radians."""
+    """Convert rulings between formats (G-code, airfoil, DXF, Rhino 3DM, lines files).
+
+    The formats: foam-cutter G-code, airfoil .dat pairs, DXF, Rhino 3DM and lines files (and
+    a mesh to 3DM).  Options of the input are plain, options of the
+    output start with --out-.  Lengths in metres, angles in radians.
+    """
     from ..io.formats.convert import convert
 
     try:

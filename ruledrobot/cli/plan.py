@@ -123,10 +123,12 @@ def demo(
         True, "--stream/--no-stream", help="Stream the cut to the embedded RTDE emulator."
     ),
 ) -> None:
-    """Run the whole chain on a built-in example (a hyperbolic paraboloid cut in foam; with
-    --part, a part of three cuts): refine, plan, time, verify in MuJoCo, render a video,
-    export URScript, and stream the cut through ur_rtde to the embedded controller
-    emulator."""
+    """Run the whole chain on a built-in example, from refining to streaming the cut.
+
+    A hyperbolic paraboloid cut in foam; with --part, a part of three cuts: refine, plan,
+    time, verify in MuJoCo, render a video, export URScript, and stream the cut through
+    ur_rtde to the embedded controller emulator.
+    """
     from ..export import export_trajectory
     from ..export.urscript import MAX_MOTION_LINES
     from ..io.atomic import atomic_write_text

@@ -91,11 +91,14 @@ def place(
                                          "the workers of this Dask scheduler "
                                          "(tcp://HOST:8786; docs/batch.md)."),
 ) -> None:
-    """Search where to put the block (or the robot) so that the arm reaches every ruling of
-    every cut with the largest worst margin; verify the best with the planner and MuJoCo;
-    when no single placement serves a job of several cuts, split it into setups and say
-    what to do between them.  Writes job.toml (the placement filled in), plan/, margin.png,
-    place.json (and setupN/, setups.txt).  Exits 1 when nothing found passes."""
+    """Search where to put the block (or the robot) so that the arm reaches every ruling.
+
+    Every ruling of every cut, with the largest worst margin; verify the best with the
+    planner and MuJoCo; when no single placement serves a job of several cuts, split it into
+    setups and say what to do between them.  Writes job.toml (the placement filled in),
+    plan/, margin.png, place.json (and setupN/, setups.txt).  Exits 1 when nothing found
+    passes.
+    """
     import contextlib
     import functools
     import math

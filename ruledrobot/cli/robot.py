@@ -171,10 +171,12 @@ def run(
 
 
 def stream(trajectory: Path, host: str | None, *, yes: bool = False, **options):
-    """Run ``trajectory`` (the CLI's side of :func:`run_trajectory`): checks table,
-    confirmation, progress bar, where it stopped and the resume command, the run's
-    verdict.  A run that completed but whose executed cut broke a check exits 1 here
-    (``typer.Exit``), after everything is printed and written."""
+    """Run ``trajectory``: the CLI's side of :func:`run_trajectory`.
+
+    Checks table, confirmation, progress bar, where it stopped and the resume command, the
+    run's verdict.  A run that completed but whose executed cut broke a check exits 1 here
+    (``typer.Exit``), after everything is printed and written.
+    """
     from rich.text import Text
 
     from ..export import ControllerError, run_trajectory
@@ -332,9 +334,11 @@ def ursim(
         "and uses the calibrated kinematics for everything (default: nominal).",
     ),
 ) -> None:
-    """Run the controller emulator (RTDE 30004, dashboard 29999, script 30003, primary 30001,
-    secondary 30002) until Ctrl-C, optionally calibrated and with faults on a timer or on a
-    signal (docs/rtde.md)."""
+    """Run the controller emulator until Ctrl-C, optionally calibrated and with faults.
+
+    RTDE 30004, dashboard 29999, script 30003, primary 30001, secondary 30002; the faults on
+    a timer or on a signal (docs/rtde.md).
+    """
     from ..ursim import serve
     from ..ursim.address import address_in_use
     from ..ursim.arm.emulated import emulated_model
@@ -415,8 +419,11 @@ def calibration_fetch(
     model: str | None = typer.Option(None, help="Robot model; default: ask the dashboard."),
     timeout: float = typer.Option(5.0, min=0.5, help="Give up after this many seconds."),
 ) -> None:
-    """Read the controller's calibrated kinematics (KinematicsInfo) and write them as a
-    calibration file for the job's ``\\[robot] calibration``."""
+    """Read the controller's calibrated kinematics and write them as a calibration file.
+
+    The kinematics are the controller's KinematicsInfo; the file is for the job's
+    ``\\[robot] calibration``.
+    """
     from ..export.fetch_calibration import fetch_calibration
     from ..io.calibration import save_calibration
 

@@ -48,8 +48,9 @@ def export_trajectory(
     force: bool = False,
     **urscript_options: object,
 ) -> Path:
-    """Write ``traj`` to ``path`` as ``"csv"``, ``"json"``, ``"npz"`` or ``"urscript"``
-    (atomic; :func:`ruledrobot.export.urscript.export_trajectory`).
+    """Write ``traj`` to ``path`` as ``"csv"``, ``"json"``, ``"npz"`` or ``"urscript"``.
+
+    Atomic; :func:`ruledrobot.export.urscript.export_trajectory`.
 
     An export never replaces a file it did not write: when a file it would write (a CSV:
     the CSV and its sidecar) exists and is not of the kind it writes there -- a user's

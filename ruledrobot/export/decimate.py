@@ -133,9 +133,12 @@ class PathStep:
 
 
 def decimate_points(x: np.ndarray, tolerance: float) -> np.ndarray:
-    """Indices of the points (M, D) to keep so that every dropped point lies within
-    ``tolerance`` (Euclidean) of the straight segment between its kept neighbours, at its
-    own fraction of the segment's samples' index (as a joint move passes them)."""
+    """Return the indices of the points (M, D) to keep within ``tolerance`` of the kept path.
+
+    Every dropped point lies within ``tolerance`` (Euclidean) of the straight segment
+    between its kept neighbours, at its own fraction of the segment's samples' index (as a
+    joint move passes them).
+    """
     x = np.asarray(x, dtype=float)
 
     def split(i: int, j: int) -> int | None:

@@ -135,8 +135,10 @@ def query_dashboard(
 
 
 def controller_checks(meta: TrajectoryMeta, info: ControllerInfo) -> list[Check]:
-    """Robot model and control period against the trajectory's (the kinematics:
-    :func:`kinematics_check`)."""
+    """Check the controller's robot model and control period against the trajectory's.
+
+    The kinematics: :func:`kinematics_check`.
+    """
     checks = []
     said = f"dashboard said {info.model_reply!r} and {info.version_reply!r}"
     robot = info.robot
@@ -194,11 +196,13 @@ def controller_checks(meta: TrajectoryMeta, info: ControllerInfo) -> list[Check]
 
 def kinematics_check(meta: TrajectoryMeta, host: str, *, timeout: float = 3.0,
                      force: bool = False) -> tuple[Check, KinematicsRef | None]:  # fmt: skip
-    """The controller's kinematics (KinematicsInfo, primary interface) against the ones
-    the trajectory was planned with: the same DH table (to :data:`DH_TOL`) and, when the
-    trajectory knows them, the same per-joint checksums.  ``force`` turns a mismatch
-    into information (a conscious choice, shown as such).  Also returns the
-    controller's kinematics (None when not read): a recording is in *its* frame."""
+    """Check the controller's kinematics against the ones the trajectory was planned with.
+
+    The controller's KinematicsInfo (primary interface): the same DH table (to
+    :data:`DH_TOL`) and, when the trajectory knows them, the same per-joint checksums.
+    ``force`` turns a mismatch into information (a conscious choice, shown as such).  Also
+    returns the controller's kinematics (None when not read): a recording is in *its* frame.
+    """
     check, info = _kinematics_check(meta, host, timeout, force)
     if info is None:
         return check, None

@@ -155,8 +155,10 @@ class RunResult:
 
     @property
     def approach_distance(self) -> float:
-        """The leading joint's distance [rad] from the arm's pose to the first sample
-        streamed (the entry's, 0 before an entry is chosen)."""
+        """The leading joint's distance [rad] from the arm's pose to the first sample streamed.
+
+        The entry's; 0 before an entry is chosen.
+        """
         return 0.0 if self.entry is None else self.entry.distance
 
     @property

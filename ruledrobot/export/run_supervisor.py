@@ -133,8 +133,9 @@ class Child:
     # ------------------------------------------------------------ lifecycle
 
     def exit_text(self) -> str:
-        """How the child ended, in words (``"exit code 0"``, ``"killed by SIGSEGV"``,
-        ``"still running"``), after waiting up to 0.5 s for it.
+        """Return how the child ended, in words, after waiting up to 0.5 s for it.
+
+        ``"exit code 0"``, ``"killed by SIGSEGV"``, ``"still running"``.
         """
         with contextlib.suppress(subprocess.TimeoutExpired):
             self.proc.wait(0.5)
@@ -159,8 +160,9 @@ class Child:
             self.conn.close()
 
     def log_tail(self, lines: int = 12) -> str:
-        """The last ``lines`` lines of the child's output (of its last 4 KiB; empty when
-        unreadable).
+        """Return the last ``lines`` lines of the child's output.
+
+        Of its last 4 KiB; empty when unreadable.
         """
         try:
             self._log.seek(0, os.SEEK_END)

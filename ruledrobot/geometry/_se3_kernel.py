@@ -34,8 +34,11 @@ _SIG = types.void(_POSES_IN, _POSES_IN, _T_IN, types.float64[:, :, ::1])
 
 @nb.njit(_SIG, cache=True, nogil=True, error_model="numpy")
 def geodesic_rows(A, B, t, out):
-    """``out[i] = A[i] exp(t[i] log(inv(A[i]) B[i]))`` for contiguous (n, 4, 4) ``A``,
-    ``B``, ``out`` and (n,) ``t``; the formulas of ``screw._geodesic_matrix_chunk``."""
+    """Compute ``out[i] = A[i] exp(t[i] log(inv(A[i]) B[i]))`` row by row.
+
+    For contiguous (n, 4, 4) ``A``, ``B``, ``out`` and (n,) ``t``; the formulas of
+    ``screw._geodesic_matrix_chunk``.
+    """
     for i in range(A.shape[0]):
         a = A[i]
         b = B[i]

@@ -85,9 +85,12 @@ class Box:
         return Box(R @ self.centre + p, self.size, R @ self.rotation)
 
     def grown(self, margin: float) -> Box:
-        """The box grown by ``margin`` [m] on every side (edge lengths ``size + 2 margin``;
-        a negative margin shrinks it, refused when an edge would vanish): the same box
-        as :meth:`contains` and :meth:`clip_lines` test with ``margin``."""
+        """Return the box grown by ``margin`` [m] on every side.
+
+        Edge lengths ``size + 2 margin``; a negative margin shrinks it, refused when an edge
+        would vanish: the same box as :meth:`contains` and :meth:`clip_lines` test with
+        ``margin``.
+        """
         return Box(self.centre, self.size + 2.0 * float(margin), self.rotation)
 
     def to_box(self, points: ArrayLike) -> FloatArray:
@@ -101,8 +104,10 @@ class Box:
     def clip_lines(
         self, origins: ArrayLike, directions: ArrayLike, margin: float = 0.0
     ) -> tuple[FloatArray, FloatArray, np.ndarray]:
-        """Parameters ``(t_in, t_out, hit)`` where lines ``origin + t direction`` (..., 3)
-        cross the box grown by ``margin``: the chord is ``t_in <= t <= t_out``.
+        """Return the parameters where lines cross the box grown by ``margin``.
+
+        ``(t_in, t_out, hit)`` for lines ``origin + t direction`` (..., 3): the chord is
+        ``t_in <= t <= t_out``.
 
         Slab method: in box coordinates the line meets slab ``k`` for ``t`` between
         ``(+-h_k - p_k)/d_k``; a direction parallel to a slab meets it everywhere or

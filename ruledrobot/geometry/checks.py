@@ -73,8 +73,10 @@ def as_shaped(value: ArrayLike, name: str, shape: tuple[int | None, ...]) -> Flo
 
 
 def as_number(value: Any, name: str, *, positive: bool = True, allow_zero: bool = False) -> float:
-    """A finite float; with ``positive`` (the default) also ``> 0`` (``>= 0`` with
-    ``allow_zero``)."""
+    """Return ``value`` as a finite float; with ``positive`` (the default) also ``> 0``.
+
+    ``>= 0`` with ``allow_zero``.
+    """
     if isinstance(value, bool):
         raise ValueError(f"{name}: expected a number, got {value!r}")
     try:

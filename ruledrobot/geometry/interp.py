@@ -22,9 +22,11 @@ def _bracket(x: FloatArray, xp: FloatArray) -> tuple[np.ndarray, FloatArray]:
 
 
 def interp_linear(x: ArrayLike, xp: ArrayLike, fp: ArrayLike) -> FloatArray:
-    """``fp`` (N, ...) sampled at increasing ``xp`` (N,), linearly interpolated at ``x``
-    (M,) -> (M, ...).  Outside ``[xp[0], xp[-1]]`` the end values hold (as ``np.interp``);
-    exact on the samples, ``(1 - w) f_k + w f_{k+1}``."""
+    """Interpolate ``fp`` (N, ...) sampled at increasing ``xp`` (N,) linearly at ``x`` (M,).
+
+    Returns (M, ...).  Outside ``[xp[0], xp[-1]]`` the end values hold (as ``np.interp``);
+    exact on the samples, ``(1 - w) f_k + w f_{k+1}``.
+    """
     x = np.asarray(x, dtype=np.float64)
     xp = np.asarray(xp, dtype=np.float64)
     fp = np.asarray(fp, dtype=np.float64)

@@ -242,7 +242,10 @@ def mesh_normals(vertices: ArrayLike, faces: ArrayLike) -> FloatArray:
 
 
 def signed_volume(vertices: FloatArray, faces: np.ndarray) -> float:
-    """Volume [m^3] enclosed by a closed triangle mesh, positive when its faces turn
-    counter-clockwise seen from outside (the divergence theorem over the faces)."""
+    """Return the volume [m^3] enclosed by a closed triangle mesh.
+
+    Positive when its faces turn counter-clockwise seen from outside (the divergence theorem
+    over the faces).
+    """
     a, b, c = vertices[faces[:, 0]], vertices[faces[:, 1]], vertices[faces[:, 2]]
     return float(np.einsum("ij,ij->i", a, np.cross(b, c)).sum() / 6.0)

@@ -25,8 +25,10 @@ def runs_of(mask: ArrayLike) -> tuple[tuple[int, int], ...]:
 
 
 def runs_of_indices(idx: ArrayLike) -> tuple[tuple[int, int], ...]:
-    """Half-open ranges ``(first, last + 1)`` of the runs of consecutive values of sorted
-    integer indices ``idx`` (K,)."""
+    """Return the runs of consecutive values of sorted indices as half-open ranges.
+
+    Ranges ``(first, last + 1)`` of the runs of sorted integer indices ``idx`` (K,).
+    """
     i = np.asarray(idx, dtype=np.int64).reshape(-1)
     if i.size == 0:
         return ()
@@ -37,8 +39,10 @@ def runs_of_indices(idx: ArrayLike) -> tuple[tuple[int, int], ...]:
 
 
 def run_indices(mask: ArrayLike, closed: bool = False) -> list[np.ndarray]:
-    """The index arrays of the True runs of ``mask`` (M,); with ``closed`` a run through the
-    end continues at the start (one array, wrapping)."""
+    """Return the index arrays of the True runs of ``mask`` (M,).
+
+    With ``closed`` a run through the end continues at the start (one array, wrapping).
+    """
     m = np.asarray(mask, dtype=bool)
     runs = [np.arange(a, b) for a, b in runs_of(m)]
     if closed and len(runs) > 1 and m[0] and m[-1]:
@@ -47,8 +51,10 @@ def run_indices(mask: ArrayLike, closed: bool = False) -> list[np.ndarray]:
 
 
 def checked_ranges(value: object, what: str) -> tuple[tuple[int, int], ...]:
-    """``value`` (pairs of integers) as half-open ranges; ValueError naming ``what[i]``
-    where a pair is not ``0 <= start < stop``."""
+    """Return ``value`` (pairs of integers) as half-open ranges.
+
+    ValueError naming ``what[i]`` where a pair is not ``0 <= start < stop``.
+    """
     out = []
     for i, r in enumerate(value or ()):  # type: ignore[attr-defined]
         a, b = (int(x) for x in r)

@@ -55,8 +55,11 @@ __all__ = ["RuledSurface", "dh_transform"]
 
 
 def dh_transform(theta: FloatArray, d: FloatArray, a: FloatArray, alpha: FloatArray) -> FloatArray:
-    """``Trans_x(a) Rot_x(alpha) Rot_z(theta) Trans_z(d)`` (..., 4, 4): one link of a
-    DH row as returned by :meth:`RuledSurface.dh_parameters` (Craig's ordering)."""
+    """Return ``Trans_x(a) Rot_x(alpha) Rot_z(theta) Trans_z(d)`` (..., 4, 4).
+
+    One link of a DH row as returned by :meth:`RuledSurface.dh_parameters` (Craig's
+    ordering).
+    """
     theta, d, a, alpha = np.broadcast_arrays(
         *(np.asarray(v, dtype=np.float64) for v in (theta, d, a, alpha))
     )

@@ -304,9 +304,11 @@ def _qt_from_matrices(T: FloatArray) -> tuple[tuple, tuple]:
 
 
 def load_kernel() -> None:
-    """Load (or, the first time after an install, compile: a few seconds) the compiled
-    geodesic kernel; the first geodesic of more than :data:`NUMPY_PAIRS` pairs does this
-    by itself.  Importing numba and loading the kernel take about a second."""
+    """Load the compiled geodesic kernel (compiling it the first time after an install).
+
+    Compiling takes a few seconds; the first geodesic of more than :data:`NUMPY_PAIRS` pairs
+    does this by itself.  Importing numba and loading the kernel take about a second.
+    """
     global _kernel
     if _kernel is None:
         from . import _se3_kernel

@@ -224,8 +224,10 @@ class SurfaceSpec:
 
     @property
     def period(self) -> float | None:
-        """Parameter period for closed/flip surfaces (``u + period`` is the same
-        ruling, reversed for ``"flip"``); None for open ones."""
+        """Parameter period for closed/flip surfaces; None for open ones.
+
+        ``u + period`` is the same ruling, reversed for ``"flip"``.
+        """
         return None if self.closure == "open" else self.domain[1] - self.domain[0]
 
     def params(self, **params: Any) -> dict[str, Any]:
@@ -246,8 +248,10 @@ class SurfaceSpec:
         }
 
     def points_directions(self, u: ArrayLike, **params: Any) -> PointsDirections:
-        """Base points ``b(u)`` and unit directions ``l(u)``, each (..., 3), for
-        parameters ``u`` of any shape (...)."""
+        """Return base points ``b(u)`` and unit directions ``l(u)``, each (..., 3).
+
+        For parameters ``u`` of any shape (...).
+        """
         uu = _param_u(u)
         b, d = self._family(uu, **self.params(**params))
         return b, d / norm(d)[..., None]
@@ -266,9 +270,11 @@ class SurfaceSpec:
 
 
 def cylindroid_residual(points: ArrayLike, c: float = 0.5) -> FloatArray:
-    """First-order distance (..., ) metres of ``points`` (..., 3) from the cylindroid
-    ``F = z (x^2 + y^2) - 2 c x y = 0``: ``F / |grad F|``; 0 where ``F = 0`` (also on
-    the singular double line, the segment ``|z| <= c`` of the z axis)."""
+    """Return the first-order distance (...,) [m] of ``points`` (..., 3) from the cylindroid.
+
+    The cylindroid ``F = z (x^2 + y^2) - 2 c x y = 0``: ``F / |grad F|``; 0 where ``F = 0``
+    (also on the singular double line, the segment ``|z| <= c`` of the z axis).
+    """
     p = as_float_array(points, "points", (3,))
     c = _nonzero(c, "c")
     x, y, z = p[..., 0], p[..., 1], p[..., 2]
@@ -288,8 +294,11 @@ def hyperbolic_paraboloid_residual(points: ArrayLike, c: float = 1.0) -> FloatAr
 
 
 def hyperboloid_residual(points: ArrayLike, a: float = 1.0, c: float = 1.0) -> FloatArray:
-    """First-order distance (...,) metres of ``points`` (..., 3) from the hyperboloid of
-    revolution ``F = (x^2 + y^2)/a^2 - z^2/c^2 - 1 = 0`` (``F / |grad F|``)."""
+    """Return the first-order distance (...,) [m] of ``points`` (..., 3) from a hyperboloid.
+
+    The hyperboloid of revolution ``F = (x^2 + y^2)/a^2 - z^2/c^2 - 1 = 0`` (``F / |grad
+    F|``).
+    """
     p = as_float_array(points, "points", (3,))
     a, c = _positive(a, "a"), _positive(c, "c")
     x, y, z = p[..., 0], p[..., 1], p[..., 2]
@@ -299,8 +308,10 @@ def hyperboloid_residual(points: ArrayLike, a: float = 1.0, c: float = 1.0) -> F
 
 
 def helicoid_residual(points: ArrayLike, pitch: float = 0.2) -> FloatArray:
-    """First-order distance (...,) metres of ``points`` (..., 3) from the helicoid
-    ``F = x sin(z/p) - y cos(z/p) = 0`` (``grad F`` never vanishes)."""
+    """Return the first-order distance (...,) [m] of ``points`` (..., 3) from the helicoid.
+
+    The helicoid ``F = x sin(z/p) - y cos(z/p) = 0`` (``grad F`` never vanishes).
+    """
     p = as_float_array(points, "points", (3,))
     pitch = _nonzero(pitch, "pitch")
     x, y, z = p[..., 0], p[..., 1], p[..., 2]
@@ -456,8 +467,11 @@ def hyperbolic_paraboloid(u: ArrayLike, c: float = 1.0) -> Lines:
 
 
 def hyperboloid(u: ArrayLike, a: float = 1.0, c: float = 1.0) -> Lines:
-    """One ruling family of the hyperboloid of revolution ``(x^2+y^2)/a^2 - z^2/c^2 = 1``
-    at ``u`` (N,) rad: through ``(a cos u, a sin u, 0)`` along ``(-a sin u, a cos u, c)``."""
+    """Return one ruling family of the hyperboloid of revolution at ``u`` (N,) [rad].
+
+    ``(x^2+y^2)/a^2 - z^2/c^2 = 1``: through ``(a cos u, a sin u, 0)`` along ``(-a sin u, a
+    cos u, c)``.
+    """
     return SURFACES["hyperboloid"](u, a=a, c=c)
 
 
@@ -482,8 +496,11 @@ def helical_surface(
 
 
 def helical_developable(u: ArrayLike, radius: float = 1.0, pitch: float = 0.3) -> Lines:
-    """Tangent lines of the helix ``(r cos u, r sin u, h u)`` at ``u`` (N,) rad, through the
-    helix point along ``(-r sin u, r cos u, h)``; ``r = radius`` m, ``h = pitch`` m/rad."""
+    """Return the tangent lines of the helix ``(r cos u, r sin u, h u)`` at ``u`` (N,) [rad].
+
+    Through the helix point along ``(-r sin u, r cos u, h)``; ``r = radius`` m, ``h =
+    pitch`` m/rad.
+    """
     return SURFACES["helical_developable"](u, radius=radius, pitch=pitch)
 
 

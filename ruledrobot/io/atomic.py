@@ -75,9 +75,12 @@ def atomic_write_bytes(path: str | os.PathLike[str], data: bytes) -> Path:
 
 
 def atomic_write_json(path: str | os.PathLike[str], doc: object, *, compact: bool = False) -> Path:
-    """Write ``doc`` as JSON to ``path`` atomically (:data:`JSON_INDENT`, a final newline;
-    ``compact``: no whitespace at all, for large arrays); returns the path.  The one
-    writer of the product's JSON files (``tests/architecture/test_one_home.py``)."""
+    """Write ``doc`` as JSON to ``path`` atomically; return the path.
+
+    Indented by :data:`JSON_INDENT`, with a final newline; ``compact``: no whitespace at
+    all, for large arrays.  The one writer of the product's JSON files
+    (``tests/architecture/test_one_home.py``).
+    """
     import json
 
     text = (json.dumps(doc, separators=(",", ":")) if compact

@@ -63,8 +63,9 @@ def cube_axes(ax: Any, centre: ArrayLike, half: float, unit: str, zoom: float = 
 
 def coarse_mesh(vertices: FloatArray, faces: np.ndarray, most: int = MESH_FACES
                 ) -> tuple[FloatArray, np.ndarray, np.ndarray]:  # fmt: skip
-    """A mesh of at most about ``most`` triangles that looks like ``(vertices, faces)``:
-    vertex clustering (Rossignac and Borrel, "Multi-resolution 3D approximations for
+    """Return a mesh of at most about ``most`` triangles that looks like ``(vertices, faces)``.
+
+    By vertex clustering (Rossignac and Borrel, "Multi-resolution 3D approximations for
     rendering complex scenes", 1993).
 
     The vertices falling in one cell of a grid are merged at their mean; triangles with
@@ -114,9 +115,12 @@ def coarse_mesh(vertices: FloatArray, faces: np.ndarray, most: int = MESH_FACES
 
 
 def lambert(normals: FloatArray) -> FloatArray:
-    """The brightness (F,) of faces with ``normals`` (F, 3) (any length) under the light
-    (:data:`LIGHT_AZIMUTH`, :data:`LIGHT_ALTITUDE`): ``AMBIENT + (1 - AMBIENT) max(n.l, 0)``
-    (Lambert's cosine law), 1 facing it, ``AMBIENT`` turned away."""
+    """Return the brightness (F,) of faces with ``normals`` (F, 3) under the light.
+
+    Normals of any length; the light is :data:`LIGHT_AZIMUTH`, :data:`LIGHT_ALTITUDE`:
+    ``AMBIENT + (1 - AMBIENT) max(n.l, 0)`` (Lambert's cosine law), 1 facing it, ``AMBIENT``
+    turned away.
+    """
     az, alt = np.radians(90.0 - LIGHT_AZIMUTH), np.radians(LIGHT_ALTITUDE)
     light = np.array([np.cos(az) * np.cos(alt), np.sin(az) * np.cos(alt), np.sin(alt)])
     n = np.asarray(normals, dtype=np.float64)

@@ -202,9 +202,12 @@ def save_lines(
     striction: ArrayLike | None = None,
     plucker: bool = False,
 ) -> Path:
-    """Write lines to ``.json`` (point/direction objects, or Plücker rows with
-    ``plucker=True``; optional ``frames`` (N,4,4) and ``striction`` (N,3)) or
-    ``.csv`` (point nearest the origin + direction).  Atomic; returns the path."""
+    """Write lines to ``.json`` or ``.csv`` atomically; return the path.
+
+    ``.json``: point/direction objects, or Plücker rows with ``plucker=True``; optional
+    ``frames`` (N,4,4) and ``striction`` (N,3).  ``.csv``: point nearest the origin +
+    direction.
+    """
     p = Path(path)
     if not isinstance(lines, Lines):
         raise ValueError(f"{p}: expected ruledrobot.Lines, got {type(lines).__name__}")

@@ -128,10 +128,12 @@ def _merge(tri: FloatArray, normals: FloatArray) -> StlMesh:
 
 
 def read_obj(path: str | os.PathLike[str]) -> Mesh:
-    """Read the vertices and faces of a Wavefront OBJ (``v`` and ``f`` lines; other
-    records ignored).  Faces with more than three corners are fanned into
-    triangles; ``f 1/2/3`` corner forms and negative (relative) indices are
-    accepted.  Errors name the file and line."""
+    """Read the vertices and faces of a Wavefront OBJ.
+
+    ``v`` and ``f`` lines; other records ignored.  Faces with more than three corners are
+    fanned into triangles; ``f 1/2/3`` corner forms and negative (relative) indices are
+    accepted.  Errors name the file and line.
+    """
     p = Path(path)
     verts: list[list[float]] = []
     faces: list[list[int]] = []

@@ -159,8 +159,11 @@ class StagedFolder:
         shutil.rmtree(self.path, ignore_errors=True)
 
     def commit(self, info: dict[str, Any] | None = None) -> Path:
-        """Write ``manifest.json`` (``info`` plus every file's size and SHA-256) and put
-        the staged folder in place of the target; returns the target."""
+        """Write ``manifest.json`` and put the staged folder in place of the target; return it.
+
+        The manifest holds ``info`` plus every file's size and SHA-256; the target is
+        returned.
+        """
         files = {}
         for p in sorted(self.path.rglob("*")):
             if p.is_file():

@@ -36,8 +36,10 @@ def input_path(named: str | os.PathLike[str], base_dir: str | os.PathLike[str] |
 
 
 def missing_file(path: Path, kind: str = "file") -> str | None:
-    """``"no such G-code file: PATH"`` when ``path`` is not a file (``kind`` a key of
-    :data:`FILE_KINDS` or a name), else None."""
+    """Return ``"no such G-code file: PATH"`` when ``path`` is not a file, else None.
+
+    ``kind`` a key of :data:`FILE_KINDS` or a name.
+    """
     if path.is_file():
         return None
     what = FILE_KINDS.get(kind, kind)
@@ -47,10 +49,12 @@ def missing_file(path: Path, kind: str = "file") -> str | None:
 
 
 def check_not_input(output: str | os.PathLike[str], *inputs: str | os.PathLike[str]) -> None:
-    """ValueError when ``output`` is one of the ``inputs`` (the same file by path, or by
-    device and inode through a link): a command never writes over the file it reads
-    (``ruledrobot refine wing.json --out wing.json`` would have replaced the user's
-    rulings with the refined ones)."""
+    """Raise ValueError when ``output`` is one of the ``inputs``.
+
+    The same file by path, or by device and inode through a link: a command never writes
+    over the file it reads (``ruledrobot refine wing.json --out wing.json`` would have
+    replaced the user's rulings with the refined ones).
+    """
     out = Path(os.path.normpath(Path(output).expanduser().absolute()))
     for given in inputs:
         src = Path(os.path.normpath(Path(given).expanduser().absolute()))

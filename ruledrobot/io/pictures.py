@@ -23,8 +23,9 @@ BUCKETS = 1200
 
 def thinned_series(t: FloatArray, y: FloatArray, buckets: int = BUCKETS
                    ) -> tuple[FloatArray, FloatArray]:  # fmt: skip
-    """``t`` (N,) and ``y`` (N,) or (N, J) thinned to at most ``4 * buckets`` samples per
-    series (module doc), for ``ax.plot(*thinned_series(t, y))``.
+    """Return ``t`` (N,) and ``y`` (N,) or (N, J) thinned to at most ``4 * buckets`` samples.
+
+    Per series (module doc), for ``ax.plot(*thinned_series(t, y))``.
 
     Returns
     -------

@@ -58,8 +58,11 @@ def json_object(
     error: type[ValueError] = ValueError,
     not_json: str = "line {line}: not valid JSON ({msg})",
 ) -> dict[str, Any]:
-    """The JSON object ``text`` of the file ``where`` holds; ``error`` naming the file when it
-    is not JSON (``not_json`` with the line and the parser's message) or not an object."""
+    """Return the JSON object the text of the file ``where`` holds.
+
+    ``text`` is the file's text; ``error`` names the file when it is not JSON (``not_json``
+    with the line and the parser's message) or not an object.
+    """
     try:
         doc = json.loads(text)
     except json.JSONDecodeError as exc:

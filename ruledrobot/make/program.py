@@ -27,9 +27,11 @@ PROGRAM = "cut.script"
 
 @dataclass(frozen=True)
 class ProgramOutcome:
-    """The program written (``path``, None when none could be), its ``mode``, what it
-    holds in words (``what``: the verification's figures, or why none was written) and
-    the ``program`` check (information)."""
+    """The program written, its mode, what it holds in words and the ``program`` check.
+
+    ``path`` (None when none could be written), ``mode``, ``what`` (the verification's
+    figures, or why none was written) and the ``program`` check (information).
+    """
 
     path: Path | None
     mode: str

@@ -49,9 +49,11 @@ def _link(src: Path, dst: Path) -> None:
 def restage(folder: Path, info: dict[str, Any] | None = None,
             drop: Callable[[str], bool] = lambda rel: False,
             add: dict[str, Path] | None = None) -> list[str]:  # fmt: skip
-    """Stage ``folder`` again without the files ``drop`` names (relative POSIX paths) and
-    with the files ``add`` maps to their names in it, its manifest's fields kept and
-    ``info`` added; the paths dropped."""
+    """Stage ``folder`` again with files dropped and added; return the paths dropped.
+
+    Without the files ``drop`` names (relative POSIX paths) and with the files ``add`` maps
+    to their names in it, its manifest's fields kept and ``info`` added.
+    """
     files = sorted(p for p in folder.rglob("*") if p.is_file())
     kept_info = {k: v for k, v in (read_manifest(folder) or {}).items() if k not in _MANIFEST_OWN}
     gone = []

@@ -44,9 +44,12 @@ __all__ = ["MakeResult", "make"]
 
 @dataclass(frozen=True)
 class MakeResult:
-    """What :func:`make` did: ``ok`` (every setup passes), the folder written (``out``),
-    carve's report (carve.json), each setup's outcome, what to do by hand before each
-    setup, the notes and ``document`` (make.json)."""
+    """What :func:`make` did: the verdict, the folder, carve's report and each setup's outcome.
+
+    ``ok`` (every setup passes), the folder written (``out``), carve's report (carve.json),
+    each setup's outcome, what to do by hand before each setup, the notes and ``document``
+    (make.json).
+    """
 
     ok: bool
     out: Path

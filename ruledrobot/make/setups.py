@@ -24,8 +24,11 @@ __all__ = ["Setup", "hand_steps", "setups_of"]
 
 @dataclass(frozen=True)
 class Setup:
-    """Setup ``number`` (1-based): its job file as carve wrote it (``job``), the names of
-    its cuts in order, and each cut's kind (``exact`` / ``rough``) and closedness."""
+    """Setup ``number`` (1-based): its job file, its cuts in order and their kinds.
+
+    The job file as carve wrote it (``job``), the names of its cuts in order, and each cut's
+    kind (``exact`` / ``rough``) and closedness.
+    """
 
     number: int
     job: Path

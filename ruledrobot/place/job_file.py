@@ -167,8 +167,9 @@ def write_job_file(
     note: str = "",
     check_as: str | os.PathLike[str] | None = None,
 ) -> Path:
-    """Write ``job`` — the moved job of ``job.source``'s file, with the cuts ``keep_cuts``
-    (indices into the file's cuts; None: all) — to ``path`` (see the module doc).
+    """Write ``job``, the moved job of ``job.source``'s file, to ``path`` (see the module doc).
+
+    With the cuts ``keep_cuts`` (indices into the file's cuts; None: all).
 
     ``job`` has only the kept cuts, in order.  ``note`` is put first as a comment.
     ``check_as``: where the file will finally live (relative paths are written for

@@ -47,8 +47,10 @@ MOVES = ("stock", "robot")
 
 
 def parse_range(text: str, what: str, unit: float = 1.0) -> tuple[float, float]:
-    """``"a:b"`` (or one number ``"a"``) -> ``(a * unit, b * unit)``; ValueError names
-    ``what`` (e.g. ``--x``) and what was expected."""
+    """Parse ``"a:b"`` (or one number ``"a"``) into ``(a * unit, b * unit)``.
+
+    ValueError names ``what`` (e.g. ``--x``) and what was expected.
+    """
     parts = str(text).split(":")
     try:
         vals = [float(p) for p in parts]
@@ -150,16 +152,20 @@ class Region:
         return cls((-half, half), (-half, half), (-yaw_half, yaw_half), "robot")
 
     def grid(self, n: tuple[int, int, int]) -> FloatArray:
-        """(N, 3) ``[x, y, yaw]`` samples: ``n`` per axis, ends included (one where a range
-        is a single value)."""
+        """Return the (N, 3) ``[x, y, yaw]`` samples: ``n`` per axis, ends included.
+
+        One where a range is a single value.
+        """
         axes = [np.linspace(lo, hi, k) if hi > lo else np.array([lo])
                 for (lo, hi), k in zip((self.x, self.y, self.yaw), n, strict=True)]  # fmt: skip
         return np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
 
     def edges(self, xyz: FloatArray) -> str:
-        """Which ends of the region ``xyz`` ``[x, y, yaw]`` (3,) lies on, as the options
-        that would widen them (``"the low end of --x"``...); '' when inside.  A range of
-        one value has no edge; a yaw range of a full turn neither."""
+        """Return which ends of the region ``xyz`` lies on, as the options that would widen them.
+
+        ``xyz`` ``[x, y, yaw]`` (3,); the options as ``"the low end of --x"``...; '' when
+        inside.  A range of one value has no edge; a yaw range of a full turn neither.
+        """
         out = []
         full_turn = self.yaw[1] - self.yaw[0] >= 2.0 * np.pi - 1e-9
         for k, (name, (lo, hi)) in enumerate(zip(("x", "y", "yaw"), (self.x, self.y, self.yaw),
@@ -205,9 +211,12 @@ class Placement:
         return transforms_of_base(np.array([[self.x, self.y, self.yaw]]))[0]
 
     def job(self, job: Job) -> Job:
-        """``job`` placed: its block moved (:func:`moved_job`) and, when the robot moves,
-        its ``[robot] base`` moved with it (``base @`` :meth:`base_motion`), so the
-        simulation's world keeps the block where it stands."""
+        """Return ``job`` placed: its block moved, and its robot base with it when the robot moves.
+
+        The block moved by :func:`moved_job` and, when the robot moves, its ``[robot] base``
+        moved with it (``base @`` :meth:`base_motion`), so the simulation's world keeps the
+        block where it stands.
+        """
         moved = moved_job(job, self.transform(job))
         if self.move != "robot":
             return moved

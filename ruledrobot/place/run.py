@@ -91,14 +91,16 @@ def run_place(
     program: Callable[[object, Path], Path] | None = None,
     scorer: Callable[[Evaluator], Evaluator] | None = None,
 ) -> PlaceOutcome:
-    """Search ``region`` for the block of ``job`` (:func:`~.search.search`), verify the
-    best with the planner and MuJoCo, and, when no single placement serves, split the
-    cuts into setups over the allowed ``turns`` (:mod:`.setups`); write the files
-    (module doc) into ``out``.  ``program(trajectory, folder)`` writes the robot program
-    of every plan that passes into its folder (``cut.script`` from the command line).
-    ``scorer(evaluator)`` returns what scores the candidates: the evaluator itself by
-    default, one that scores them on Dask workers from the command line
-    (:class:`ruledrobot.batch.place.DistributedEvaluator`)."""
+    """Search ``region`` for ``job``'s block, verify the best, split into setups if need be.
+
+    The search is :func:`~.search.search`; the best is verified with the planner and MuJoCo,
+    and, when no single placement serves, the cuts are split into setups over the allowed
+    ``turns`` (:mod:`.setups`); the files (module doc) are written into ``out``.
+    ``program(trajectory, folder)`` writes the robot program of every plan that passes into
+    its folder (``cut.script`` from the command line).  ``scorer(evaluator)`` returns what
+    scores the candidates: the evaluator itself by default, one that scores them on Dask
+    workers from the command line (:class:`ruledrobot.batch.place.DistributedEvaluator`).
+    """
     say = progress or (lambda msg: None)
     out = Path(out)
     model = job.robot_model()

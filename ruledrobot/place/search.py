@@ -117,8 +117,10 @@ class PlaceResult:
 
 def job_passes(job: Job, model: RobotModel | None = None,
                progress: Callable[[str], None] | None = None) -> list[CutPath]:  # fmt: skip
-    """The planner's passes of every cut of ``job`` at its placement (their frames move
-    with the block; the redundancy search's choice is not used)."""
+    """Return the planner's passes of every cut of ``job`` at its placement.
+
+    Their frames move with the block; the redundancy search's choice is not used.
+    """
     say = progress or (lambda msg: None)
     model = job.robot_model() if model is None else model
     out: list[CutPath] = []
@@ -139,9 +141,11 @@ def search(
     cuts: list[int] | None = None,
     progress: Callable[[str], None] | None = None,
 ) -> PlaceResult:
-    """Search ``region`` for the placement of ``job``'s block (after ``turn``) with the
-    largest worst margin (module doc); ``cuts`` (indices): score only these cuts (a
-    setup's), default all."""
+    """Search ``region`` for the placement of ``job``'s block with the largest worst margin.
+
+    After ``turn``; the margin of the module doc.  ``cuts`` (indices): score only these cuts
+    (a setup's), default all.
+    """
     say = progress or (lambda msg: None)
     t0 = time.perf_counter()
     which = list(range(len(job.cuts))) if cuts is None else list(cuts)
@@ -227,12 +231,15 @@ def verify_best(
     progress: Callable[[str], None] | None = None,
     program: Callable[[object, Path], Path] | None = None,
 ) -> Verified:
-    """Write the candidates' job files into ``folder`` in turn (``job.toml``) and plan
-    them with MuJoCo verification (``plan/``) until one passes (at most ``tries``, only
-    candidates with a margin >= 0).  ``final``: where ``folder`` will finally be
-    (relative paths in the job file are written for it).  ``cuts``: the cuts kept (a
-    setup's; default all).  ``program(trajectory, folder)``: writes the robot program of
-    the plan that passes (the command line writes ``cut.script``)."""
+    """Write and plan the candidates' job files in turn until one passes MuJoCo verification.
+
+    The job files go into ``folder`` (``job.toml``), the plans with MuJoCo verification into
+    ``plan/``, until one passes (at most ``tries``, only candidates with a margin >= 0).
+    ``final``: where ``folder`` will finally be (relative paths in the job file are written
+    for it).  ``cuts``: the cuts kept (a setup's; default all).  ``program(trajectory,
+    folder)``: writes the robot program of the plan that passes (the command line writes
+    ``cut.script``).
+    """
     import dataclasses
 
     from ..wirecut.job.load import load_job

@@ -84,9 +84,11 @@ def plan_setups(
     refine: int = 2,
     progress: Callable[[str], None] | None = None,
 ) -> SetupPlan | None:
-    """The setups of ``job`` (module doc), or None when the job has one cut, more than
-    :data:`MAX_CUTS`, or no grouping into at most :data:`MAX_SETUPS` setups has a
-    worst margin >= 0 on the sampled placements."""
+    """Return the setups of ``job`` (module doc), or None.
+
+    None when the job has one cut, more than :data:`MAX_CUTS`, or no grouping into at most
+    :data:`MAX_SETUPS` setups has a worst margin >= 0 on the sampled placements.
+    """
     say = progress or (lambda msg: None)
     n = len(job.cuts)
     if n < 2 or n > MAX_CUTS:

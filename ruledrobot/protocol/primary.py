@@ -218,9 +218,11 @@ def version_message(version: Version, timestamp: int = 0) -> bytes:
 
 
 def split_messages(buffer: bytes) -> tuple[list[tuple[int, bytes]], bytes]:
-    """Complete messages ``(type, body)`` at the start of ``buffer`` and the rest (an
-    incomplete message).  Raises on a size field below the header or above
-    :data:`MAX_MESSAGE_SIZE`."""
+    """Split the complete messages ``(type, body)`` off the start of ``buffer``.
+
+    Returns them and the rest (an incomplete message).  Raises on a size field below the
+    header or above :data:`MAX_MESSAGE_SIZE`.
+    """
     out: list[tuple[int, bytes]] = []
     pos = 0
     view = memoryview(buffer)
@@ -298,9 +300,11 @@ def parse_version(body: bytes) -> Version | None:
 def read_kinematics_info(
     host: str, port: int = PRIMARY_PORT, timeout: float = 3.0
 ) -> tuple[KinematicsInfo, Version | None]:
-    """Connect to a controller's primary interface and return its KinematicsInfo (and
-    version, when it came first).  Gives up after ``timeout`` s in all (OSError /
-    TimeoutError naming the host), raises :class:`PrimaryProtocolError` on bad packets."""
+    """Connect to a controller's primary interface and return its KinematicsInfo.
+
+    And its version, when it came first.  Gives up after ``timeout`` s in all (OSError /
+    TimeoutError naming the host), raises :class:`PrimaryProtocolError` on bad packets.
+    """
     deadline = time.monotonic() + timeout
     version: Version | None = None
     buf = b""

@@ -29,8 +29,10 @@ POSE_TOL = 1e-6
 
 
 def as_poses(value: ArrayLike, name: str = "poses", tol: float = POSE_TOL) -> FloatArray:
-    """``value`` as float64 poses (..., 4, 4) checked to be rigid motions (see
-    :func:`ruledrobot.geometry.se3.validate_poses`)."""
+    """Return ``value`` as float64 poses (..., 4, 4) checked to be rigid motions.
+
+    See :func:`ruledrobot.geometry.se3.validate_poses`.
+    """
     return validate_poses(value, name, tol)
 
 

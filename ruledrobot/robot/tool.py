@@ -21,9 +21,11 @@ __all__ = ["BowSpec", "BowTool"]
 
 
 class BowSpec(Protocol):
-    """What :meth:`BowTool.from_spec` reads of a spec (the ``[tool]`` of a cut job,
-    ``ruledrobot.wirecut.job.spec.ToolSpec``): the wire's end points in the flange frame
-    [m] and the bow's mass [kg] (None: the default)."""
+    """What :meth:`BowTool.from_spec` reads of a spec: the wire's ends and the bow's mass.
+
+    The spec is the ``[tool]`` of a cut job (``ruledrobot.wirecut.job.spec.ToolSpec``): the
+    wire's end points in the flange frame [m] and the bow's mass [kg] (None: the default).
+    """
 
     @property
     def wire_start(self) -> ArrayLike:
@@ -87,8 +89,10 @@ class BowTool:
 
     @classmethod
     def from_spec(cls, spec: BowSpec, **overrides: Any) -> BowTool:
-        """From any object with ``wire_start``, ``wire_end`` (and optionally ``mass``),
-        e.g. the ``[tool]`` of a cut job (``ruledrobot.wirecut.job.spec.ToolSpec``)."""
+        """Build the bow from any object with ``wire_start``, ``wire_end`` (optionally ``mass``).
+
+        E.g. the ``[tool]`` of a cut job (``ruledrobot.wirecut.job.spec.ToolSpec``).
+        """
         kw: dict[str, Any] = {"wire_start": spec.wire_start, "wire_end": spec.wire_end}
         if getattr(spec, "mass", None) is not None:
             kw["mass"] = spec.mass
@@ -97,8 +101,10 @@ class BowTool:
 
     @classmethod
     def of(cls, tool: BowSpec | BowTool) -> BowTool:
-        """``tool`` itself when it is a bow already (built once and passed down), else
-        :meth:`from_spec` of it."""
+        """Return ``tool`` itself when it is a bow already, else :meth:`from_spec` of it.
+
+        A bow is built once and passed down.
+        """
         return tool if isinstance(tool, BowTool) else cls.from_spec(tool)
 
     @property

@@ -47,8 +47,11 @@ _TRAIL_RGBA = {
 
 
 def phase_labels(phases: Any, n: int) -> np.ndarray | None:
-    """(n,) phase names of the samples from ``Phase``-like ranges (``name``, ``start``,
-    ``stop``), or None without phases; samples no phase names are ``"move"``."""
+    """Return the (n,) phase names of the samples from ``Phase``-like ranges, or None.
+
+    Ranges with ``name``, ``start``, ``stop``; None without phases; samples no phase names
+    are ``"move"``.
+    """
     if phases is None:
         return None
     labels = np.full(n, "move", dtype=object)

@@ -133,7 +133,9 @@ class ServoGains:
 
     @classmethod
     def default(cls, model: RobotModel) -> ServoGains:
-        """``kp = 100 /rad * tau_max``, ``kv = 4 s/rad * tau_max`` (UR5e: 15000 / 600 on the
+        """Return the default servo gains, proportional to each joint's torque limit.
+
+        ``kp = 100 /rad * tau_max``, ``kv = 4 s/rad * tau_max`` (UR5e: 15000 / 600 on the
         big joints, 2800 / 112 on the wrists); unlimited torque: as for 150 N m.
 
         With the armature of :func:`default_armature` the wrist servo has a

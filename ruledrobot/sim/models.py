@@ -26,8 +26,11 @@ EXAMPLE_SCENE_FILE = "ur5e_hotwire_cell.xml"
 def write_models(
     folder: str | os.PathLike[str], names: tuple[str, ...] = COMMITTED_MODELS
 ) -> list[Path]:
-    """Write ``<name>.xml`` for each catalogue model in ``names`` and the example cell
-    ``ur5e_hotwire_cell.xml`` into ``folder``, atomically; returns the paths."""
+    """Write the catalogue models' MJCF and the example cell into ``folder``; return the paths.
+
+    ``<name>.xml`` for each catalogue model in ``names`` and the example cell
+    ``ur5e_hotwire_cell.xml``, atomically.
+    """
     from ..robot import load
 
     out = Path(folder)

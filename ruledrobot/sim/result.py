@@ -228,9 +228,12 @@ class PlaybackResult:
     def write(
         self, out_dir: str | os.PathLike[str], *, plots: bool = True, trajectory: bool = True
     ) -> dict[str, Path]:
-        """Write ``report.json``, ``tracking.png``, ``limits.png`` and ``simulated.csv``
-        (the simulated trajectory with its sidecar, ``ruledrobot.io.trajectory``) into ``out_dir``;
-        returns ``{name: path}``.  Every file is written atomically."""
+        """Write the playback's report, plots and simulated trajectory into ``out_dir``.
+
+        ``report.json``, ``tracking.png``, ``limits.png`` and ``simulated.csv`` (the
+        simulated trajectory with its sidecar, ``ruledrobot.io.trajectory``); returns
+        ``{name: path}``.  Every file is written atomically.
+        """
         out = Path(out_dir)
         out.mkdir(parents=True, exist_ok=True)
         paths: dict[str, Path] = {}
@@ -253,8 +256,11 @@ class PlaybackResult:
         return paths
 
     def plot(self, out_dir: str | os.PathLike[str]) -> dict[str, Path]:
-        """``tracking.png`` (joint, TCP position and orientation errors over time) and
-        ``limits.png`` (|torque| / limit and |speed| / limit per joint); matplotlib Agg."""
+        """Draw ``tracking.png`` and ``limits.png`` (matplotlib Agg).
+
+        ``tracking.png``: joint, TCP position and orientation errors over time;
+        ``limits.png``: |torque| / limit and |speed| / limit per joint.
+        """
         import matplotlib
 
         matplotlib.use("Agg", force=False)

@@ -69,8 +69,10 @@ class CutJob(Protocol):
         ...
 
     def robot_model(self) -> RobotModel:
-        """The arm's model (with the job's calibration) in its own base frame (``base`` the
-        identity); :meth:`Scene.from_job` places it at ``robot.base``."""
+        """Return the arm's model (with the job's calibration) in its own base frame.
+
+        ``base`` the identity; :meth:`Scene.from_job` places it at ``robot.base``.
+        """
         ...
 
 
@@ -89,9 +91,11 @@ _TABLE_RGBA = "0.55 0.42 0.30 1"
 
 
 def default_table(model: RobotModel, stock: Box | None = None, margin: float = 0.25) -> Box:
-    """A 4 cm table top whose upper face is the base plane (z = 0 of the base frame),
-    covering the robot's footprint and the stock's, with ``margin`` [m] around them
-    (at least 1.2 x 0.9 m)."""
+    """Return a 4 cm table top whose upper face is the base plane (z = 0 of the base frame).
+
+    Covering the robot's footprint and the stock's, with ``margin`` [m] around them (at
+    least 1.2 x 0.9 m).
+    """
     reach = float(model.reach) if model.reach else float(np.sum(np.abs(model.a)) + 0.3)
     pts = [np.array([-0.2, -0.2]), np.array([0.2, 0.2])]
     if stock is not None:

@@ -135,8 +135,9 @@ def _child_entry(fd: int) -> None:  # pragma: no cover - runs in the child
 
 
 class Emulator:
-    """A UR controller emulator on ``host`` (RTDE 30004, dashboard 29999, script 30003,
-    primary 30001, secondary 30002).
+    """A UR controller emulator on ``host``.
+
+    RTDE 30004, dashboard 29999, script 30003, primary 30001, secondary 30002.
 
     The real ur_rtde client (RTDEReceiveInterface, RTDEControlInterface,
     RTDEIOInterface, DashboardClient) connects to it as to a robot.
@@ -326,8 +327,11 @@ class Emulator:
         return int(self._call("drop_connections", refuse_for))
 
     def freeze(self, duration: float | None = None) -> None:
-        """Fault: a frozen controller (sockets open, nothing answers or is sent, the time
-        stands still) for ``duration`` s, or until :meth:`unfreeze`."""
+        """Freeze the controller (a fault) for ``duration`` s, or until :meth:`unfreeze`.
+
+        A frozen controller: sockets open, nothing answers or is sent, the time stands
+        still.
+        """
         self._call("freeze", duration)
 
     def unfreeze(self) -> None:

@@ -63,10 +63,13 @@ class PlannedMeasures:
 
 @dataclass(frozen=True, eq=False)
 class Plan:
-    """A planned job.  ``motion``/``trajectory``/``measured`` are None when some pass has
-    no feasible wire motion (``reasons`` say why), a transit between passes has no
-    clear route (``transit_failures`` say which, and what is in the way) or the time law
-    found no usable trajectory for a pass (``timing_failures``)."""
+    """A planned job.
+
+    ``motion``/``trajectory``/``measured`` are None when some pass has no feasible wire
+    motion (``reasons`` say why), a transit between passes has no clear route
+    (``transit_failures`` say which, and what is in the way) or the time law found no usable
+    trajectory for a pass (``timing_failures``).
+    """
 
     job: Job
     model: RobotModel = field(repr=False)  # flange, no tool, the job's base
@@ -92,20 +95,27 @@ class Plan:
 
     @property
     def reachable(self) -> bool:
-        """Every pass has a feasible wire motion and every transit a clear route
-        (``motion`` is not None)."""
+        """Whether every pass has a feasible wire motion and every transit a clear route.
+
+        Then ``motion`` is not None.
+        """
         return self.motion is not None
 
 
 def job_source_bytes(job: Job) -> bytes | None:
-    """The job file's bytes as loaded (:func:`~.job.load.load_job` read them; None: a job
-    built in memory, or without its bytes): the job file is not read again."""
+    """Return the job file's bytes as loaded: the job file is not read again.
+
+    :func:`~.job.load.load_job` read them; None: a job built in memory, or without its
+    bytes.
+    """
     return None if job.source is None else job.source_bytes
 
 
 def job_reference(job: Job | Plan) -> dict[str, str] | None:
-    """``{"path", "sha256"}`` of the job file (None for a job built in memory); of a
-    :class:`Plan`, the reference it hashed when it was made."""
+    """Return ``{"path", "sha256"}`` of the job file (None for a job built in memory).
+
+    Of a :class:`Plan`, the reference it hashed when it was made.
+    """
     if isinstance(job, Plan):
         return job.job_ref if job.job_ref is not None else job_reference(job.job)
     return _reference(job, job_source_bytes(job))
@@ -118,11 +128,14 @@ def _reference(job: Job, data: bytes | None) -> dict[str, str] | None:
 
 
 def wire_deviation(plan: Plan, q: FloatArray) -> FloatArray:
-    """Per sample (M,) the distance [m] of the wire's chord ends, with joints ``q``
-    (M, 6), from the target ruling of its pass at the same path parameter — the z axis
-    of the wire's frame motion there (the screw geodesic between neighbouring frames);
-    0 outside the stock.  The chord is the planned one (the one model,
-    ``plan.motion.wire``), as points of the wire."""
+    """Return per sample the distance [m] of the wire from its pass's target ruling.
+
+    Per sample (M,) the distance of the wire's chord ends, with joints ``q`` (M, 6), from
+    the target ruling of its pass at the same path parameter — the z axis of the wire's
+    frame motion there (the screw geodesic between neighbouring frames); 0 outside the
+    stock.  The chord is the planned one (the one model, ``plan.motion.wire``), as points of
+    the wire.
+    """
     return _deviation_at(plan.model.fk(q), plan.passes, plan.motion)
 
 
@@ -140,12 +153,15 @@ def _deviation_at(flange: FloatArray, passes: tuple[CutPath, ...], mo: Motion) -
 
 
 def wire_cut(job: Job, motion: Motion, bow: BowTool | None = None) -> WireCut:
-    """What the planned trajectory cuts (the sidecar's ``cut``): the block, the wire and
-    per pass the feed window — the pass's samples, the cut's feed and tolerance, and
-    where the feed is held (its cut phase less the corner stops and slits) — and, for a
-    cut that names the part's side (``keep``), the face it must leave (``face_error``'s
-    target: the target rulings' lines and normals, the samples on the face), and the
-    job's material.  ``bow``: the job's, when the caller built it."""
+    """Return what the planned trajectory cuts: block, wire and each pass's feed window.
+
+    The sidecar's ``cut``: the block, the wire and per pass the feed window — the pass's
+    samples, the cut's feed and tolerance, and where the feed is held (its cut phase less
+    the corner stops and slits) — and, for a cut that names the part's side (``keep``), the
+    face it must leave (``face_error``'s target: the target rulings' lines and normals,
+    the samples on the face), and the job's material.  ``bow``: the job's, when the caller
+    built it.
+    """
     held_all = motion.surface & ~(False if motion.corner_stop is None else motion.corner_stop)
     feeds, faces = [], []
     for k, cp in enumerate(motion.passes):
@@ -250,6 +266,7 @@ def make_plan(
     search: SearchOptions | None = None,
 ) -> Plan:
     """Plan every cut of ``job`` (no files, no simulation): see the module doc.
+
     ``search``: the options of every pass's wire-pose search (default: the planner's).
 
     Each thing once: the job file's bytes are hashed once, the bow and the clearance cell

@@ -163,8 +163,11 @@ def parse_write_options(kind: str, raw: Mapping[str, Any], where: str, cli: bool
 
 def write_rulings(path: str | os.PathLike[str], rulings: Rulings, kind: str | None = None,
                   options: Any = None) -> Path:  # fmt: skip
-    """Write rulings as ``kind`` (default: by the suffix) with the writer's ``options``
-    (from :func:`parse_write_options`; None: defaults).  Atomic; returns the path."""
+    """Write rulings as ``kind`` (default: by the suffix) with the writer's ``options``.
+
+    ``options`` from :func:`parse_write_options` (None: defaults).  Atomic; returns the
+    path.
+    """
     kind = kind or kind_of(path, writing=True)
     if kind == "lines":
         from ..lines import save_lines

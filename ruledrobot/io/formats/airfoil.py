@@ -32,8 +32,11 @@ __all__ = ["Airfoil", "leading_edge_index", "read_airfoil"]
 
 @dataclass(frozen=True)
 class Airfoil:
-    """A profile: ``name``, ``points`` (N, 2) in chord units (Selig order, see the
-    module doc), the ``format`` it was read from (``"selig"``/``"lednicer"``)."""
+    """A profile: its name, its points in chord units and the format it was read from.
+
+    ``name``, ``points`` (N, 2) in chord units (Selig order, see the module doc), the
+    ``format`` it was read from (``"selig"``/``"lednicer"``).
+    """
 
     name: str
     points: FloatArray = field(repr=False)

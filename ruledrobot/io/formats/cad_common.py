@@ -51,9 +51,11 @@ class CadWriteOptions:
 
     @classmethod
     def parse(cls, o: Options, surface: bool = False) -> CadWriteOptions:
-        """The options ``units``, ``length`` [m] (non-zero), ``frame`` (a UR pose vector,
-        shape (6,): position [m], rotation vector [rad]) and, when ``surface`` is true, the
-        option ``surface`` read from ``o``; unknown options are refused.
+        """Read the options ``units``, ``length``, ``frame`` (and ``surface``) from ``o``.
+
+        ``length`` [m] (non-zero), ``frame`` (a UR pose vector, shape (6,): position [m],
+        rotation vector [rad]) and, when ``surface`` is true, the option ``surface``;
+        unknown options are refused.
         """
         frame = o.vector("frame", 6)
         opts = cls(
@@ -109,12 +111,15 @@ def _flat_z(p: FloatArray) -> float | None:
 def pair_to_rulings(a: FloatArray, b: FloatArray, closed: bool, m: MatchOptions,
                     distance: float | None, where: str, names: tuple[str, str],
                     source: str, profiles: bool = True) -> Rulings:  # fmt: skip
-    """Rulings between profile ``a`` and ``b`` (points (N, 3) m, a closed profile without
-    its repeated first point).  ``distance`` puts two flat profiles (both in one plane
-    z = c) that far apart along z.  A profile ``b`` that runs the other way round than
-    ``a``, or whose seam (first point) is elsewhere, is turned to match (noted).
-    ``profiles=False`` (ruledrobot's own end curves: wire paths, matched already, which
-    may cross themselves) skips the profile checks and turns."""
+    """Return the rulings between profile ``a`` and ``b``.
+
+    Profiles: points (N, 3) m, a closed profile without its repeated first point.
+    ``distance`` puts two flat profiles (both in one plane z = c) that far apart along z.  A
+    profile ``b`` that runs the other way round than ``a``, or whose seam (first point) is
+    elsewhere, is turned to match (noted).  ``profiles=False`` (ruledrobot's own end curves:
+    wire paths, matched already, which may cross themselves) skips the profile checks and
+    turns.
+    """
     notes = []
     za, zb = _flat_z(a), _flat_z(b)
     if distance is not None:

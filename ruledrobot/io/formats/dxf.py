@@ -54,9 +54,10 @@ class DxfOptions:
 
     @classmethod
     def parse(cls, o: Options) -> DxfOptions:
-        """The options ``layers`` (two names), ``distance`` [m] (non-zero), ``units``,
-        ``tolerance`` (> 0, default 1e-5) and those of :meth:`.cad_common.MatchOptions.parse`
-        read from ``o``; unknown options are refused.
+        """Read the DXF reader's options from ``o``; unknown options are refused.
+
+        ``layers`` (two names), ``distance`` [m] (non-zero), ``units``, ``tolerance`` (> 0,
+        default 1e-5) and those of :meth:`.cad_common.MatchOptions.parse`.
         """
         layers = o.strings("layers", 2)
         opts = cls(layers=layers, distance=o.number("distance", nonzero=True),

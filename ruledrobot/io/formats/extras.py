@@ -18,8 +18,10 @@ class MissingExtraError(ValueError):
 
 
 def require(module: str, what: str) -> ModuleType:
-    """Import ``module`` for ``what`` (e.g. "reading DXF files"), or raise
-    :class:`MissingExtraError` naming the extra that installs it."""
+    """Import ``module`` for ``what``, or raise :class:`MissingExtraError`.
+
+    ``what``: e.g. "reading DXF files"; the error names the extra that installs the module.
+    """
     try:
         return importlib.import_module(module)
     except ImportError:

@@ -69,8 +69,11 @@ class Options(FieldReader):
     def number(self, key: str, default: float | None = None, *, lo: float | None = None,
                hi: float | None = None, positive: bool = False, nonzero: bool = False,
                required: str = "") -> float | None:  # fmt: skip
-        """A finite number (``None`` when absent and ``default`` is None and not
-        ``required``; ``required`` is the hint given when it is missing)."""
+        """Return option ``key`` as a finite number.
+
+        ``None`` when absent and ``default`` is None and not ``required``; ``required`` is
+        the hint given when it is missing.
+        """
         v = self.get(key, default)
         if v is None:
             if required:
@@ -89,8 +92,9 @@ class Options(FieldReader):
 
     def integer(self, key: str, default: int | None = None, *, lo: int | None = None,
                 hi: int | None = None) -> int | None:  # fmt: skip
-        """An integer, ``lo <= v <= hi`` when those are given (``None`` when absent
-        and ``default`` is None); booleans and floats are refused.
+        """Return option ``key`` as an integer, ``lo <= v <= hi`` when those are given.
+
+        ``None`` when absent and ``default`` is None; booleans and floats are refused.
         """
         v = self.get(key, default)
         if v is None:
@@ -104,8 +108,10 @@ class Options(FieldReader):
         return int(v)
 
     def choice(self, key: str, options: tuple[str, ...], default: str | None) -> str | None:
-        """One of ``options``, lower-cased (the value is matched case-insensitively;
-        ``None`` when absent and ``default`` is None).
+        """Return option ``key`` as one of ``options``, lower-cased.
+
+        The value is matched case-insensitively; ``None`` when absent and ``default`` is
+        None.
         """
         v = self.get(key, default)
         if v is None:
@@ -141,8 +147,10 @@ class Options(FieldReader):
         return None if v is None else self.numbers(key, v, n)
 
     def unit(self, key: str, default: str | None = None) -> str | None:
-        """A length unit's canonical name (``m``, ``cm``, ``mm``, ``in``; see
-        :func:`ruledrobot.io.units.unit_name`), ``None`` when absent and ``default`` is None.
+        """Return a length unit's canonical name (``m``, ``cm``, ``mm``, ``in``).
+
+        See :func:`ruledrobot.io.units.unit_name`; ``None`` when absent and ``default`` is
+        None.
         """
         v = self.get(key, default)
         if v is None:
@@ -150,9 +158,11 @@ class Options(FieldReader):
         return unit_name(v, self.label(key))
 
     def path(self, key: str, required: bool = True, kind: str = "file") -> Path | None:
-        """A file that exists (relative paths from ``base_dir``,
-        :func:`ruledrobot.io.paths.input_path`); ``kind`` names it in the message when it
-        is missing (``"lines"``, ``"gcode"``, ...: ``"no such G-code file: PATH"``)."""
+        """Return a file that exists (relative paths from ``base_dir``).
+
+        Resolved by :func:`ruledrobot.io.paths.input_path`; ``kind`` names it in the message
+        when it is missing (``"lines"``, ``"gcode"``, ...: ``"no such G-code file: PATH"``).
+        """
         v = self.get(key)
         if v is None:
             if required:

@@ -36,9 +36,11 @@ def _dedupe(points: FloatArray) -> FloatArray:
 
 
 def resample(points: ArrayLike, n: int, spacing: str = "uniform") -> FloatArray:
-    """``n`` points (n, d) along the polyline ``points`` (N, d) at equal steps of the
-    normalised arc length (``uniform``) or at ``(1 - cos(pi u))/2`` (``cosine``); the
-    first and last points are kept exactly."""
+    """Return ``n`` points (n, d) along the polyline ``points`` (N, d).
+
+    At equal steps of the normalised arc length (``uniform``) or at ``(1 - cos(pi u))/2``
+    (``cosine``); the first and last points are kept exactly.
+    """
     p = _dedupe(np.asarray(points, dtype=np.float64))
     s = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(p, axis=0), axis=1))]
     u = np.linspace(0.0, 1.0, n)
@@ -85,10 +87,13 @@ def _candidate_pairs(s0: FloatArray, s1: FloatArray) -> tuple[np.ndarray, np.nda
 
 def check_simple(points: ArrayLike, where: str, closed: bool = False,
                  labels: list[str] | None = None) -> None:  # fmt: skip
-    """ValueError naming two segments of the polyline (N, 2) (or (N, 3), taken in its
-    best-fit plane) that cross; touching ends and neighbours do not count.  ``labels``
-    name the points in the message (e.g. file lines); default their indices.  Only
-    segments that share a cell of a grid are compared (vectorised, near linear time)."""
+    """Raise ValueError naming two segments of the polyline that cross.
+
+    The polyline (N, 2) (or (N, 3), taken in its best-fit plane); touching ends and
+    neighbours do not count.  ``labels`` name the points in the message (e.g. file lines);
+    default their indices.  Only segments that share a cell of a grid are compared
+    (vectorised, near linear time).
+    """
     p = np.asarray(points, dtype=np.float64)
     if p.shape[1] == 3:
         p = plane_coordinates(p)

@@ -58,8 +58,10 @@ class RhinoOptions:
 
     @classmethod
     def parse(cls, o: Options) -> RhinoOptions:
-        """The options ``use``, ``layer``, ``units``, ``direction`` and those of
-        :meth:`.cad_common.MatchOptions.parse` read from ``o``; unknown options are refused.
+        """Read the Rhino reader's options from ``o``; unknown options are refused.
+
+        ``use``, ``layer``, ``units``, ``direction`` and those of
+        :meth:`.cad_common.MatchOptions.parse`.
         """
         opts = cls(use=o.choice("use", ("auto", "lines", "curves", "surface"), "auto"),
                    layer=o.string("layer"), units=o.unit("units"),

@@ -28,10 +28,12 @@ __all__ = ["Planes", "Rulings", "fit_planes", "plane_ends", "rulings_from_ends"]
 
 @dataclass(frozen=True)
 class Planes:
-    """Planes ``z = 0`` and ``z = distance`` (m, signed, non-zero) of the frame ``pose``
-    (4, 4) given in the rulings' frame; ``name`` says what they are: ``"towers"`` (a
-    G-code file's), ``"faces"`` (a wing panel's root and tip), ``"profiles"`` (the
-    planes of two flat CAD profiles), ``"planes"``."""
+    """Planes ``z = 0`` and ``z = distance`` of the frame ``pose``, and what they are.
+
+    ``distance`` m, signed, non-zero; ``pose`` (4, 4) given in the rulings' frame; ``name``
+    says what they are: ``"towers"`` (a G-code file's), ``"faces"`` (a wing panel's root and
+    tip), ``"profiles"`` (the planes of two flat CAD profiles), ``"planes"``.
+    """
 
     pose: FloatArray = field(repr=False)
     distance: float

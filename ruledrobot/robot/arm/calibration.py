@@ -214,8 +214,10 @@ class Calibration:
     # ------------------------------------------------------------------ views
 
     def dh(self) -> FloatArray:
-        """(6, 4) per joint ``[theta_offset, a, d, alpha]`` (the column order of
-        :class:`ruledrobot.robot.KinematicsRef`)."""
+        """Return the DH table (6, 4): per joint ``[theta_offset, a, d, alpha]``.
+
+        The column order of :class:`ruledrobot.robot.KinematicsRef`.
+        """
         return np.stack([self.theta_offset, self.a, self.d, self.alpha], axis=1)
 
     def deltas(self) -> FloatArray:
@@ -238,8 +240,10 @@ class Calibration:
         return STATUS_TEXT.get(self.status, f"code {self.status}")
 
     def kinematics_info(self) -> KinematicsInfo:
-        """This calibration as the primary interface's KinematicsInfo (checksums 0 if unknown,
-        status 2 "linearised" if unknown)."""
+        """Return this calibration as the primary interface's KinematicsInfo.
+
+        Checksums 0 if unknown, status 2 "linearised" if unknown.
+        """
         from ...protocol.primary import KinematicsInfo
 
         return KinematicsInfo(

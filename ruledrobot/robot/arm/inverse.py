@@ -36,8 +36,10 @@ def _measure_scale(g: _ik.URGeometry) -> float:
 
 
 class InverseKinematics:
-    """IK methods of :class:`~ruledrobot.robot.arm.model.RobotModel` (see there for the
-    frames: world, robot base, flange, TCP)."""
+    """IK methods of :class:`~ruledrobot.robot.arm.model.RobotModel`.
+
+    See there for the frames: world, robot base, flange, TCP.
+    """
 
     if TYPE_CHECKING:  # read from the model (its dataclass fields and derived values)
         d: FloatArray

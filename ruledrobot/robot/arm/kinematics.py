@@ -148,8 +148,10 @@ class DHChain:
     tool: FloatArray | None = None
 
     def fk(self, q: FloatArray) -> FloatArray:
-        """TCP poses (n, 4, 4) ``base @ A_1(q_1) ... A_J(q_J) @ tool`` of joint positions
-        ``q`` (n, J) [rad] (already validated)."""
+        """Return the TCP poses (n, 4, 4) of joint positions ``q`` (n, J) [rad].
+
+        ``q`` is already validated; ``base @ A_1(q_1) ... A_J(q_J) @ tool``.
+        """
         n = q.shape[0]
         out = np.empty((n, 4, 4))
         for rows, frame, _ in self._walks(q):

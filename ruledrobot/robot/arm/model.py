@@ -411,15 +411,21 @@ class RobotModel(InverseKinematics):
         return pts.reshape(*q.shape[:-1], 2 * self.n_joints + 1, 3)
 
     def within_limits(self, q: ArrayLike, tol: float = LIMIT_TOL) -> np.ndarray:
-        """(...) bool: every joint of ``q`` (..., J) inside ``[lower - tol, upper + tol]``
-        [rad] (default the one slack, :data:`~ruledrobot.robot.ik.path.LIMIT_TOL`)."""
+        """Return whether every joint of ``q`` (..., J) is inside its limits, (...) bool.
+
+        Inside ``[lower - tol, upper + tol]`` [rad] (default the one slack,
+        :data:`~ruledrobot.robot.ik.path.LIMIT_TOL`).
+        """
         q = self._joints(q)
         return np.all((q >= self.lower - tol) & (q <= self.upper + tol), axis=-1)
 
     def position_ratio(self, q: ArrayLike) -> float:
-        """The largest ``|q - centre| / (half range + LIMIT_TOL)`` over the samples of
-        ``q`` (..., J) and the joints with finite limits (0 when none): at most 1 exactly
-        when :meth:`within_limits` holds (1 = at a limit, within the one slack)."""
+        """Return the largest ``|q - centre| / (half range + LIMIT_TOL)`` over samples and joints.
+
+        Over the samples of ``q`` (..., J) and the joints with finite limits (0 when none):
+        at most 1 exactly when :meth:`within_limits` holds (1 = at a limit, within the one
+        slack).
+        """
         q = self._joints(q)
         fin = np.isfinite(self.lower) & np.isfinite(self.upper)
         if not fin.any() or q.size == 0:

@@ -144,9 +144,11 @@ def link_segments(
 
 
 def body_frames(model: RobotModel, q: ArrayLike) -> FloatArray:
-    """World poses (n, J, 4, 4) of the link bodies at configurations ``q`` (n, J), on the
-    model's nominal table (the links' shape; a calibration moves them by millimetres)
-    and with its base."""
+    """Return the world poses (n, J, 4, 4) of the link bodies at configurations ``q`` (n, J).
+
+    On the model's nominal table (the links' shape; a calibration moves them by millimetres)
+    and with its base.
+    """
     q = np.asarray(q, dtype=np.float64).reshape(-1, model.n_joints)
     nom = model.nominal
     n, J = q.shape
@@ -167,9 +169,11 @@ def body_frames(model: RobotModel, q: ArrayLike) -> FloatArray:
 def arm_capsules(
     model: RobotModel, q: ArrayLike
 ) -> tuple[FloatArray, FloatArray, np.ndarray]:
-    """The link segments (:func:`link_segments`) as capsules in the world at
-    configurations ``q`` (..., J): end points (..., S, 2, 3) [m], radii (S,) [m] and the
-    body index (S,) of each (0 = the column over the base)."""
+    """Return the link segments as capsules in the world at configurations ``q`` (..., J).
+
+    The segments of :func:`link_segments`: end points (..., S, 2, 3) [m], radii (S,) [m] and
+    the body index (S,) of each (0 = the column over the base).
+    """
     q = np.asarray(q, dtype=np.float64)
     shape = q.shape[:-1]
     segs, _ = link_segments(model.nominal)

@@ -294,11 +294,13 @@ def _step(V):
 
 @_jit
 def refine(ch, offset, flange, seeds, shift, tol, max_iter, theta, conv, res, its):
-    """Refine the seeds (n, 8, 6) (DH angles of the seed table, NaN rows = none) on the chain
-    ``ch`` (4, 6): d, a, cos alpha, sin alpha.  Fills ``theta`` (n, 8, 6) joint positions in
-    (-pi, pi] (NaN where not converged), ``conv`` (n, 8), ``res`` (n, 8) (residual at the
-    solution, or the best one of a pair that failed; NaN where not seeded) and ``its`` (n, 8)
-    (Newton steps taken).
+    """Refine the IK seeds (n, 8, 6) on the chain ``ch`` by Newton steps.
+
+    The seeds are DH angles of the seed table (NaN rows = none); the chain ``ch`` (4, 6): d,
+    a, cos alpha, sin alpha.  Fills ``theta`` (n, 8, 6) joint positions in (-pi, pi] (NaN
+    where not converged), ``conv`` (n, 8), ``res`` (n, 8) (residual at the solution, or the
+    best one of a pair that failed; NaN where not seeded) and ``its`` (n, 8) (Newton steps
+    taken).
 
     ``_L`` lanes iterate side by side; a lane whose pair finishes takes the next pair at
     once.  Each round: cos and sin, the residual and the damped step of every lane

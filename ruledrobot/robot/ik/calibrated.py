@@ -173,9 +173,11 @@ def fallback_geometry(g: _ik.URGeometry, e: float = 0.01) -> _ik.URGeometry:
 def nominal_seeds(
     g: _ik.URGeometry, flange: FloatArray, seed6: FloatArray
 ) -> tuple[FloatArray, np.ndarray]:
-    """Seeds (n, 8, 6) (DH angles of the nominal table) and (n, 8) "from the closed form of
-    the nominal arm" flags; branches the nominal arm misses are filled from
-    :func:`fallback_geometry` where that reaches (flag False), else NaN.
+    """Return the IK seeds (n, 8, 6) from the nominal arm and their closed-form flags (n, 8).
+
+    The seeds are DH angles of the nominal table; a flag says "from the closed form of the
+    nominal arm".  Branches the nominal arm misses are filled from :func:`fallback_geometry`
+    where that reaches (flag False), else NaN.
 
     Compiled closed form (``_calibrated_kernel.seeds``, the formulas of ``analytic_ik``);
     poses whose wrist is within ``analytic_ik.RESCUE_W`` of singular, where ``seed6`` and

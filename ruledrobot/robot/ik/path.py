@@ -68,8 +68,11 @@ class PathArm(Protocol):
         ...
 
     def flange_poses(self, T: ArrayLike, *, check: bool = True) -> FloatArray:
-        """Poses of the flange in the robot base frame (..., 4, 4) [m] for TCP poses ``T``
-        (..., 4, 4) in the world frame: what the closed-form IK solves for."""
+        """Return the flange poses in the robot base frame for TCP poses ``T`` in the world frame.
+
+        Flange poses (..., 4, 4) [m] for ``T`` (..., 4, 4): what the closed-form IK solves
+        for.
+        """
         ...
 
 

@@ -43,8 +43,10 @@ def _annulus(g: URGeometry) -> tuple[float, float]:
 
 
 def elbow_distance(model: RobotModel, q: ArrayLike) -> FloatArray:
-    """Distance (m) from the shoulder to the origin of DH frame 3 in the arm plane,
-    ``sqrt(a2^2 + a3^2 + 2 a2 a3 cos q3)``, of joint positions ``q`` (..., 6)."""
+    """Return the distance (m) from the shoulder to the origin of DH frame 3 in the arm plane.
+
+    ``sqrt(a2^2 + a3^2 + 2 a2 a3 cos q3)``, of joint positions ``q`` (..., 6).
+    """
     g = model.nominal.ur_geometry
     q3 = np.asarray(q, dtype=np.float64)[..., 2] + float(model.nominal.theta_offset[2])
     d2 = g.a2 * g.a2 + g.a3 * g.a3 + 2.0 * g.a2 * g.a3 * np.cos(q3)
@@ -52,8 +54,11 @@ def elbow_distance(model: RobotModel, q: ArrayLike) -> FloatArray:
 
 
 def reach_margin(model: RobotModel, q: ArrayLike) -> FloatArray:
-    """How far (m) the elbow target of joint positions ``q`` (..., 6) lies inside the
-    elbow's annulus: ``min(|a2| + |a3| - D, D - ||a2| - |a3||)`` (0 stretched or folded)."""
+    """Return how far (m) the elbow target of ``q`` lies inside the elbow's annulus.
+
+    Joint positions ``q`` (..., 6): ``min(|a2| + |a3| - D, D - ||a2| - |a3||)`` (0 stretched
+    or folded).
+    """
     lo, hi = _annulus(model.nominal.ur_geometry)
     D = elbow_distance(model, q)
     return np.minimum(hi - D, D - lo)

@@ -364,8 +364,9 @@ class StopMotion:
         return self.t >= self.duration
 
     def next(self, dt: float, time_scale: float = 1.0) -> Setpoint | None:
-        """Advance by ``dt`` [s] and return the setpoint ``(q, qd, qdd)``, each (6,) [rad],
-        [rad/s], [rad/s^2]; None once at rest.
+        """Advance by ``dt`` [s] and return the setpoint ``(q, qd, qdd)``; None once at rest.
+
+        Each (6,) [rad], [rad/s], [rad/s^2].
 
         ``time_scale`` is taken for the motions' common interface and ignored: a stop
         runs in real time.

@@ -44,10 +44,13 @@ DWELL_SLACK = 0.1
 
 @dataclass(frozen=True)
 class FeedWindow:
-    """One pass's feed: samples ``[start, stop)`` of the pass (lead-in to lead-out), the
-    cut's name, its set ``speed`` (m/s) and relative ``tolerance``, the ``held``
-    ranges where the lowest feed is checked (module doc), and the cut's
-    ``wire_tolerance`` (m): how far the wire may stray from its target in the stock."""
+    """One pass's feed: its samples, the cut's set speed and tolerances, where it is held.
+
+    Samples ``[start, stop)`` of the pass (lead-in to lead-out), the cut's name, its set
+    ``speed`` (m/s) and relative ``tolerance``, the ``held`` ranges where the lowest feed is
+    checked (module doc), and the cut's ``wire_tolerance`` (m): how far the wire may stray
+    from its target in the stock.
+    """
 
     name: str
     start: int
@@ -95,11 +98,14 @@ class FeedWindow:
 
 @dataclass(frozen=True, eq=False)
 class WireCut:
-    """The block (robot base frame), the wire's length (m) and the passes' feeds: what
-    a trajectory cuts, so that any motion of it can be measured (module doc).  The
-    trajectory's TCP is the wire's midpoint with z along the wire.  ``faces``: the part's
-    surface each pass leaves (:mod:`.face`: ``face_error``); ``material``: the foam's
-    kerf model (None: every cut's constant kerf)."""
+    """What a trajectory cuts: the block, the wire's length and the passes' feeds.
+
+    The block (robot base frame), the wire's length (m) and the passes' feeds, so that any
+    motion of the trajectory can be measured (module doc).  The trajectory's TCP is the
+    wire's midpoint with z along the wire.  ``faces``: the part's surface each pass leaves
+    (:mod:`.face`: ``face_error``); ``material``: the foam's kerf model (None: every cut's
+    constant kerf).
+    """
 
     stock: Box
     wire_length: float
@@ -132,9 +138,11 @@ class WireCut:
 
 @dataclass(frozen=True)
 class FeedMeasure:
-    """The feed of one cut (all its windows) on a measured motion: the highest feed in
-    the stock and the lowest where it is held (m/s, NaN when never in the stock there),
-    the samples where they are, and the set speed and tolerance."""
+    """The feed of one cut (all its windows) on a measured motion.
+
+    The highest feed in the stock and the lowest where it is held (m/s, NaN when never in
+    the stock there), the samples where they are, and the set speed and tolerance.
+    """
 
     name: str
     speed: float
@@ -146,14 +154,19 @@ class FeedMeasure:
 
     @property
     def max_ok(self) -> bool:
-        """Whether the highest feed is at most ``speed · (1 + tolerance)``; False when the
-        wire never entered the stock in the cut's window (:func:`feed_checks`)."""
+        """Whether the highest feed is at most ``speed · (1 + tolerance)``.
+
+        False when the wire never entered the stock in the cut's window
+        (:func:`feed_checks`).
+        """
         return self.checks()[0].ok
 
     @property
     def min_ok(self) -> bool:
-        """Whether the lowest feed where it is held is at least ``speed · (1 - tolerance)``;
-        False when the wire was never in the stock there (:func:`feed_checks`)."""
+        """Whether the lowest feed where it is held is at least ``speed · (1 - tolerance)``.
+
+        False when the wire was never in the stock there (:func:`feed_checks`).
+        """
         return self.checks()[1].ok
 
     def checks(
@@ -181,11 +194,14 @@ def feed_checks(
     labels: tuple[str, str] = ("highest feed", "lowest feed"),
     details: tuple[str, str] = ("", ""),
 ) -> tuple[Check, Check]:
-    """The one feed rule of a cut, for the plan's verdict, an exported program's and a
-    run's: ``feed_max<key>``: the highest feed in the stock at most ``speed · (1 +
-    tolerance)``; ``feed_min<key>``: the lowest where it is held at least ``speed · (1 -
-    tolerance)``.  Values in mm/s; None (the wire never in the stock there: the cut was
-    not made) fails.  ``labels`` and ``details`` word the two checks for their report."""
+    """Return the one feed rule of a cut: its two checks, in mm/s.
+
+    For the plan's verdict, an exported program's and a run's: ``feed_max<key>``: the
+    highest feed in the stock at most ``speed · (1 + tolerance)``; ``feed_min<key>``: the
+    lowest where it is held at least ``speed · (1 - tolerance)``.  Values in mm/s; None (the
+    wire never in the stock there: the cut was not made) fails.  ``labels`` and ``details``
+    word the two checks for their report.
+    """
     return (
         Check.at_most("feed_max" + key, labels[0], highest_mm_s, speed_mm_s * (1 + tolerance),
                       "mm/s", details[0]),
@@ -195,8 +211,10 @@ def feed_checks(
 
 
 def feed_measures(wis: WireInStock, cut: WireCut) -> tuple[FeedMeasure, ...]:
-    """Per cut name (in the order of ``cut.feeds``) the feed checks' figures (module
-    doc) of the measured motion ``wis``."""
+    """Return per cut name the feed checks' figures of the measured motion ``wis``.
+
+    The figures of the module doc, in the order of ``cut.feeds``.
+    """
     n = wis.n
     names: list[str] = []
     for w in cut.feeds:
@@ -218,9 +236,11 @@ def feed_measures(wis: WireInStock, cut: WireCut) -> tuple[FeedMeasure, ...]:
 
 @dataclass(frozen=True)
 class HotDwell:
-    """The longest time the hot wire stayed in the block cutting slower than
-    :data:`DWELL_FRACTION` of the slowest set feed: ``seconds``, from sample ``start`` to
-    ``stop`` (half-open; ``start = -1`` and 0 s when it never did)."""
+    """The longest time the hot wire stayed in the block cutting too slowly.
+
+    Slower than :data:`DWELL_FRACTION` of the slowest set feed: ``seconds``, from sample
+    ``start`` to ``stop`` (half-open; ``start = -1`` and 0 s when it never did).
+    """
 
     seconds: float
     start: int = -1
@@ -228,9 +248,12 @@ class HotDwell:
 
 
 def hot_dwell(wis: WireInStock, hot: ArrayLike, speed: float) -> HotDwell:
-    """:class:`HotDwell` of a motion: ``wis`` the wire against the block (M samples),
-    ``hot`` (M,) the heat on, ``speed`` (m/s) the slowest set feed.  A dwell lasts from
-    its first sample to the first sample after it (the time the wire spent there)."""
+    """Return the :class:`HotDwell` of a motion.
+
+    ``wis`` the wire against the block (M samples), ``hot`` (M,) the heat on, ``speed``
+    (m/s) the slowest set feed.  A dwell lasts from its first sample to the first sample
+    after it (the time the wire spent there).
+    """
     h = np.asarray(hot, dtype=bool)
     slow = wis.inside & h & ~(np.nan_to_num(wis.feed, nan=0.0) >= DWELL_FRACTION * speed)
     best = HotDwell(0.0)

@@ -135,11 +135,13 @@ class FaceTarget:
 
 @dataclass(frozen=True)
 class FaceError:
-    """:func:`face_error` of one cut: ``error`` (M,) m per sample, the larger of its two
-    chord ends (NaN off the face, inf at a burn); ``kerf`` (M, 2) m at the chord ends
-    (NaN off the face); ``worst`` m (NaN when the wire was never on the face) at sample
-    ``at`` (-1: none), ``t`` s its time; ``burn``: the worst is a burn (a stop with the
-    heat above the threshold)."""
+    """The :func:`face_error` of one cut: per-sample error and kerf, and the worst error.
+
+    ``error`` (M,) m per sample, the larger of its two chord ends (NaN off the face, inf at
+    a burn); ``kerf`` (M, 2) m at the chord ends (NaN off the face); ``worst`` m (NaN when
+    the wire was never on the face) at sample ``at`` (-1: none), ``t`` s its time; ``burn``:
+    the worst is a burn (a stop with the heat above the threshold).
+    """
 
     name: str
     error: FloatArray = field(repr=False)
@@ -160,8 +162,11 @@ class FaceError:
         return bool(np.isfinite(self.worst) and self.worst <= self.tolerance)
 
     def kerf_range(self) -> FloatArray:
-        """(2, 2) m: per chord end (wire start side, wire end side) the smallest and the
-        largest predicted kerf on the face (NaN when never on it)."""
+        """Return per chord end the smallest and the largest predicted kerf on the face.
+
+        (2, 2) m: per chord end (wire start side, wire end side) the smallest and the
+        largest (NaN when never on it).
+        """
         k = self.kerf[~np.isnan(self.kerf).any(axis=1)]
         if not k.size:
             return np.full((2, 2), np.nan)
@@ -238,8 +243,11 @@ def face_errors(
     wis: WireInStock, power: ArrayLike | None, material: Material | None,
     faces: tuple[FaceTarget, ...],
 ) -> dict[str, FaceError]:
-    """:func:`face_error` per cut name (the passes of one cut joined: the larger error per
-    sample, the kerf where a pass is on its face), in the order of ``faces``."""
+    """Return :func:`face_error` per cut name, in the order of ``faces``.
+
+    The passes of one cut joined: the larger error per sample, the kerf where a pass is on
+    its face.
+    """
     out: dict[str, FaceError] = {}
     for f in faces:
         e = face_error(wis, power, material, f)

@@ -62,11 +62,13 @@ TOUCH = 1e-6
 def largest_line_distance(
     points: ArrayLike, origins: ArrayLike, directions: ArrayLike
 ) -> FloatArray:
-    """The largest distance (K,) [m] of points (K, P, 3) from the lines through
-    ``origins`` (K, 3) along ``directions`` (K, 3), normalised here:
-    ``max_p |(x_p - o) x u|``; NaN points are left out (0 when all are).  The wire's
-    deviation from a line — its target ruling (the plan), the planned wire (an exported
-    program, a run) — with the points the chord's ends."""
+    """Return the largest distance (K,) [m] of points from lines.
+
+    Points (K, P, 3); the lines through ``origins`` (K, 3) along ``directions`` (K, 3),
+    normalised here: ``max_p |(x_p - o) x u|``; NaN points are left out (0 when all are).
+    The wire's deviation from a line — its target ruling (the plan), the planned wire (an
+    exported program, a run) — with the points the chord's ends.
+    """
     x = np.asarray(points, dtype=np.float64)
     o = np.asarray(origins, dtype=np.float64)
     u = np.asarray(directions, dtype=np.float64)
@@ -76,9 +78,11 @@ def largest_line_distance(
 
 
 def wire_ends(tcp: ArrayLike, wire_length: float) -> FloatArray:
-    """Wire ends (M, 2, 3) of TCP poses (M, 4, 4) whose origin is the wire's midpoint
-    and whose z axis runs along the wire from its start to its end (the planner's wire
-    frame, the trajectory's TCP): ``p -+ (L / 2) z``."""
+    """Return the wire ends (M, 2, 3) of TCP poses (M, 4, 4): ``p -+ (L / 2) z``.
+
+    The poses' origin is the wire's midpoint and their z axis runs along the wire from its
+    start to its end (the planner's wire frame, the trajectory's TCP).
+    """
     T = np.asarray(tcp, dtype=np.float64)
     half = 0.5 * float(wire_length) * T[..., :3, 2]
     p = T[..., :3, 3]
@@ -119,10 +123,12 @@ def _neighbours(m: int) -> tuple[np.ndarray, np.ndarray]:
 
 
 def across_speeds(x: ArrayLike, ends: ArrayLike, fractions: ArrayLike) -> FloatArray:
-    """Speed across the wire (M, K) of the material points at ``fractions`` (M, K) of
-    each wire (``ends`` (M, 2, 3)), per unit of ``x`` (M,) strictly increasing (time:
-    m/s; a path parameter: m per unit).  Central differences of the same material
-    points, one-sided at the ends (module doc); NaN fractions give NaN."""
+    """Return the speed across the wire (M, K) of the material points at ``fractions``.
+
+    Points at ``fractions`` (M, K) of each wire (``ends`` (M, 2, 3)), per unit of ``x`` (M,)
+    strictly increasing (time: m/s; a path parameter: m per unit).  Central differences of
+    the same material points, one-sided at the ends (module doc); NaN fractions give NaN.
+    """
     xa = np.asarray(x, dtype=np.float64)
     e = np.asarray(ends, dtype=np.float64)
     f = np.asarray(fractions, dtype=np.float64)
@@ -223,15 +229,20 @@ class WireInStock:
         return runs_of(self.inside)
 
     def first_last(self, rows: ArrayLike | None = None) -> tuple[int, int] | None:
-        """The first and last sample (of ``rows``, default all) with the wire in the
-        stock, or None when it never is."""
+        """Return the first and last sample with the wire in the stock, or None when it never is.
+
+        Of ``rows``, default all.
+        """
         idx = np.arange(self.n) if rows is None else np.asarray(rows)
         k = idx[self.inside[idx]]
         return (int(k[0]), int(k[-1])) if k.size else None
 
     def feed_extremes(self, mask: ArrayLike) -> tuple[float, float, int, int]:
-        """``(lowest, highest, at_lowest, at_highest)`` feed over the samples of ``mask``
-        that are in the stock (NaN and -1 when there are none)."""
+        """Return the lowest and highest feed over the samples of ``mask`` in the stock, and where.
+
+        ``(lowest, highest, at_lowest, at_highest)`` over the samples of ``mask`` that are
+        in the stock (NaN and -1 when there are none).
+        """
         k = np.flatnonzero(np.asarray(mask, dtype=bool) & self.inside)
         if not k.size:
             return float("nan"), float("nan"), -1, -1
@@ -283,8 +294,10 @@ def _nearest(ends: FloatArray, stock: Box) -> tuple[FloatArray, FloatArray]:
 
 
 def wire_gap(ends: ArrayLike, stock: Box) -> FloatArray:
-    """(M,) m: how far the wire (ends (M, 2, 3)) is from the block (0 where it touches
-    or crosses it)."""
+    """Return how far (M,) [m] the wire (ends (M, 2, 3)) is from the block.
+
+    0 where it touches or crosses it.
+    """
     e = np.asarray(ends, dtype=np.float64).reshape(-1, 2, 3)
     return _nearest(e, stock)[0]
 

@@ -46,8 +46,11 @@ def _positive(name: str, value: float, allow_zero: bool = False) -> float:
 
 @dataclass(frozen=True)
 class Material:
-    """A foam's kerf constants (module doc): ``kerf_base`` m, ``kerf_gain`` m^2/s per W/m,
-    ``power_threshold`` W/m, ``max_speed`` (m/s per W/m above the threshold) or None."""
+    """A foam's kerf constants (module doc).
+
+    ``kerf_base`` m, ``kerf_gain`` m^2/s per W/m, ``power_threshold`` W/m, ``max_speed``
+    (m/s per W/m above the threshold) or None.
+    """
 
     kerf_base: float
     kerf_gain: float
@@ -63,9 +66,12 @@ class Material:
             object.__setattr__(self, "max_speed", _positive("max_speed", self.max_speed))
 
     def kerf(self, speed: ArrayLike, power: ArrayLike) -> FloatArray:
-        """The kerf [m] (broadcast shape) at ``speed`` [m/s] across the wire and wire
-        ``power`` [W/m]: ``kerf_base + kerf_gain * max(p - p0, 0) / v``; ``inf`` where the
-        wire is hotter than its threshold and still, ``kerf_base`` where it is not hotter."""
+        """Return the kerf [m] at ``speed`` [m/s] across the wire and wire ``power`` [W/m].
+
+        In the broadcast shape: ``kerf_base + kerf_gain * max(p - p0, 0) / v``; ``inf``
+        where the wire is hotter than its threshold and still, ``kerf_base`` where it is not
+        hotter.
+        """
         v = np.asarray(speed, dtype=np.float64)
         excess = np.maximum(np.asarray(power, dtype=np.float64) - self.power_threshold, 0.0)
         with np.errstate(divide="ignore", invalid="ignore"):
@@ -73,9 +79,11 @@ class Material:
         return self.kerf_base + np.where(np.isnan(melt), np.inf, melt)
 
     def power_for_kerf(self, kerf: ArrayLike, speed: ArrayLike) -> FloatArray:
-        """The wire power [W/m] (broadcast shape) that melts ``kerf`` [m] at ``speed``
-        [m/s]: ``p0 + (kerf - kerf_base) * v / kerf_gain``; raises where ``kerf`` is below
-        ``kerf_base`` (no power melts less than the wire's own width)."""
+        """Return the wire power [W/m] that melts ``kerf`` [m] at ``speed`` [m/s].
+
+        In the broadcast shape: ``p0 + (kerf - kerf_base) * v / kerf_gain``; raises where
+        ``kerf`` is below ``kerf_base`` (no power melts less than the wire's own width).
+        """
         w = np.asarray(kerf, dtype=np.float64)
         if np.any(w < self.kerf_base):
             raise ValueError(f"kerf {np.min(w) * 1e3:.4g} mm is below the material's "
@@ -84,8 +92,10 @@ class Material:
         return self.power_threshold + (w - self.kerf_base) * np.asarray(speed) / self.kerf_gain
 
     def speed_limit(self, power: ArrayLike) -> FloatArray:
-        """The fastest speed [m/s] the wire melts its way at ``power`` [W/m]:
-        ``max_speed * max(p - p0, 0)``; ``inf`` when the material gives no ``max_speed``."""
+        """Return the fastest speed [m/s] the wire melts its way at ``power`` [W/m].
+
+        ``max_speed * max(p - p0, 0)``; ``inf`` when the material gives no ``max_speed``.
+        """
         p = np.asarray(power, dtype=np.float64)
         if self.max_speed is None:
             return np.full(p.shape, np.inf)
@@ -93,10 +103,12 @@ class Material:
 
 
 def wire_power(t: ArrayLike, setpoint: ArrayLike, lag: float) -> FloatArray:
-    """The wire's power (N,) [W/m] at times ``t`` (N,) [s, increasing] of a set-point
-    schedule ``setpoint`` (N,) [W/m] given at the same times: the set-point ``lag`` s
-    earlier (a pure delay, module doc), held at the first set-point before it and
-    linearly interpolated between samples."""
+    """Return the wire's power (N,) [W/m] at times ``t`` (N,) of a set-point schedule.
+
+    Times ``t`` [s, increasing]; ``setpoint`` (N,) [W/m] given at the same times: the
+    set-point ``lag`` s earlier (a pure delay, module doc), held at the first set-point
+    before it and linearly interpolated between samples.
+    """
     ta = np.asarray(t, dtype=np.float64)
     p = np.asarray(setpoint, dtype=np.float64)
     if lag < 0.0 or not np.isfinite(lag):

@@ -29,9 +29,12 @@ __all__ = ["corner_dwell", "wire_bow"]
 def wire_bow(
     speed: ArrayLike, chord: ArrayLike, length: float, tension: float, drag: float
 ) -> FloatArray:
-    """The wire's mid-span bow [m] behind its ends (broadcast shape) at ``speed`` [m/s]
-    across itself with ``chord`` [m] of it in the foam, a wire of ``length`` [m] under
-    ``tension`` [N] and a foam of ``drag`` [N/m per m/s]: ``drag v c (2L - c) / (8T)``."""
+    """Return the wire's mid-span bow [m] behind its ends: ``drag v c (2L - c) / (8T)``.
+
+    In the broadcast shape, at ``speed`` [m/s] across itself with ``chord`` [m] of it in the
+    foam, a wire of ``length`` [m] under ``tension`` [N] and a foam of ``drag`` [N/m per
+    m/s].
+    """
     if not (np.isfinite(tension) and tension > 0.0):
         raise ValueError(f"wire_tension: expected newtons > 0, got {tension!r}")
     if not (np.isfinite(drag) and drag >= 0.0):
@@ -42,8 +45,10 @@ def wire_bow(
 
 
 def corner_dwell(bow: ArrayLike, speed: ArrayLike) -> FloatArray:
-    """The dwell [s] a corner asks for: the time the trailing middle takes to catch up,
-    ``bow / v`` (0 where the wire does not bow; ``inf`` where it bows and is still)."""
+    """Return the dwell [s] a corner asks for: the time the trailing middle takes to catch up.
+
+    ``bow / v`` (0 where the wire does not bow; ``inf`` where it bows and is still).
+    """
     b = np.asarray(bow, dtype=np.float64)
     v = np.asarray(speed, dtype=np.float64)
     with np.errstate(divide="ignore", invalid="ignore"):

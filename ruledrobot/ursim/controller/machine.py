@@ -299,8 +299,10 @@ class Controller(IOMixin, SafetyMixin):
         return r.line if isinstance(r, Interpreter) else 0
 
     def arm_state(self) -> ArmState:
-        """The arm's state after the last period (the
-        :class:`~ruledrobot.ursim.script.host.ProgramHost` interface)."""
+        """Return the arm's state after the last period.
+
+        The :class:`~ruledrobot.ursim.script.host.ProgramHost` interface.
+        """
         return self.backend.state()
 
     # ------------------------------------------------------------ log
@@ -509,8 +511,11 @@ class Controller(IOMixin, SafetyMixin):
             return self.start_program(prog)
 
     def program_path(self, path: str) -> Path | None:
-        """The file ``path`` names inside :attr:`programs_dir` (relative to it, or absolute
-        within it, symbolic links resolved), or None: outside, missing, not a file."""
+        """Return the file ``path`` names inside :attr:`programs_dir`, or None.
+
+        Relative to it, or absolute within it, symbolic links resolved; None: outside,
+        missing, not a file.
+        """
         root = self.programs_dir
         if root is None or not path or "\x00" in path:
             return None
@@ -522,10 +527,12 @@ class Controller(IOMixin, SafetyMixin):
         return real if real.is_relative_to(root) and real.is_file() else None
 
     def load(self, path: str) -> str:
-        """Dashboard ``load``: ``"ok"``, ``"not found"`` or ``"error"`` (a ``.script`` that
-        does not compile: logged and shown as a popup).  Only files inside
-        :attr:`programs_dir` (:meth:`program_path`).  A ``.script`` is run by
-        ``play``; a ``.urp`` idles (the emulator cannot run PolyScope programs)."""
+        """Answer the dashboard's ``load``: ``"ok"``, ``"not found"`` or ``"error"``.
+
+        ``"error"``: a ``.script`` that does not compile (logged and shown as a popup).
+        Only files inside :attr:`programs_dir` (:meth:`program_path`).  A ``.script`` is run
+        by ``play``; a ``.urp`` idles (the emulator cannot run PolyScope programs).
+        """
         found = self.program_path(path)
         if found is None:
             return "not found"

@@ -106,9 +106,12 @@ class SafetyMixin:
             self._power_off_when_stopped = True
 
     def restart_safety(self) -> None:
-        """Dashboard ``restart safety``: the safety system restarts after a fault or a
-        violation, the robot is then powered off.  An emergency stop stays: it is
-        released on the robot (the button), never from the network."""
+        """Answer the dashboard's ``restart safety``: restart the safety system, then power off.
+
+        The safety system restarts after a fault or a violation, the robot is then powered
+        off.  An emergency stop stays: it is released on the robot (the button), never from
+        the network.
+        """
         with self.lock:
             if self.safety_mode in (SafetyMode.ROBOT_EMERGENCY_STOP,
                                     SafetyMode.SYSTEM_EMERGENCY_STOP):  # fmt: skip

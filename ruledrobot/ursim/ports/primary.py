@@ -199,9 +199,11 @@ def robot_state(ctrl: Controller, kinematics: bytes, reserved: bool = True) -> b
 
 
 class PrimaryPublisher:
-    """The thread that sends a robot-state message to every primary/secondary client
-    every :data:`PUBLISH_PERIOD` s (an absolute schedule; a late wake-up skips ahead,
-    it never sends a burst).  Nothing is sent while ``frozen`` is set."""
+    """The thread that sends a robot-state message to every primary/secondary client.
+
+    Every :data:`PUBLISH_PERIOD` s (an absolute schedule; a late wake-up skips ahead, it
+    never sends a burst).  Nothing is sent while ``frozen`` is set.
+    """
 
     def __init__(
         self,

@@ -89,7 +89,9 @@ SEND_BUFFER = 64 * 1024
 
 
 def due(tick: int, ratio: float) -> bool:
-    """Is a stream of ``ratio`` = frequency / controller frequency due at controller ``tick``?
+    """Return whether a stream of ``ratio`` is due at controller ``tick``.
+
+    ``ratio`` = frequency / controller frequency.
 
     True at the ticks where ``floor(tick * ratio)`` steps: every tick for
     ratio 1, the multiples of 4 for 1/4 (125 Hz on 500 Hz), of 5 for 1/5.

@@ -51,11 +51,13 @@ class ScriptPortServer(TcpServer):
 
 
 class ProgramReceiver:
-    """Cuts one connection's URScript into programs and hands each to the controller
-    (``received(text)`` is called first).  :meth:`feed` raises ValueError beyond
+    """The receiver that cuts one connection's URScript into programs for the controller.
+
+    ``received(text)`` is called first.  :meth:`feed` raises ValueError beyond
     :data:`~ruledrobot.ursim.script.program.MAX_PROGRAM_BYTES` or
-    :data:`~ruledrobot.ursim.script.program.MAX_LINE_BYTES` (the
-    connection must then close: the stream cannot be resynchronised)."""
+    :data:`~ruledrobot.ursim.script.program.MAX_LINE_BYTES` (the connection must then close:
+    the stream cannot be resynchronised).
+    """
 
     def __init__(
         self, controller: Controller, received: Callable[[str], None] | None = None

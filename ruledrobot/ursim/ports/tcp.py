@@ -120,8 +120,11 @@ class QueuedConnection(Connection):
 
     @property
     def closing(self) -> bool:
-        """Broken: the connection's own thread closes it (closing a socket with megabytes
-        unsent costs milliseconds, which the sending thread must not pay)."""
+        """Whether the connection is broken, to be closed by its own thread.
+
+        Broken: the connection's own thread closes it (closing a socket with megabytes
+        unsent costs milliseconds, which the sending thread must not pay).
+        """
         return self.broken
 
     def push(self, data: bytes, max_backlog: int, send: bool = True) -> None:
@@ -184,8 +187,9 @@ def writable_fds(conns: list[QueuedConnection]) -> set[int]:
 
 
 def quick_ack(sock: socket.socket) -> None:
-    """Acknowledge what ``sock`` received at once instead of after Linux's delayed-ACK timer
-    (up to 40 ms); call it after each ``recv``.
+    """Acknowledge what ``sock`` received at once, not after Linux's delayed-ACK timer.
+
+    The timer waits up to 40 ms; call it after each ``recv``.
 
     A peer that sends small packets with Nagle's algorithm on (ur_rtde's sockets: their
     no-delay option is lost when boost::asio's connect reopens the socket) holds its next
@@ -504,8 +508,10 @@ class TcpServer:
     def recv_loop(
         self, conn: Connection, on_data: Callable[[bytes], None], bufsize: int = 65536
     ) -> None:
-        """Read until the peer closes, the server stops or ``on_data`` raises (a
-        non-blocking socket: also when the connection is closing)."""
+        """Read until the peer closes, the server stops or ``on_data`` raises.
+
+        A non-blocking socket: also when the connection is closing.
+        """
         if conn.sock.gettimeout() != 0.0:  # recv waits up to the socket's timeout
             self._recv(conn, on_data, bufsize, None, (TimeoutError,))
             return

@@ -43,9 +43,11 @@ _MOVES = ("movej", "movel", "movep")
 
 
 class Library:
-    """The built-ins bound to a controller (``host``) and the interpreter's threads
-    (``runtime``: ``join`` and the pending moves); :meth:`namespace` is what the
-    transpiled program sees."""
+    """The built-ins bound to a controller and the interpreter's threads.
+
+    The controller ``host``; the threads ``runtime`` (``join`` and the pending moves).
+    :meth:`namespace` is what the transpiled program sees.
+    """
 
     def __init__(self, host: ProgramHost, runtime: Any) -> None:
         self.c = host

@@ -63,8 +63,11 @@ class CompileError(ScriptSyntaxError):
 
 
 class ScriptRuntimeError(MotionError):
-    """A runtime error of a running program (an index out of range, a bad argument, a pose
-    out of reach): the program stops; the interpreter adds the line."""
+    """A runtime error of a running program: the program stops.
+
+    An index out of range, a bad argument, a pose out of reach; the interpreter adds the
+    line.
+    """
 
 
 @dataclass(frozen=True)

@@ -198,8 +198,10 @@ class ScriptSockets:
     # ------------------------------------------------------------ reads
     def socket_read_binary_integer(self, number: int, socket_name: str = "socket_0",
                                    timeout: float = 2.0) -> Gen:  # fmt: skip
-        """``[number, v1, ..., vn]``: ``number`` big-endian int32 values, waiting up to
-        ``timeout`` s of controller time; ``[0, -1, ..., -1]`` on a timeout."""
+        """Read ``number`` big-endian int32 values: ``[number, v1, ..., vn]``.
+
+        Waiting up to ``timeout`` s of controller time; ``[0, -1, ..., -1]`` on a timeout.
+        """
         n = int(number)
         if n < 1 or n > 30:
             raise ScriptRuntimeError(f"socket_read_binary_integer(): number must be 1..30, got {n}")

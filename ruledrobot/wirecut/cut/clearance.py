@@ -101,8 +101,10 @@ class Cell:
 
     @functools.cached_property
     def touch(self) -> _Touch:
-        """The capsule pairs of the arm with itself and with the bow (``self_collision``),
-        built on first use."""
+        """Return the capsule pairs of the arm with itself and with the bow, built on first use.
+
+        The pairs the ``self_collision`` rule tests.
+        """
         return _touch_pairs(self)
 
     @classmethod
@@ -151,9 +153,11 @@ def _excluded(model: RobotModel) -> set[tuple[int, int]]:
 
 
 def self_pairs(model: RobotModel, body: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The capsule pairs (I, J) (P,) the arm's self-collision rule tests, indices into the
-    capsules ``body`` (S,) (the body of each, -1 the base): those of bodies MuJoCo lets
-    touch (module doc)."""
+    """Return the capsule pairs (I, J) (P,) the arm's self-collision rule tests.
+
+    Indices into the capsules ``body`` (S,) (the body of each, -1 the base): the pairs are
+    those of bodies MuJoCo lets touch (module doc).
+    """
     I, J = np.triu_indices(len(body), 1)
     excluded = _excluded(model)
     keep = np.array([(min(a, b), max(a, b)) not in excluded

@@ -115,10 +115,13 @@ def _move(ends: FloatArray, step: FloatArray, stock: Box) -> FloatArray:
 
 def profile_entry(lines: Lines, kind: str | None, closed: bool, stock: Box, half: float,
                   planes: tuple[FloatArray, float] | None = None) -> ProfileEntry | None:
-    """The entry and exit moves of a profile (see the module doc), or None when
-    ``lines`` (N) of a file of ``kind`` are not a profile that returns to its start,
-    or neither end cuts the block.  ``half`` [m]: half the wire; ``planes``: the file's
-    (:meth:`~..job.spec.SurfaceSpec.planes`), in the frame of ``lines`` and ``stock``."""
+    """Return the entry and exit moves of a profile (see the module doc), or None.
+
+    None when ``lines`` (N) of a file of ``kind`` are not a profile that returns to its
+    start, or neither end cuts the block.  ``half`` [m]: half the wire; ``planes``: the
+    file's (:meth:`~..job.spec.SurfaceSpec.planes`), in the frame of ``lines`` and
+    ``stock``.
+    """
     n = len(lines)
     if closed or kind not in PROFILE_KINDS or n < 3:
         return None

@@ -70,8 +70,10 @@ SHORT_CHORD = 0.002
 
 @dataclass(frozen=True)
 class KerfOffsets:
-    """Per ruling (M,) the wire's offset vector (M, 3) [m] and the predicted error of the
-    kept surface (M,) [m] (the largest over the chord, >= 0); zeros when not compensated.
+    """Per ruling, the wire's offset vector and the predicted error of the kept surface.
+
+    Per ruling (M,) the offset vector (M, 3) [m] and the predicted error (M,) [m] (the
+    largest over the chord, >= 0); zeros when not compensated.
 
     ``turn`` (M, 3, 3): the rotation (world frame) of the wire's axes about its moved
     origin, per point compensated (None: parallel offsets, the axes unchanged);
@@ -87,8 +89,11 @@ class KerfOffsets:
 
     def moved(self, frames: FloatArray, index: ArrayLike | None = None,
               back: bool = False) -> FloatArray:  # fmt: skip
-        """Frames (K, 4, 4) moved as the wire of rulings ``index`` (K,) (default all) is
-        moved from its target; ``back``: the target of wire frames (the inverse)."""
+        """Return frames moved as the wire of the given rulings is moved from its target.
+
+        Frames (K, 4, 4) moved as the wire of rulings ``index`` (K,) (default all) is moved
+        from its target; ``back``: the target of wire frames (the inverse).
+        """
         k = slice(None) if index is None else np.asarray(index)
         out = np.array(frames, dtype=np.float64)
         off = np.broadcast_to(self.offset[k], out[:, :3, 3].shape)
@@ -108,8 +113,10 @@ def _derivative(x: FloatArray, closed: bool) -> FloatArray:
 
 
 def ruling_normals(frames: FloatArray, t: FloatArray, closed: bool = False) -> FloatArray:
-    """Unit normals (M, K, 3) of the surface swept by the frames' z axes at wire
-    parameters ``t`` (M, K) [m along z from the origin], ``z x (o' + t z')``."""
+    """Return unit normals of the surface swept by the frames' z axes at wire parameters ``t``.
+
+    Normals (M, K, 3) at ``t`` (M, K) [m along z from the origin]: ``z x (o' + t z')``.
+    """
     o, z = frames[:, :3, 3], frames[:, :3, 2]
     do, dz = _derivative(o, closed), _derivative(z, closed)
     tangent = do[:, None, :] + t[..., None] * dz[:, None, :]
@@ -162,9 +169,12 @@ def waste_sign(
 def kerf_offsets(
     frames: FloatArray, stock: Box, kerf: float, keep: str | FloatArray | None, closed: bool
 ) -> KerfOffsets:
-    """The minimax offsets (module doc) of every ruling towards the waste by ``kerf / 2``;
-    zero offsets when ``keep`` is None or ``kerf`` is 0.  Rulings that miss the stock get
-    the offset of the nearest ruling that crosses it (the lead-in/out keeps its side)."""
+    """Return the minimax offsets of every ruling towards the waste by ``kerf / 2``.
+
+    The offsets are the module doc's; zero offsets when ``keep`` is None or ``kerf`` is 0.
+    Rulings that miss the stock get the offset of the nearest ruling that crosses it (the
+    lead-in/out keeps its side).
+    """
     M = frames.shape[0]
     if keep is None or kerf <= 0.0:
         return KerfOffsets(np.zeros((M, 3)), np.zeros(M), False)
@@ -198,11 +208,13 @@ def kept_surface_error(
     keep: str | FloatArray,
     closed: bool = False,
 ) -> FloatArray:
-    """Per ruling (M,) the largest error [m] of the kept surface left by a wire on
-    ``wire_frames`` (parallel, offset rulings) against the target ``surface_frames``:
-    ``|distance from the wire to each tangent plane along the chord - kerf / 2|``, with
-    the wire required on the waste side (a wire on the part side counts its full
-    distance plus half the kerf)."""
+    """Return per ruling the largest error [m] of the kept surface left by a wire.
+
+    Per ruling (M,), for a wire on ``wire_frames`` (parallel, offset rulings) against the
+    target ``surface_frames``: ``|distance from the wire to each tangent plane along the
+    chord - kerf / 2|``, with the wire required on the waste side (a wire on the part side
+    counts its full distance plus half the kerf).
+    """
     sign = waste_sign(surface_frames, stock, keep, closed)
     t, hit = _chord_samples(surface_frames, stock)
     n = sign * ruling_normals(surface_frames, t, closed)
@@ -212,10 +224,12 @@ def kept_surface_error(
 
 
 def on_power(cut: CutSpec, heat: HeatSpec | None, material: Material) -> float:
-    """The wire's power [W/m] while the heat is on in the modes ``on_off`` and
-    ``constant`` (docs/kerf.md): ``[tool] heat power`` when given (clipped to
-    ``full_scale`` on an analog output), else the power that melts the cut's ``kerf``
-    at its feed (the supply set up for the nominal kerf)."""
+    """Return the wire's power [W/m] while the heat is on (modes ``on_off``, ``constant``).
+
+    In the modes ``on_off`` and ``constant`` (docs/kerf.md): ``[tool] heat power`` when
+    given (clipped to ``full_scale`` on an analog output), else the power that melts the
+    cut's ``kerf`` at its feed (the supply set up for the nominal kerf).
+    """
     if heat is not None and heat.power is not None:
         top = heat.full_scale if heat.kind == "analog" and heat.full_scale else np.inf
         return float(min(heat.power, top))
@@ -225,10 +239,12 @@ def on_power(cut: CutSpec, heat: HeatSpec | None, material: Material) -> float:
 def held_kerf(
     ratio: ArrayLike, cut: CutSpec, heat: HeatSpec | None, material: Material
 ) -> FloatArray:
-    """The kerf [m] (ratio's shape) at chord points moving ``ratio`` (<= 1) times as fast
-    as the reference point, which the time law holds at the cut's feed (module doc):
-    ``constant_kerf`` ``kerf_base + (kerf - kerf_base) / ratio``, else
-    ``material.kerf(feed * ratio, on_power)``."""
+    """Return the kerf [m] at chord points moving ``ratio`` times as fast as the reference.
+
+    The kerf has ``ratio``'s shape; ``ratio`` <= 1, relative to the reference point, which
+    the time law holds at the cut's feed (module doc): ``constant_kerf`` ``kerf_base +
+    (kerf - kerf_base) / ratio``, else ``material.kerf(feed * ratio, on_power)``.
+    """
     r = np.asarray(ratio, dtype=np.float64)
     if heat is not None and heat.mode == "constant_kerf":
         with np.errstate(divide="ignore"):
@@ -260,11 +276,13 @@ def point_kerf_offsets(
     frames: FloatArray, stock: Box, cut: CutSpec, heat: HeatSpec | None, material: Material,
     closed: bool = False, rounds: int = ROUNDS,
 ) -> KerfOffsets:
-    """The per-point compensation (module doc) of the target rulings ``frames`` (M, 4, 4):
-    each chord end moved by half the kerf predicted there (:func:`held_kerf`) into the
-    waste, ``rounds`` times with the speed ratios of the moved wire.  Rulings that miss
-    the stock, or whose chord is shorter than :data:`SHORT_CHORD`, get the offset and turn
-    of the nearest ruling with a longer chord."""
+    """Return the per-point compensation (module doc) of the target rulings ``frames``.
+
+    ``frames`` (M, 4, 4): each chord end is moved by half the kerf predicted there
+    (:func:`held_kerf`) into the waste, ``rounds`` times with the speed ratios of the moved
+    wire.  Rulings that miss the stock, or whose chord is shorter than :data:`SHORT_CHORD`,
+    get the offset and turn of the nearest ruling with a longer chord.
+    """
     M = frames.shape[0]
     sign = waste_sign(frames, stock, cut.keep, closed)
     c0, c1, hit = chords(frames, stock)
@@ -310,8 +328,11 @@ def cut_offsets(
     frames: FloatArray, stock: Box, cut: CutSpec, heat: HeatSpec | None,
     material: Material | None, closed: bool,
 ) -> KerfOffsets:
-    """A cut's compensation: per point (:func:`point_kerf_offsets`) with a ``material``,
-    else today's constant kerf (:func:`kerf_offsets`); none without ``keep``."""
+    """Return a cut's kerf compensation.
+
+    Per point (:func:`point_kerf_offsets`) with a ``material``, else today's constant kerf
+    (:func:`kerf_offsets`); none without ``keep``.
+    """
     if material is None or cut.keep is None or cut.kerf <= 0.0:
         return kerf_offsets(frames, stock, cut.kerf, cut.keep, closed)
     return point_kerf_offsets(frames, stock, cut, heat, material, closed)

@@ -176,10 +176,13 @@ def refine_cut(
     cut: CutSpec, stock: Box, where: str = "job", wire_length: float = 0.4,
     document: LinesDocument | None = None,
 ) -> RefinedCut:
-    """Refined frames of ``cut`` (see the module doc): ``spacing`` takes the fewest
-    steps whose largest gap inside the stock meets it.  ``wire_length`` [m] (the
-    tool's) places the wire points whose turns are a polygon's corners.  ``document``:
-    the cut's input rulings (``cut.surface.document()``) when the caller has them."""
+    """Return the refined frames of ``cut`` (see the module doc).
+
+    ``spacing`` takes the fewest steps whose largest gap inside the stock meets it.
+    ``wire_length`` [m] (the tool's) places the wire points whose turns are a polygon's
+    corners.  ``document``: the cut's input rulings (``cut.surface.document()``) when the
+    caller has them.
+    """
     s = cut.surface
     label = f"{where}: [surface]" if cut.name == "cut" else f"{where}: [cut '{cut.name}'.surface]"
     doc = s.document() if document is None else document
@@ -410,9 +413,11 @@ def _extended_note(where: str, runs: list[_Overrun]) -> str:
 
 
 def job_search(job: Job, search: SearchOptions | None = None) -> SearchOptions:
-    """The search options of ``job``'s passes: ``search`` (default: the planner's), whose
-    motion starts near the job's ``[robot] home`` when it names one and the options no
-    ``q_start``."""
+    """Return the search options of ``job``'s passes.
+
+    ``search`` (default: the planner's), whose motion starts near the job's ``[robot] home``
+    when it names one and the options no ``q_start``.
+    """
     options = SearchOptions() if search is None else search
     if job.robot.home is not None and options.q_start is None:
         options = dataclasses.replace(options, q_start=job.robot.home)
@@ -424,8 +429,10 @@ def cut_paths(
     search: SearchOptions | None = None, *, cell: Cell | None = None,
     document: LinesDocument | None = None,
 ) -> list[CutPath]:
-    """The passes of ``cut`` (default: the job's first): one for an open surface or a
-    closed one cut in one pass, two when a loop must be split (:mod:`.closed`).
+    """Return the passes of ``cut`` (default: the job's first).
+
+    One for an open surface or a closed one cut in one pass, two when a loop must be split
+    (:mod:`.closed`).
 
     ``search``: the wire-pose search's options (:func:`job_search` of them is used);
     ``cell``: their clearance cell when the caller built it once for every cut
@@ -501,8 +508,11 @@ def cut_paths(
 def cut_path(
     job: Job, model: RobotModel | None = None, search: SearchOptions | None = None
 ) -> CutPath:
-    """The geometric cut of the job's first cut (see the module doc); ``search`` the
-    wire-pose search's options.  ``model`` defaults to the job's robot (flange, no tool)."""
+    """Return the geometric cut of the job's first cut (see the module doc).
+
+    ``search``: the wire-pose search's options.  ``model`` defaults to the job's robot
+    (flange, no tool).
+    """
     return cut_paths(job, None, model, search)[0]
 
 

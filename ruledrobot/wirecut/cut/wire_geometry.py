@@ -60,15 +60,19 @@ def wire_frame(tool: ToolSpec | BowTool) -> FloatArray:
 
 
 def chords(frames: ArrayLike, stock: Box) -> tuple[FloatArray, FloatArray, np.ndarray]:
-    """Chord parameters ``(c0, c1, hit)`` (M,) of each ruling in the stock, in the
-    z coordinate of its frame (m); NaN where the ruling misses the stock."""
+    """Return the chord parameters ``(c0, c1, hit)`` (M,) of each ruling in the stock.
+
+    In the z coordinate of its frame (m); NaN where the ruling misses the stock.
+    """
     F = np.asarray(frames, dtype=np.float64)
     return stock.clip_lines(F[:, :3, 3], F[:, :3, 2])
 
 
 def anchored_frames(frames: ArrayLike, point: ArrayLike) -> FloatArray:
-    """Frames (M, 4, 4) moved along their own z axis so that each origin is the point
-    of its ruling nearest ``point`` (3,) (m, robot base frame); orientation unchanged.
+    """Move frames along their own z axis to the points of their rulings nearest ``point``.
+
+    Frames (M, 4, 4) moved so that each origin is the point of its ruling nearest ``point``
+    (3,) (m, robot base frame); orientation unchanged.
 
     The DH frames of nearly parallel rulings sit where consecutive rulings' common
     normals meet them, which can be metres away along the rulings and jump from one
@@ -89,8 +93,9 @@ WORLD_REFERENCE_MIN = 0.1
 
 
 def world_referenced(F: FloatArray) -> FloatArray:
-    """The frames (M, 4, 4) turned about their z axes so that x points, as nearly as it
-    can, along one world axis — the one the rulings are most nearly normal to.
+    """Turn frames about their z axes so that x points as nearly as it can along a world axis.
+
+    The frames (M, 4, 4); the world axis is the one the rulings are most nearly normal to.
 
     A roll relative to these frames is the bow's attitude in the world.  Relative to
     the DH frames it is not: their x axes (common normals) turn once with a closed
@@ -160,8 +165,10 @@ def flange_poses(wire: ArrayLike, W: ArrayLike) -> FloatArray:
 def speed_factor(
     flange: ArrayLike, path_s: ArrayLike, tool: ToolSpec | BowTool, stock: Box, near: float
 ) -> FloatArray:
-    """Metres moved across the wire by its fastest point in (or, within ``near`` m,
-    nearest) the stock per unit of path parameter: the time law's feed bound.
+    """Return the metres the wire's fastest point in the stock moves per unit path parameter.
+
+    Metres moved across the wire by its fastest point in (or, within ``near`` m, nearest)
+    the stock per unit of path parameter: the time law's feed bound.
 
     ``flange`` (M, 4, 4) flange poses along the path at parameters ``path_s`` (M,).
     The chord and the speed across the wire come from the one model of the wire
@@ -180,9 +187,12 @@ def speed_factor(
 
 
 def distance_from_rulings(points: ArrayLike, frames: ArrayLike) -> FloatArray:
-    """The largest distance (K,) [m] of points (K, P, 3) from the lines of frames
-    (K, 4, 4) (origin, z axis): ``max_p |(x_p - o) x z|``; NaN points are left out
-    (0 when all are NaN).  The wire's deviation from its target ruling, with the points
-    its chord ends and the frames the target rulings at the same path parameter."""
+    """Return the largest distance (K,) [m] of points from the lines of frames.
+
+    Points (K, P, 3), frames (K, 4, 4) (origin, z axis): ``max_p |(x_p - o) x z|``; NaN
+    points are left out (0 when all are NaN).  The wire's deviation from its target ruling,
+    with the points its chord ends and the frames the target rulings at the same path
+    parameter.
+    """
     F = np.asarray(frames, dtype=np.float64)
     return largest_line_distance(points, F[:, :3, 3], F[:, :3, 2])

@@ -62,8 +62,9 @@ ROLLS = 36
 
 @dataclass(frozen=True, eq=False)
 class SearchOptions:
-    """The settings of the wire-pose search (:func:`solve_redundancy`), one value that
-    travels from the plan to every pass (the defaults are the planner's).
+    """The settings of the wire-pose search (:func:`solve_redundancy`).
+
+    One value that travels from the plan to every pass (the defaults are the planner's).
 
     ``rolls``: constant rolls scored; ``sample``: rulings they are scored on;
     ``singular_min``: least singularity measure; ``jump_threshold`` [rad]: largest joint
@@ -99,10 +100,12 @@ class SearchOptions:
 
 
 def bow_segments(tool: ToolSpec) -> FloatArray:
-    """The bow's rods (3, 2, 3) in the flange frame
-    (:meth:`ruledrobot.robot.tool.BowTool.segments`): an arm from each wire end back to
-    the plane through the flange axis normal to the bow's depth direction, and the
-    crossbar between the arms' ends."""
+    """Return the bow's rods (3, 2, 3) in the flange frame.
+
+    See :meth:`ruledrobot.robot.tool.BowTool.segments`: an arm from each wire end back to
+    the plane through the flange axis normal to the bow's depth direction, and the crossbar
+    between the arms' ends.
+    """
     return BowTool.from_spec(tool).segments()
 
 
@@ -175,9 +178,11 @@ def solve_redundancy(
 def search_wire_pose(
     frames: FloatArray, tool: ToolSpec, cell: Cell, options: SearchOptions
 ) -> RedundancyResult:
-    """:func:`solve_redundancy` in ``cell`` (robot, bow, stock, table and thresholds: the
-    cell of ``options``, :meth:`SearchOptions.cell`); ``tool`` gives the wire's length
-    and clearance."""
+    """Run :func:`solve_redundancy` in ``cell``.
+
+    ``cell``: robot, bow, stock, table and thresholds (the cell of ``options``,
+    :meth:`SearchOptions.cell`); ``tool`` gives the wire's length and clearance.
+    """
     rolls, sample, jump_threshold = options.rolls, options.sample, options.jump_threshold
     singular_min, strategy, q_start = cell.singular_min, options.strategy, cell.q_start
     model, stock = cell.model, cell.stock

@@ -256,8 +256,11 @@ def _check_heat_model(tool: ToolSpec, cuts: tuple[CutSpec, ...], material, where
 
 
 def job_document(text: str, where: str) -> dict:
-    """The TOML document of a job file's text; ValueError naming ``where`` when it is not
-    valid TOML (the fields are checked by :func:`parse_job`)."""
+    """Return the TOML document of a job file's text.
+
+    ValueError naming ``where`` when it is not valid TOML (the fields are checked by
+    :func:`parse_job`).
+    """
     try:
         return tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
@@ -271,10 +274,12 @@ _SURFACE_FILES = {"file": ()} | {k: ("root", "tip") if k == "airfoil" else ("fil
 
 
 def file_fields(doc: dict) -> list[tuple[tuple[str | int, ...], str]]:
-    """Every field of a job document that names an input file, as ``(location, path)``:
-    ``location`` the keys from the document's root (``("cut", 0, "surface", "file")``),
-    ``path`` as written (relative paths are taken from the job file's folder).  Fields
-    of the wrong type are left out (:func:`parse_job` reports them)."""
+    """Return every field of a job document that names an input file.
+
+    As ``(location, path)``: ``location`` the keys from the document's root (``("cut", 0,
+    "surface", "file")``), ``path`` as written (relative paths are taken from the job file's
+    folder).  Fields of the wrong type are left out (:func:`parse_job` reports them).
+    """
     found: list[tuple[tuple[str | int, ...], str]] = []
     surfaces: list[tuple[tuple[str | int, ...], object]] = [(("surface",), doc.get("surface"))]
     if isinstance(doc.get("cut"), list):

@@ -14,8 +14,11 @@ __all__ = ["scene_of_trajectory"]
 
 
 def scene_of_trajectory(trajectory: str | os.PathLike[str]) -> tuple[Scene | None, str]:
-    """The scene of the job a trajectory names (its file, or the plan folder's copy
-    ``job.toml``, with the same SHA-256), else None: the robot alone on a table."""
+    """Return the scene of the job a trajectory names, else None.
+
+    The job is the trajectory's file, or the plan folder's copy ``job.toml``, with the same
+    SHA-256; None: the robot alone on a table.
+    """
     import hashlib
 
     trajectory = Path(trajectory)

@@ -347,9 +347,11 @@ def _calibration(sec: Section, model: str, base_dir: Path | None) -> Calibration
 
 
 def parse_material(m: Section) -> Material:
-    """``[material]`` -> :class:`~ruledrobot.robot.wire.kerf.Material` (docs/kerf.md):
-    ``kerf_base`` m, ``kerf_gain`` m^2/s per W/m, ``power_threshold`` W/m (default 0),
-    ``max_speed`` (m/s) per W/m (optional)."""
+    """Parse ``[material]`` into a :class:`~ruledrobot.robot.wire.kerf.Material`.
+
+    See docs/kerf.md: ``kerf_base`` m, ``kerf_gain`` m^2/s per W/m, ``power_threshold`` W/m
+    (default 0), ``max_speed`` (m/s) per W/m (optional).
+    """
     top = m.get("max_speed")
     material = Material(
         kerf_base=m.number("kerf_base", lo=0.0),
@@ -362,10 +364,13 @@ def parse_material(m: Section) -> Material:
 
 
 def parse_heat(h: Section) -> HeatSpec:
-    """``[tool.heat]`` -> :class:`.spec.HeatSpec`: ``output = "standard:0"`` (kind:index),
-    ``preheat`` (s), ``value`` (analog outputs: the fraction of the range), and the heat
-    model (docs/kerf.md): ``mode``, ``power`` (W/m), ``full_scale`` (W/m at an analog
-    output's 1.0), ``lag`` (s).  What needs ``[material]`` is checked with the job."""
+    """Parse ``[tool.heat]`` into a :class:`.spec.HeatSpec`.
+
+    ``output = "standard:0"`` (kind:index), ``preheat`` (s), ``value`` (analog outputs: the
+    fraction of the range), and the heat model (docs/kerf.md): ``mode``, ``power`` (W/m),
+    ``full_scale`` (W/m at an analog output's 1.0), ``lag`` (s).  What needs ``[material]``
+    is checked with the job.
+    """
     out = h.get("output")
     if not isinstance(out, str) or ":" not in out:
         raise h.fail("output", 'expected "KIND:N" with KIND one of '

@@ -104,9 +104,12 @@ class SurfaceSpec:
 
     @property
     def whole_period(self) -> bool:
-        """A periodic built-in surface, ``closed = true``, whose ``u`` range is one whole
+        """Whether the surface is a closed periodic built-in over one whole period of ``u``.
+
+        A periodic built-in surface, ``closed = true``, whose ``u`` range is one whole
         period (within 0.1 %: ``u = [0.0, 6.2832]`` for 2 pi): its ``rulings`` are spread
-        over the period and the end, the start again, is not repeated."""
+        over the period and the end, the start again, is not repeated.
+        """
         if self.builtin is None or self.u is None or self.closed is not True:
             return False
         from ...geometry.surfaces import SURFACES
@@ -115,8 +118,11 @@ class SurfaceSpec:
         return period is not None and abs(self.u[1] - self.u[0] - period) <= 1e-3 * period
 
     def planes(self) -> tuple[np.ndarray, float] | None:
-        """The file's planes ``z = 0`` and ``z = distance`` as their frame (4, 4) in the
-        robot base frame and the distance [m], or None (a file without, a built-in)."""
+        """Return the file's planes ``z = 0`` and ``z = distance``, or None.
+
+        As their frame (4, 4) in the robot base frame and the distance [m]; None: a file
+        without, a built-in.
+        """
         if self.read_planes is None:
             return None
         return self.pose @ self.read_planes.pose, float(self.read_planes.distance)
@@ -197,8 +203,11 @@ class HeatSpec:
 
 @dataclass(frozen=True)
 class ToolSpec:
-    """The bow: wire end points in the flange frame (m), clearance beyond the stock, mass,
-    and the wire's heat output (None: the heat is not switched by the robot)."""
+    """The bow: wire ends, clearance, mass and the wire's heat output.
+
+    Wire end points in the flange frame (m), clearance beyond the stock, mass, and the
+    wire's heat output (None: the heat is not switched by the robot).
+    """
 
     wire_start: np.ndarray
     wire_end: np.ndarray
@@ -240,8 +249,9 @@ class CutSpec:
 
 @dataclass(frozen=True)
 class Job:
-    """A validated cut job (see the module doc for the file format): one stock, robot and
-    tool, and the cuts in the order they are made.
+    """A validated cut job: one stock, robot and tool, and the cuts in the order they are made.
+
+    See the module doc for the file format.
 
     ``source``: the job file, as the reports name it; ``source_bytes``: its bytes as
     loaded (:func:`~.load.load_job` reads them once; a batch worker, a copy's): the
@@ -267,10 +277,12 @@ class Job:
         return self.cuts[0].surface
 
     def robot_model(self):
-        """The job's robot: the catalogue model with its calibration (if the job names
-        one) and its joint acceleration limits, in its own base frame (``base`` the
-        identity) -- the frame of every pose of the job; the arm every stage plans and
-        checks with."""
+        """Return the job's robot in its own base frame: the arm every stage plans and checks with.
+
+        The catalogue model with its calibration (if the job names one) and its joint
+        acceleration limits, in its own base frame (``base`` the identity) -- the frame of
+        every pose of the job.
+        """
         from ...robot import load
 
         model = load(self.robot.model).with_calibration(self.robot.calibration)
@@ -279,9 +291,11 @@ class Job:
         return model
 
     def cell_robot(self):
-        """:meth:`robot_model` placed in the world at ``[robot] base``: the arm of the
-        MuJoCo scene and the viewer, which place the stock and table at ``base @ pose``
-        with it (so ``[robot] base`` moves the whole cell, never the plan)."""
+        """Return :meth:`robot_model` placed in the world at ``[robot] base``.
+
+        The arm of the MuJoCo scene and the viewer, which place the stock and table at
+        ``base @ pose`` with it (so ``[robot] base`` moves the whole cell, never the plan).
+        """
         return self.robot_model().with_base(self.robot.base)
 
     def input_lines(self) -> Lines:

@@ -96,9 +96,11 @@ class Motion:
 
 
 class PassNotTimed(RuntimeError):
-    """The time law found no usable trajectory for a pass (its :class:`TimingFailure` in
-    ``failure``): ``name`` the cut, ``rulings`` (first, last) the pass's rulings (from 0)
-    spanning the stretch where the time goes, of ``count``."""
+    """The time law found no usable trajectory for a pass.
+
+    Its :class:`TimingFailure` in ``failure``: ``name`` the cut, ``rulings`` (first, last)
+    the pass's rulings (from 0) spanning the stretch where the time goes, of ``count``.
+    """
 
     def __init__(self, cp: CutPath, failure: TimingFailure) -> None:
         s = np.asarray(cp.s, dtype=np.float64)
@@ -229,9 +231,11 @@ def feed_param(
 def measure_wire(
     job: Job, model: RobotModel, t: FloatArray, q: FloatArray, bow: BowTool | None = None
 ) -> WireInStock:
-    """The one model of the wire against the job's block along joints ``q`` (M, 6) at
-    times ``t`` (M,) (``model``: the planner's, flange without tool, base frame; ``bow``:
-    the job's, when the caller built it)."""
+    """Return the one model of the wire against the job's block along joints ``q``.
+
+    Joints ``q`` (M, 6) at times ``t`` (M,) (``model``: the planner's, flange without tool,
+    base frame; ``bow``: the job's, when the caller built it).
+    """
     bow = BowTool.of(job.tool if bow is None else bow)
     ends = flange_wire_ends(model.fk(q), bow)
     return wire_in_stock(t, ends, job.stock)
@@ -286,10 +290,12 @@ def _pass_timing(
 def assemble_motion(
     job: Job, model: RobotModel, passes: list[CutPath], cell: Cell | None = None
 ) -> Motion:
-    """Time the passes and join them with approach, pre-heat, transits and retract
-    (``Motion.passes`` are the passes as timed).  ``cell``: the plan's clearance cell
-    (its bow; the transits' cell is the same under their rules), built once by the
-    caller (default: built here)."""
+    """Time the passes and join them with approach, pre-heat, transits and retract.
+
+    ``Motion.passes`` are the passes as timed.  ``cell``: the plan's clearance cell (its
+    bow; the transits' cell is the same under their rules), built once by the caller
+    (default: built here).
+    """
     passes = list(passes)
     dt = float(model.control_period)
     vel = model.max_velocity * job.robot.speed_scale

@@ -47,8 +47,11 @@ CORNER_ANGLE = np.radians(30.0)
 
 
 def corner_nodes(frames: FloatArray, half_length: float, angle: float = CORNER_ANGLE) -> np.ndarray:
-    """Indices (K,) of the interior nodes of a pass where the wire's travel turns by more
-    than ``angle`` [rad] (see the module doc).  ``frames`` (M, 4, 4), ``half_length`` [m]."""
+    """Return the interior nodes of a pass where the wire's travel turns more than ``angle``.
+
+    Indices (K,); ``angle`` [rad] (see the module doc).  ``frames`` (M, 4, 4),
+    ``half_length`` [m].
+    """
     F = np.asarray(frames, dtype=np.float64)
     return _turning(F[:, :3, 3], F[:, :3, 2], half_length, angle)
 
@@ -56,9 +59,11 @@ def corner_nodes(frames: FloatArray, half_length: float, angle: float = CORNER_A
 def polygon_corners(
     plucker: FloatArray, centre: FloatArray, half_length: float, angle: float = CORNER_ANGLE
 ) -> np.ndarray:
-    """:func:`corner_nodes` of a sequence of lines (N, 6) (Plücker ``[l, m]``), each
-    taken at its point nearest ``centre`` (3,) [m]: the corners of a foam cutter's
-    polygon of moves, where refinement splits it (:func:`~..cut.passes.refine_cut`)."""
+    """Return the corners of a foam cutter's polygon of moves (:func:`corner_nodes` of lines).
+
+    Lines (N, 6) (Plücker ``[l, m]``), each taken at its point nearest ``centre`` (3,) [m]:
+    the corners are where refinement splits the polygon (:func:`~..cut.passes.refine_cut`).
+    """
     L = np.asarray(plucker, dtype=np.float64)
     L = L / np.linalg.norm(L[:, :3], axis=1, keepdims=True)
     z, p0 = L[:, :3], point_nearest_origin(L)
@@ -90,9 +95,11 @@ def time_between_corners(
     dt: float,
     corners: np.ndarray,
 ) -> TimedPath:
-    """:func:`~.timing.time_path` of the pass in pieces split at ``corners`` (node
-    indices), each from rest to rest, joined (:func:`~.timing.concatenate`; ``s_of_t``
-    stays the pass's parameter).  Without corners, the pass in one piece.
+    """Time the pass in pieces split at ``corners``, each from rest to rest, joined.
+
+    :func:`~.timing.time_path` of each piece between ``corners`` (node indices), joined by
+    :func:`~.timing.concatenate` (``s_of_t`` stays the pass's parameter).  Without corners,
+    the pass in one piece.
 
     ``speed_factor``: (N,) for the whole pass, or a function of a piece's first and last
     node giving its own (so that its differences never reach across a corner, where a
@@ -112,8 +119,11 @@ def time_between_corners(
 
 
 def corner_stop_mask(timed: TimedPath, s_corners: FloatArray) -> np.ndarray:
-    """(M,) the samples of ``timed`` in the runs of feed-limited samples (slowed by the
-    joints, inside the stock) that reach a corner at path parameters ``s_corners``."""
+    """Return the samples (M,) of the feed-limited runs of ``timed`` that reach a corner.
+
+    The runs of feed-limited samples (slowed by the joints, inside the stock) that reach a
+    corner at path parameters ``s_corners``.
+    """
     fl = np.asarray(timed.feed_limited, dtype=bool)
     if not fl.any() or len(s_corners) == 0:
         return np.zeros(fl.shape, dtype=bool)

@@ -36,17 +36,22 @@ __all__ = [
 
 
 def target_frames(cp: CutPath, s: FloatArray) -> tuple[np.ndarray, FloatArray]:
-    """The interval between rulings (K,) each path parameter ``s`` (K,) lies in, and the
-    target ruling's frame (K, 4, 4) there: the screw geodesic between the interval's
-    frames at the same fraction."""
+    """Return the interval each path parameter lies in and the target ruling's frame there.
+
+    The interval between rulings (K,) of each path parameter ``s`` (K,), and the frame (K,
+    4, 4): the screw geodesic between the interval's frames at the same fraction.
+    """
     i0, frac = cp.locate(s)
     return i0, se3.geodesic(cp.frames[i0], cp.frames[i0 + 1], frac)
 
 
 def pass_deviation(cp: CutPath, timed: TimedPath, wire: WireInStock) -> FloatArray:
-    """Per interval between rulings (M - 1,) the largest distance [m] of the timed
-    wire's chord ends from the target rulings at the same path parameter, where the wire
-    is in the stock; ``wire`` the one model measured on ``timed``."""
+    """Return per interval the largest distance [m] of the timed wire from the target rulings.
+
+    Per interval between rulings (M - 1,): of the timed wire's chord ends from the target
+    rulings at the same path parameter, where the wire is in the stock; ``wire`` the one
+    model measured on ``timed``.
+    """
     out = np.zeros(len(cp.frames) - 1)
     k = np.flatnonzero(wire.inside)
     if not k.size:
@@ -59,11 +64,14 @@ def pass_deviation(cp: CutPath, timed: TimedPath, wire: WireInStock) -> FloatArr
 def pass_feed_error(
     cp: CutPath, timed: TimedPath, wire: WireInStock, feed_speed: float
 ) -> FloatArray:
-    """Per interval between rulings (M - 1,) the largest relative error of the timed
-    wire's cutting speed (the one model, ``wire``) against ``feed_speed`` where the wire
-    is in the stock and the time law meant to hold the feed (not where the joints set
-    the pace).  The time law bounds a speed factor interpolated linearly between the
-    rulings; where the joint path bends within an interval, the real feed strays."""
+    """Return per interval the largest relative error of the timed wire's cutting speed.
+
+    Per interval between rulings (M - 1,), of the one model's speed (``wire``) against
+    ``feed_speed``, where the wire is in the stock and the time law meant to hold the feed
+    (not where the joints set the pace).  The time law bounds a speed factor interpolated
+    linearly between the rulings; where the joint path bends within an interval, the real
+    feed strays.
+    """
     out = np.zeros(len(cp.frames) - 1)
     held = wire.inside & ~timed.feed_limited
     if not held.any():
@@ -75,11 +83,14 @@ def pass_feed_error(
 
 
 def uneven_intervals(cp: CutPath, share: float) -> np.ndarray:
-    """Intervals between rulings (indices) inside the stock where the wire's distance per
-    joint distance changes by more than ``share`` (relative) from the neighbouring
-    interval.  The time law holds the feed with the larger of the two at every ruling
-    (its feed bound is then safe between rulings), so a jump there slows the wire by the
-    jump; halving such intervals halves the jumps."""
+    """Return the intervals in the stock where the wire's distance per joint distance jumps.
+
+    Intervals between rulings (indices) inside the stock where the wire's distance per joint
+    distance changes by more than ``share`` (relative) from the neighbouring interval.  The
+    time law holds the feed with the larger of the two at every ruling (its feed bound is
+    then safe between rulings), so a jump there slows the wire by the jump; halving such
+    intervals halves the jumps.
+    """
     m = cp.motion
     dsig = np.abs(np.diff(m.q, axis=0)).sum(axis=1)
     ratio = np.diff(cp.s) / np.maximum(dsig, 1e-12)
@@ -97,9 +108,12 @@ MIN_INTERVAL = 2e-4
 def densified(
     cp: CutPath, intervals: np.ndarray, model: RobotModel, tool: ToolSpec | BowTool, stock: Box
 ) -> CutPath:
-    """``cp`` with a ruling added halfway through each interval ``i`` (between rulings
-    ``i`` and ``i + 1``) of ``intervals`` (module doc) that is longer than
-    :data:`MIN_INTERVAL`; ``tool``: the job's spec or the bow built from it."""
+    """Return ``cp`` with a ruling added halfway through each long interval of ``intervals``.
+
+    Each interval ``i`` (between rulings ``i`` and ``i + 1``) of ``intervals`` (module doc)
+    that is longer than :data:`MIN_INTERVAL`; ``tool``: the job's spec or the bow built from
+    it.
+    """
     m = cp.motion
     idx = np.unique(np.asarray(intervals, dtype=np.intp))
     idx = idx[np.diff(cp.s)[idx] > 2.0 * MIN_INTERVAL]

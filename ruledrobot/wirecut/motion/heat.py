@@ -33,16 +33,20 @@ __all__ = ["has_heat_model", "heat_schedule"]
 
 
 def has_heat_model(job: Job) -> bool:
-    """Whether the job's heat has a power to schedule: a ``[material]``, or a heat
-    ``mode`` other than ``on_off``, or a ``power``."""
+    """Whether the job's heat has a power to schedule.
+
+    A ``[material]``, or a heat ``mode`` other than ``on_off``, or a ``power``.
+    """
     h = job.tool.heat
     return job.material is not None or (h is not None and (h.mode != "on_off"
                                                           or h.power is not None))  # fmt: skip
 
 
 def heat_schedule(job: Job, motion: Motion) -> FloatArray | None:
-    """The set-point power (M,) [W/m] of every sample of ``motion`` (module doc); None
-    when the job has no heat model (:func:`has_heat_model`)."""
+    """Return the set-point power (M,) [W/m] of every sample of ``motion`` (module doc).
+
+    None when the job has no heat model (:func:`has_heat_model`).
+    """
     if not has_heat_model(job):
         return None
     h = job.tool.heat

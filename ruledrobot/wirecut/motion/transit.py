@@ -58,9 +58,11 @@ OUT_OF_LIMITS = "outside the joint limits"
 
 
 def joint_reach(cell: Cell) -> FloatArray:
-    """(J,) ``R_j`` [m / rad]: a bound on the distance of any point of the arm's capsules
-    (their radius included), the bow, its hub and the wire from joint ``j``'s axis, at
-    every configuration — the most any of them moves per radian of joint ``j``.
+    """Return per joint ``j`` the most any point of the arm and bow moves per radian of ``j``.
+
+    (J,) ``R_j`` [m / rad]: a bound on the distance of any point of the arm's capsules
+    (their radius included), the bow, its hub and the wire from joint ``j``'s axis, at every
+    configuration.
 
     Body ``k``'s frame origin lies within ``sum_{i=j}^{k-1} (|d_i| + |a_i|)`` of body ``j``'s
     (the nominal DH table: the links' shape), and its capsules within their largest end
@@ -203,9 +205,12 @@ class TransitPlanner:
         return qa + u * (qb - qa)
 
     def free(self, q: FloatArray) -> np.ndarray:
-        """(n,) bool: configurations (n, J) that keep every clearance rule, the arm's
-        against itself included, hold the wire out of the stock (between cuts the wire
-        is an obstacle like the bow) and the joints within their limits."""
+        """Return which configurations keep every clearance rule and the joint limits.
+
+        (n,) bool of configurations (n, J): every clearance rule kept, the arm's against
+        itself included, the wire held out of the stock (between cuts the wire is an
+        obstacle like the bow) and the joints within their limits.
+        """
         q = np.atleast_2d(q)
         P = self.cell.model.fk(q)
         bad = np.zeros(len(q), dtype=bool)
@@ -237,8 +242,11 @@ class TransitPlanner:
         return np.array([bool(f.all()) for f in np.split(free, ends[:-1])])
 
     def lifted(self, q: FloatArray) -> FloatArray | None:
-        """Joints nearest ``q`` with the flange raised until the bow and wire are CLEAR
-        above the stock's top; None when unreachable."""
+        """Return the joints nearest ``q`` with the flange raised clear of the stock, or None.
+
+        Raised until the bow and wire are CLEAR above the stock's top; None when
+        unreachable.
+        """
         model = self.cell.model
         P = model.fk(q)
         pts = np.concatenate([self.cell.rods.reshape(-1, 3), self.cell.wire])
@@ -250,12 +258,14 @@ class TransitPlanner:
         return nearest_ik(model, P, q)
 
     def search(self, qa: FloatArray, qb: FloatArray) -> list[FloatArray] | None:
-        """A route (waypoints, each (J,)) from ``qa`` to ``qb`` (both free) by OMPL's
-        RRT-Connect (:func:`.transit_ompl.rrt_connect`), its waypoints then dropped
-        greedily while the move that skips them is clear; None when none is found
-        within the time limit.  The search box: the joint limits, and per joint at most
-        pi beyond the start and the goal (a route turns no joint a whole turn more than
-        it must)."""
+        """Return a route from ``qa`` to ``qb`` by OMPL's RRT-Connect, or None.
+
+        A route of waypoints, each (J,), from ``qa`` to ``qb`` (both free) by
+        :func:`.transit_ompl.rrt_connect`, its waypoints then dropped greedily while the
+        move that skips them is clear; None when none is found within the time limit.  The
+        search box: the joint limits, and per joint at most pi beyond the start and the goal
+        (a route turns no joint a whole turn more than it must).
+        """
         from .transit_ompl import rrt_connect
 
         lo = np.minimum(np.maximum(self.lower, np.minimum(qa, qb) - np.pi), np.minimum(qa, qb))
@@ -311,9 +321,11 @@ class TransitPlanner:
         return self.broken_along(q, q)
 
     def broken_along(self, qa: FloatArray, qb: FloatArray) -> list[str]:
-        """The clearance rules some sample of the straight joint move qa -> qb breaks, in
-        the rules' order (:data:`~..cut.clearance.RULES`, then the wire in the stock and
-        the joint limits)."""
+        """Return the clearance rules some sample of the straight joint move qa -> qb breaks.
+
+        In the rules' order (:data:`~..cut.clearance.RULES`, then the wire in the stock and
+        the joint limits).
+        """
         q = self.samples(qa, qb)
         P = self.cell.model.fk(q)
         out = [k for k, v in clearance(self.cell, q, P).items() if v.any()]

@@ -336,14 +336,18 @@ class ColumnDetail:
                 f", IK branch {self.branch}")
 
     def percent(self) -> str:
-        """The share served in whole percent, ``100`` only when every sampled ruling is
-        served and ``0`` only when none is."""
+        """Return the share served in whole percent.
+
+        ``100`` only when every sampled ruling is served and ``0`` only when none is.
+        """
         p = 100.0 * self.share
         return str(int(min(max(round(p), 1), 99)) if 0.0 < p < 100.0 else int(p))
 
     def words(self) -> str:
-        """The best constant roll of the pass in words (the same sentence wherever it is
-        said: a failed plan, ``reach``, ``place``)."""
+        """Return the best constant roll of the pass in words.
+
+        The same sentence wherever it is said: a failed plan, ``reach``, ``place``.
+        """
         k = int(np.argmin(self.margin))
         where = (f"worst margin {self.worst * 1e3:.0f} mm at ruling {int(self.idx[k])}: "
                  f"{self.limit[k]}")

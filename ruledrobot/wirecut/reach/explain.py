@@ -54,10 +54,12 @@ def suggest_move(
     job: Job, passes: list[CutPath], model: RobotModel | None = None,
     evaluator: Evaluator | None = None,
 ) -> tuple[str, float, FloatArray, float] | None:
-    """The shortest horizontal move of the block after which one constant roll serves
-    every sampled ruling of every pass (the placement search's margin >= 0, on its
-    default grid, or ``evaluator``'s): ``(direction in words, distance m, new block
-    centre (3,), worst margin m)``, or None when none of the moves tried does."""
+    """Return the shortest horizontal move of the block after which one roll serves every pass.
+
+    One constant roll serves every sampled ruling of every pass (the placement search's
+    margin >= 0, on its default grid, or ``evaluator``'s): ``(direction in words, distance
+    m, new block centre (3,), worst margin m)``, or None when none of the moves tried does.
+    """
     from .evaluate import Evaluator
 
     ev = Evaluator(job, list(passes), model) if evaluator is None else evaluator

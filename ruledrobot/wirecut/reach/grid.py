@@ -71,8 +71,10 @@ def sample_rulings(m: int, n: int) -> np.ndarray:
 
 
 def planner_slide(frames: FloatArray, stock: Box, tool: ToolSpec) -> tuple[FloatArray, FloatArray]:
-    """The slide (M,) [m] the redundancy search starts from, and per ruling how much
-    (m) its chord is longer than the wire allows (<= 0: it fits).
+    """Return the slide the redundancy search starts from and how much each chord is too long.
+
+    The slide (M,) [m], and per ruling how much (m) its chord is longer than the wire allows
+    (<= 0: it fits).
 
     The middle of the intersection of every ruling's slide interval when there is
     one, else each ruling's interval point nearest the middle of the median bounds
@@ -116,9 +118,12 @@ def pass_poses(
     rolls: FloatArray,
     directions: tuple[bool, ...] = DIRECTIONS,
 ) -> FloatArray:
-    """Flange poses (D, K, R, 4, 4) of the wire on rulings ``frames`` (R, 4, 4) at
-    ``slide`` (R,), for the wire ``directions`` (D,) (False: along the ruling) and
-    ``rolls`` (K,) [rad]; ``W`` the wire frame in the flange frame."""
+    """Return the flange poses of the wire on rulings ``frames`` for each direction and roll.
+
+    Poses (D, K, R, 4, 4) on rulings ``frames`` (R, 4, 4) at ``slide`` (R,), for the wire
+    ``directions`` (D,) (False: along the ruling) and ``rolls`` (K,) [rad]; ``W`` the wire
+    frame in the flange frame.
+    """
     R, K, D = len(frames), len(rolls), len(directions)
     psi = np.broadcast_to(np.asarray(rolls, float)[None, :, None], (D, K, R))
     s = np.broadcast_to(np.asarray(slide, float)[None, None, :], (D, K, R))

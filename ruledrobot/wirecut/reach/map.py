@@ -221,8 +221,11 @@ def reach_map(
     passes: list[CutPath] | None = None,
     slides: int = 1,
 ) -> ReachMap:
-    """The reachability map of every pass of ``job`` (the planner's passes, or ``passes``
-    when already planned): see :class:`PassMap` and :func:`map_pass`."""
+    """Return the reachability map of every pass of ``job``.
+
+    The planner's passes, or ``passes`` when already planned: see :class:`PassMap` and
+    :func:`map_pass`.
+    """
     import time
 
     say = progress or (lambda msg: None)

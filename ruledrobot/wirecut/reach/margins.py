@@ -149,9 +149,11 @@ def limit_levers(model: RobotModel) -> FloatArray:
 def joint_limit_margin(
     model: RobotModel, q: FloatArray, levers: FloatArray | None = None
 ) -> FloatArray:
-    """Distance (...) of joint positions ``q`` (..., 6) from the nearest joint limit, for
-    the best whole-turn representative of each joint (negative: no representative fits):
-    radians, or metres with ``levers`` (6,) m/rad (:func:`limit_levers`).
+    """Return the distance of joint positions ``q`` from the nearest joint limit.
+
+    Distance (...) of ``q`` (..., 6), for the best whole-turn representative of each joint
+    (negative: no representative fits): radians, or metres with ``levers`` (6,) m/rad
+    (:func:`limit_levers`).
 
     The best representative is the one nearest the middle of the limits.
     """
@@ -209,8 +211,9 @@ def clearance_margins(
     cap: FloatArray | None = None,
     depth: bool = True,
 ) -> tuple[FloatArray, np.ndarray]:
-    """Clearance margins (m) and the first clearance rule broken, of configurations
-    ``q`` (n, 6) with flange poses ``P`` (n, 4, 4) (world frame).
+    """Return the clearance margins (m) and the first clearance rule broken of configurations.
+
+    Configurations ``q`` (n, 6) with flange poses ``P`` (n, 4, 4) (world frame).
 
     Every rule is checked at the planner's margin.  The rules of the bow against the
     stock and against the arm (:data:`GATES`: the tool and the wrist decide them) only

@@ -40,8 +40,10 @@ REASON_COLOURS = {
 
 
 def ruling_ranges(pm: PassMap, mask: np.ndarray) -> str:
-    """The sampled rulings where ``mask`` holds, as ranges of ruling numbers (runs of
-    consecutive samples joined)."""
+    """Return the sampled rulings where ``mask`` holds, as ranges of ruling numbers.
+
+    Runs of consecutive samples are joined.
+    """
     return index_ranges(mask, pm.idx)
 
 
@@ -88,8 +90,10 @@ def pass_summary(pm: PassMap) -> dict:
 
 
 def write_reach_json(path: str | Path, rm: ReachMap, job_ref: dict | None) -> Path:
-    """``reach.json``: every cell of every pass (margins in mm, reasons as codes with
-    their words), the rules and the summaries."""
+    """Write ``reach.json``: every cell of every pass, the rules and the summaries.
+
+    Margins in mm, reasons as codes with their words.
+    """
     passes = []
     for pm in rm.passes:
         passes.append({
@@ -246,8 +250,10 @@ def write_reach(
     progress: Callable[[str], None] | None = None,
     slides: int = 1,
 ) -> tuple[ReachMap, dict[str, Path]]:
-    """Map ``job`` (:func:`~.map.reach_map`) and write ``reach.png`` and ``reach.json``
-    into the folder ``out`` (written whole, swapped in at the end)."""
+    """Map ``job`` (:func:`~.map.reach_map`) and write ``reach.png`` and ``reach.json``.
+
+    Into the folder ``out`` (written whole, swapped in at the end).
+    """
     from ...io.outdir import StagedFolder
     from ..plan import job_reference
     from .map import reach_map

@@ -58,9 +58,11 @@ def _with_edge_rulings(frames: np.ndarray, stock) -> np.ndarray:
 
 
 def surface_mesh(plan: Plan) -> Mesh | None:
-    """The target surfaces of every pass inside the stock as one mesh [m, base frame]
-    (``surface.stl``, drawn in ``plots.png`` when no cut names its kept side); None when
-    no pass crosses the block."""
+    """Return the target surfaces of every pass inside the stock as one mesh, or None.
+
+    In [m, base frame] (``surface.stl``, drawn in ``plots.png`` when no cut names its kept
+    side); None when no pass crosses the block.
+    """
     verts, faces, n = [], [], 0
     job = plan.job
     for cp in plan.passes:
@@ -93,8 +95,10 @@ def write_plan(
     verdict: Verdict,
     video: bool = False,
 ) -> dict[str, Path]:
-    """Write the plan's files into ``stage`` (not yet committed); returns them by name.
-    ``report`` gains the write time and, when the video cannot be made, a note."""
+    """Write the plan's files into ``stage`` (not yet committed); return them by name.
+
+    ``report`` gains the write time and, when the video cannot be made, a note.
+    """
     folder = stage.path
     files: dict[str, Path] = {}
     if plan.motion is not None:

@@ -214,8 +214,11 @@ def _settle_sides(f: FloatArray, plane: FloatArray, domain: np.ndarray, step: fl
 
 def part_sdf(job: Job, passes: tuple[CutPath, ...], world: FloatArray,
              shape: tuple[int, ...], band: float) -> FloatArray:  # fmt: skip
-    """Signed distance [m] to the part on a grid of world points ``world`` (N, 3) with
-    ``shape`` (module doc): negative inside, the distance within ``band`` of a cut."""
+    """Return the signed distance [m] to the part on a grid of world points.
+
+    Points ``world`` (N, 3) with ``shape`` (module doc): negative inside, the distance
+    within ``band`` of a cut.
+    """
     stock = job.stock
     local = stock.to_box(world)
     q = np.abs(local) - 0.5 * stock.size
@@ -260,9 +263,10 @@ GridSDF = Callable[[FloatArray, tuple[int, ...], float], FloatArray]
 
 
 def stock_mesh(stock: Box, resolution: float, sdf: GridSDF) -> Mesh | None:
-    """The zero level of ``sdf`` (negative inside) as a closed triangle mesh in the base
-    frame [m], marched on a grid over ``stock`` and 2 steps beyond it; None when ``sdf``
-    is nowhere negative.
+    """Return the zero level of ``sdf`` (negative inside) as a closed triangle mesh, or None.
+
+    In the base frame [m], marched on a grid over ``stock`` and 2 steps beyond it; None when
+    ``sdf`` is nowhere negative.
 
     The grid step is ``resolution`` [m], grown so that the grid holds at most
     ``MAX_POINTS``; the distances are kept off zero at grid points

@@ -51,8 +51,11 @@ def joints_panel(ax: Any, plan: Plan) -> None:
 
 
 def feed_panel(ax: Any, plan: Plan) -> None:
-    """The feed [mm/s] of the wire on the target surface, measured on the samples, each
-    cut against its set feed (a black line), and the phases' legend."""
+    """Draw the feed [mm/s] of the wire on the target surface into ``ax``.
+
+    Measured on the samples, each cut against its set feed (a black line), and the phases'
+    legend.
+    """
     from matplotlib.patches import Patch
 
     job, mo, me = plan.job, plan.motion, plan.measured

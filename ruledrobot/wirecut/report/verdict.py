@@ -159,17 +159,22 @@ def _cut_info(c: CutMeasurements, single: bool) -> list[Check]:
 
 
 def transits_check(failures: tuple[str, ...]) -> Check:
-    """``transits``: how many transits found no route clear of the cell (at most 0); the
-    detail names each, the passes it connects and what is in the way."""
+    """Return the ``transits`` check: how many transits found no route clear of the cell.
+
+    At most 0; the detail names each, the passes it connects and what is in the way.
+    """
     return Check("transits", "transits without a clear route (arm, bow, wire, stock, table)",
                  len(failures), 0, relation="<=", ok=not failures,
                  detail="\n".join(failures))  # fmt: skip
 
 
 def timing_check(failures: tuple[str, ...]) -> Check:
-    """``timing``: how many passes the time law found no usable trajectory for (at most
-    0): an absurd duration (hours for a loop), a path speed that collapses; the detail
-    names each pass, the rulings where the time goes and the limit that binds there."""
+    """Return the ``timing`` check: how many passes the time law found no trajectory for.
+
+    How many passes the time law found no usable trajectory for (at most 0): an absurd
+    duration (hours for a loop), a path speed that collapses; the detail names each pass,
+    the rulings where the time goes and the limit that binds there.
+    """
     return Check("timing", "motions without a usable time law (hours long, stalled)",
                  len(failures), 0, relation="<=", ok=not failures,
                  detail="\n".join(failures))  # fmt: skip

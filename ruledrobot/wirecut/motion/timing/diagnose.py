@@ -59,8 +59,11 @@ class Binding:
     ramp: bool = False
 
     def words(self) -> str:
-        """``"joint 3's acceleration limit (|q''| = 2.1e+04 rad/rad² there)"`` /
-        ``"the feed bound"``."""
+        """Return the binding limit in words.
+
+        ``"joint 3's acceleration limit (|q''| = 2.1e+04 rad/rad² there)"`` / ``"the feed
+        bound"``.
+        """
         if self.joint is None:
             return "the feed bound"
         if self.ramp:
@@ -104,11 +107,13 @@ def _ds_dsigma(prob: _Problem, sigma: FloatArray) -> FloatArray:
 def binding_at(
     prob: _Problem, i: int, vlim: FloatArray, alim: FloatArray, x: float | None = None
 ) -> Binding:
-    """The tightest path-speed bound at grid node ``i`` (module doc), joint limits
-    ``vlim``, ``alim`` (J,) as the solver used them.  ``x``: the law's σ̇² there; when it
-    lies far below every bound of the node (a tenth), the path is slow because it cannot
-    speed up (or must brake early) — the acceleration limit of the joint that bounds σ̈
-    most (``a_j / |q'_j|`` least) binds (``ramp``)."""
+    """Return the tightest path-speed bound at grid node ``i`` (module doc).
+
+    Joint limits ``vlim``, ``alim`` (J,) as the solver used them.  ``x``: the law's σ̇²
+    there; when it lies far below every bound of the node (a tenth), the path is slow
+    because it cannot speed up (or must brake early) — the acceleration limit of the joint
+    that bounds σ̈ most (``a_j / |q'_j|`` least) binds (``ramp``).
+    """
     d1, d2 = np.abs(prob.d1[i]), np.abs(prob.d2[i])
     with np.errstate(divide="ignore"):
         xv = np.where(d1 > 0, (vlim / np.maximum(d1, 1e-300)) ** 2, np.inf)
@@ -163,8 +168,10 @@ def too_long(
     prob: _Problem, x: FloatArray, vlim: FloatArray, alim: FloatArray, dt: float,
     max_samples: int, stalled: bool = False,
 ) -> TimingFailure:  # fmt: skip
-    """The :class:`TimingFailure` of a law that lasts longer than ``max_samples``
-    periods of ``dt`` (or never ends: ``stalled``), with its diagnosis."""
+    """Return the :class:`TimingFailure` of a law that lasts too long, with its diagnosis.
+
+    Too long: longer than ``max_samples`` periods of ``dt`` (or never ends: ``stalled``).
+    """
     T, (s0, s1), share, b, speed = where_time_goes(prob, x, vlim, alim)
     if stalled or not np.isfinite(T):
         head = (f"time_path: the path speed collapses to zero between s = {s0:.6g} and "

@@ -127,8 +127,10 @@ def joint_move(
 def dwell(
     q: ArrayLike, duration: float, vel_limits: ArrayLike, acc_limits: ArrayLike, dt: float
 ) -> TimedPath:
-    """Hold still at ``q`` (J,) [rad] for ``duration`` [s], rounded up to whole periods
-    (e.g. while the wire heats).  ``s_of_t`` runs 0…1 over the hold."""
+    """Hold still at ``q`` (J,) [rad] for ``duration`` [s], rounded up to whole periods.
+
+    E.g. while the wire heats.  ``s_of_t`` runs 0…1 over the hold.
+    """
     a = as_shaped(q, "q", (None,))
     J = a.shape[0]
     vlim, alim, dt = as_rate_limits(vel_limits, acc_limits, dt, J)
