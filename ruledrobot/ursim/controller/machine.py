@@ -48,6 +48,7 @@ from ..script.interpreter import Interpreter, load_program
 from ..script.program import CompileError, PathWaypoint, Program
 from ..script.runner import move_segment
 from ..script.syntax import warm_up
+from .programs import program_in
 from .registers import IN_DOUBLE, IN_INT, OUT_DOUBLE, OUT_INT, IOMixin
 from .safety import SafetyMixin
 
@@ -511,20 +512,8 @@ class Controller(IOMixin, SafetyMixin):
             return self.start_program(prog)
 
     def program_path(self, path: str) -> Path | None:
-        """Return the file ``path`` names inside :attr:`programs_dir`, or None.
-
-        Relative to it, or absolute within it, symbolic links resolved; None: outside,
-        missing, not a file.
-        """
-        root = self.programs_dir
-        if root is None or not path or "\x00" in path:
-            return None
-        p = Path(path)
-        try:
-            real = (p if p.is_absolute() else root / p).resolve(strict=True)
-        except (OSError, RuntimeError, ValueError):
-            return None
-        return real if real.is_relative_to(root) and real.is_file() else None
+        """Return the file ``path`` names inside :attr:`programs_dir`, or None."""
+        return program_in(self.programs_dir, path)
 
     def load(self, path: str) -> str:
         """Answer the dashboard's ``load``: ``"ok"``, ``"not found"`` or ``"error"``.
