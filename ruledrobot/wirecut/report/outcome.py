@@ -45,7 +45,7 @@ def _cut_sections(plan: Plan, ver: Verification | None) -> tuple[list[dict], lis
     sections, measures = [], []
     cut_meta = plan.trajectory.meta.cut
     feeds = {f.name: f for f in feed_measures(mo.wire, cut_meta)}
-    faces = plan.trajectory.face_errors(mo.wire)
+    faces = me.faces  # computed once with the plan
     for cut in plan.job.cuts:
         ks = [k for k, cp in enumerate(plan.passes) if cp.cut is cut]
         passes = [plan.passes[k] for k in ks]
