@@ -25,7 +25,7 @@ from ...geometry.ranges import runs_of
 from ...io.pictures import thinned_series
 from ..plan import Plan
 
-__all__ = ["has_kerf_model", "has_heat_schedule", "heat_panel", "kerf_panel", "runs_thinned"]
+__all__ = ["has_heat_schedule", "has_kerf_model", "heat_panel", "kerf_panel", "runs_thinned"]
 
 #: mm: the kerf axis spans at least this (twice the default face tolerance)
 MIN_SPAN_MM = 0.2

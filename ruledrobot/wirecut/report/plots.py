@@ -25,8 +25,8 @@ from ...geometry.mesh import Mesh
 from ...io.atomic import atomic_write_bytes
 from ...io.pictures import thinned_series
 from ..plan import Plan
-from .plot_heat import has_heat_schedule, has_kerf_model, heat_panel, kerf_panel
 from .plot3d import PHASE_COLOURS, PHASE_WORDS, phase_runs, scene_panel
+from .plot_heat import has_heat_schedule, has_kerf_model, heat_panel, kerf_panel
 
 __all__ = ["PHASE_COLOURS", "TIME_PANELS", "ShownWhen", "feed_panel", "joints_panel",
            "plot_plan"]
