@@ -25,9 +25,10 @@ MIN_SPAN = 1e-4
 
 
 def kerf_range(scene: PlanScene) -> tuple[float, float] | None:
-    """The colour scale's ends [m]: the smallest and largest finite kerf of the timeline
-    and the cut's planned kerf (``limits["kerf_set"]``), widened about their middle to
-    :data:`MIN_SPAN`; None without a predicted kerf."""
+    """The colour scale's ends [m], None without a predicted kerf.
+
+    The smallest and largest finite kerf of the timeline and the cut's planned kerf (``limits["kerf_set"]``), widened about their middle to
+    :data:`MIN_SPAN`."""
     tl = scene.timeline
     finite = np.zeros(0) if tl is None or tl.kerf is None else tl.kerf[np.isfinite(tl.kerf)]
     if not finite.size:
@@ -41,8 +42,9 @@ def kerf_range(scene: PlanScene) -> tuple[float, float] | None:
 
 
 def kerf_colours(w: FloatArray, lo: float, hi: float) -> np.ndarray:
-    """RGB (..., 3) uint8 of kerfs ``w`` [m] on the scale ``[lo, hi]`` (clipped to it);
-    :data:`BURN_COLOUR` where ``w`` is infinite."""
+    """RGB (..., 3) uint8 of kerfs ``w`` [m] on the scale ``[lo, hi]``.
+
+    Clipped to the scale; :data:`BURN_COLOUR` where ``w`` is infinite."""
     w = np.asarray(w, dtype=np.float64)
     x = np.clip((np.where(np.isfinite(w), w, lo) - lo) / (hi - lo), 0.0, 1.0)
     at = np.linspace(0.0, 1.0, len(STOPS))
@@ -52,8 +54,9 @@ def kerf_colours(w: FloatArray, lo: float, hi: float) -> np.ndarray:
 
 
 def kerf_trace(tl: Timeline) -> tuple[FloatArray, FloatArray] | None:
-    """The chord ends' paths on the face between consecutive frames, both ends:
-    segments (S, 2, 3) world m and their kerf (S, 2) m at each segment's points (the
+    """The chord ends' paths on the face between consecutive frames, both ends.
+
+    Segments (S, 2, 3) world m and their kerf (S, 2) m at each segment's points (the
     frames' own); None without a predicted kerf on any frame."""
     if tl.kerf is None:
         return None
@@ -67,8 +70,9 @@ def kerf_trace(tl: Timeline) -> tuple[FloatArray, FloatArray] | None:
 
 
 def burn_points(tl: Timeline) -> FloatArray:
-    """(B, 3) world m: the chord ends where a run of burning frames begins (a stop leaves
-    no trace to colour: it gets a marker)."""
+    """The chord ends (B, 3) [world m] where a run of burning frames begins.
+
+    A stop leaves no trace to colour: it gets a marker."""
     if tl.kerf is None:
         return np.zeros((0, 3))
     burn = np.isinf(tl.kerf)  # (K, 2)
@@ -81,24 +85,28 @@ def _mm(w: float) -> str:
 
 
 def kerf_words(tl: Timeline, k: int) -> str | None:
-    """``"kerf 0.800 / 0.925 mm"`` at frame ``k`` (wire start / end side; ``burn``
-    where the wire stands hot); None off the face or without a predicted kerf."""
+    """The kerf at frame ``k`` in words: ``"kerf 0.800 / 0.925 mm"``.
+
+    Wire start / end side; ``burn`` where the wire stands hot; None off the face or
+    without a predicted kerf."""
     if tl.kerf is None or np.isnan(tl.kerf[k]).any():
         return None
     return f"kerf {_mm(tl.kerf[k, 0])} / {_mm(tl.kerf[k, 1])} mm"
 
 
 def heat_words(tl: Timeline, k: int) -> str | None:
-    """``"heat 50.0 W/m (wire 48.2)"`` at frame ``k``: the set-point and the wire's power
-    after the lag; None without a heat schedule."""
+    """The heat at frame ``k`` in words: ``"heat 50.0 W/m (wire 48.2)"``.
+
+    The set-point and the wire's power after the lag; None without a heat schedule."""
     if tl.heat_power is None:
         return None
     return f"heat {tl.heat_power[k]:.1f} W/m (wire {tl.wire_power[k]:.1f})"
 
 
 def kerf_legend_html(scene: PlanScene) -> str:
-    """The colour scale of the kerf trace as HTML (a gradient bar, its ends and the cut's
-    planned kerf in mm, the burn colour); "" without a predicted kerf."""
+    """The colour scale of the kerf trace as HTML ("" without a predicted kerf).
+
+    A gradient bar, its ends and the cut's planned kerf in mm, the burn colour."""
     tl = scene.timeline
     rng = kerf_range(scene)
     if rng is None or tl is None or tl.kerf is None:

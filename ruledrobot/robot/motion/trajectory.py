@@ -493,10 +493,11 @@ class Trajectory:
     def wire_power(
         self, t: ArrayLike | None = None, heat_power: ArrayLike | None = None
     ) -> FloatArray | None:
-        """The wire's power (M,) [W/m] at times ``t`` (default: this trajectory's) of the
-        set-points ``heat_power`` (default: this trajectory's), delayed by the heat's lag
-        (:func:`..wire.kerf.wire_power`: what :meth:`face_errors` judges the kerf with);
-        None without set-points."""
+        """The wire's power (M,) [W/m]: the set-points delayed by the heat's lag.
+
+        At times ``t`` (default: this trajectory's) of the set-points ``heat_power``
+        (default: this trajectory's), by :func:`..wire.kerf.wire_power`: what
+        :meth:`face_errors` judges the kerf with; None without set-points."""
         from ..wire.kerf import wire_power
 
         hp = self.heat_power if heat_power is None else heat_power

@@ -52,16 +52,18 @@ def has_heat_schedule(plan: Plan) -> bool:
 
 
 def has_kerf_model(plan: Plan) -> bool:
-    """Whether the plan predicts the kerf (a ``[material]`` and a heat schedule) on some cut's
-    face: the kerf panel's rule."""
+    """Whether the plan predicts the kerf on some cut's face: the kerf panel's rule.
+
+    It needs a ``[material]`` and a heat schedule."""
     me = plan.measured
     return (has_heat_schedule(plan) and plan.job.material is not None
             and any(np.isfinite(fe.worst) or fe.burn for fe in me.faces.values()))  # fmt: skip
 
 
 def runs_thinned(t: FloatArray, y: FloatArray) -> tuple[FloatArray, FloatArray]:
-    """``(t, y)`` kept on the runs where ``y`` (M,) is finite, each run thinned
-    (:func:`~ruledrobot.io.pictures.thinned_series`: every point kept is a sample), the
+    """``(t, y)`` kept on the runs where ``y`` (M,) is finite, each run thinned.
+
+    By :func:`~ruledrobot.io.pictures.thinned_series` (every point kept is a sample); the
     runs joined by a NaN (a gap in the line)."""
     ts, ys = [], []
     for a, b in runs_of(np.isfinite(y)):
