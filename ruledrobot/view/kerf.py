@@ -27,8 +27,8 @@ MIN_SPAN = 1e-4
 def kerf_range(scene: PlanScene) -> tuple[float, float] | None:
     """The colour scale's ends [m], None without a predicted kerf.
 
-    The smallest and largest finite kerf of the timeline and the cut's planned kerf (``limits["kerf_set"]``), widened about their middle to
-    :data:`MIN_SPAN`."""
+    The smallest and largest finite kerf of the timeline and the cut's planned kerf
+    (``limits["kerf_set"]``), widened about their middle to :data:`MIN_SPAN`."""
     tl = scene.timeline
     finite = np.zeros(0) if tl is None or tl.kerf is None else tl.kerf[np.isfinite(tl.kerf)]
     if not finite.size:
