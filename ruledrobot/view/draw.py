@@ -13,7 +13,9 @@ Scene tree (world frame, z up):
   surface the wire has swept inside the stock up to frame k (appears as the
   wire passes); ``/motion/trail/<k>`` — the whole wire's swept trail,
   coloured by phase; ``/motion/caption`` — time, phase, feed, joint speed,
-  singularity at the wire;
+  singularity at the wire (and, with a heat model, the heat and the predicted kerf);
+* ``/plan/kerf`` — with a ``[material]``: the trace of the wire's two chord ends on the
+  part's face, coloured by the kerf predicted there (:mod:`.kerf`), burns as magenta balls;
 * ``/events/<i>`` — collisions (red) and near misses (amber) where they happen.
 
 :meth:`Painter.show` moves everything to a frame; only what changes is sent.
@@ -26,6 +28,16 @@ from typing import Any
 import numpy as np
 
 from ..robot.motion.trajectory import CUTTING_PHASES
+from .kerf import (
+    BURN_COLOUR,
+    BURN_RADIUS,
+    burn_points,
+    heat_words,
+    kerf_colours,
+    kerf_range,
+    kerf_trace,
+    kerf_words,
+)
 from .scene import PlanScene
 
 __all__ = ["PHASE_COLOURS", "Painter", "caption", "figures_markdown"]
@@ -66,6 +78,7 @@ def caption(scene: PlanScene, k: int) -> str:
     lines = [f"t = {tl.t[k]:.2f} s · {phase}"]
     if np.isfinite(tl.feed[k]):
         lines.append(f"feed {1e3 * tl.feed[k]:.2f} mm/s (set {1e3 * lim['feed_set']:.1f})")
+    lines += [w for w in (heat_words(tl, k), kerf_words(tl, k)) if w is not None]
     j = int(np.argmax(tl.speed_ratio[k]))
     lines.append(f"joint speed {100 * tl.speed_ratio[k, j]:.0f} % of limit (J{j + 1})")
     lines.append(f"singularity {tl.singularity[k]:.3f} (≥ {lim['singularity']:.2f})")
@@ -86,6 +99,10 @@ def figures_markdown(scene: PlanScene, k: int) -> str:
         ("time", f"{tl.t[k]:.2f} s of {tl.t[-1]:.2f} s (sample {int(tl.sample[k])})"),
         ("phase", f"**{tl.phase[k]}**"),
         ("feed", feed),
+        *[(w.split(" ", 1)[0], w.split(" ", 1)[1] + note) for w, note in (
+            (heat_words(tl, k), " (set-point; the wire after the lag)"),
+            (kerf_words(tl, k), " (predicted at the wire's start / end side)"))
+          if w is not None],
         ("joint speed / limit", bars),
         ("singularity measure", f"{tl.singularity[k]:.3f} "
          f"({'ok' if sing_ok else 'BELOW'} ≥ {lim['singularity']:.2f})"),
@@ -149,6 +166,16 @@ class Painter:
             self.markers.append(api.add_label(f"/events/{i}/label", text,
                                               position=(0.0, 0.0, 0.02),
                                               anchor="bottom-center"))  # fmt: skip
+        trace = None if scene.timeline is None else kerf_trace(scene.timeline)
+        rng = kerf_range(scene)
+        if trace is not None and rng is not None:
+            seg, w = trace
+            api.add_line_segments("/plan/kerf", seg.astype(np.float32),
+                                  kerf_colours(w, *rng), thickness=5.0,
+                                  thickness_units="screen")  # fmt: skip
+            for i, x in enumerate(burn_points(scene.timeline)):
+                api.add_icosphere(f"/plan/kerf/burn{i}", radius=BURN_RADIUS, color=BURN_COLOUR,
+                                  position=x, cast_shadow=False)  # fmt: skip
         self.frame = -1
         self.trail: list[Any] = []
         self.cut: list[Any | None] = []
@@ -207,7 +234,8 @@ class Painter:
     def set_visible(self, group: str, visible: bool) -> None:
         """Show or hide a group of nodes.
 
-        ``"trail"``, ``"cut"``, ``"rulings"``, ``"surface"``, ``"stock"``, ``"events"``."""
+        ``"trail"``, ``"cut"``, ``"rulings"``, ``"surface"``, ``"stock"``, ``"events"``,
+        ``"kerf"``."""
         api = self.server.scene
         if group in ("trail", "cut"):
             self.enabled[group] = visible
@@ -221,7 +249,7 @@ class Painter:
                 h.visible = visible
             return
         name = {"rulings": "/plan/rulings", "surface": "/plan/surface",
-                "stock": "/cell/stock"}[group]  # fmt: skip
+                "stock": "/cell/stock", "kerf": "/plan/kerf"}[group]  # fmt: skip
         h = api.get_handle_by_name(name)
         if h is not None:
             h.visible = visible

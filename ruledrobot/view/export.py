@@ -27,6 +27,7 @@ from ..io.atomic import atomic_write_text
 from ._viser import viser
 from .draw import PHASE_COLOURS, Painter
 from .folder import PlanFolder
+from .kerf import kerf_legend_html
 from .scene import PlanScene, build_scene
 
 __all__ = ["export_html", "overlay_html"]
@@ -68,13 +69,17 @@ def overlay_html(scene: PlanScene) -> str:
 <details{"" if scene.ok else " open"}><summary>checks</summary>
 <table style="border-collapse:collapse">{"".join(rows)}</table>
 {f"<ul style='color:#c62828'>{failed}</ul>" if failed else ""}</details>
+{kerf_legend_html(scene)}
 <details><summary>collisions and near misses</summary><ul>{events}</ul></details>
 <details><summary>how to read it</summary><div>Drag to turn, scroll to zoom, right-drag to
 pan. The bar at the bottom plays, pauses and scrubs the motion; the caption at the wire
-gives time, phase, feed, joint speed and singularity measure. Red: the wire (and parts named
+gives time, phase, feed, the heat and the predicted kerf (with a heat model), joint speed and
+singularity measure. Red: the wire (and parts named
 in a collision). Orange: the cut
 surface the wire has swept in the stock. Trail of the whole wire by phase: {legend}.
-Blue lines: the refined rulings; blue film: the planned surface.</div></details>
+Blue lines: the refined rulings; blue film: the planned surface. With a [material]: the
+thick line along the part's face is the wire's chord ends' trace, coloured by the kerf
+predicted there (the scale above).</div></details>
 </div>"""
 
 

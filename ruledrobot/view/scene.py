@@ -32,7 +32,7 @@ from ..geometry.box import Box
 from ..geometry.mesh import Mesh
 from ..robot.arm.model import RobotModel
 from ..robot.motion.rates import finite_difference_rates
-from ..robot.motion.trajectory import KinematicsRef, model_for
+from ..robot.motion.trajectory import KinematicsRef, Trajectory, model_for
 from ..robot.verdict import Check
 from ..robot.wire.in_stock import chord_fractions, flange_wire_ends, wire_in_stock
 from ..sim._mujoco import mujoco
@@ -62,7 +62,12 @@ class Timeline:
     ``chord`` (K, 2, 3) the part of the wire inside the stock (NaN outside);
     ``phase`` (K,) names; ``feed`` (K,) m/s (NaN outside the stock);
     ``speed_ratio`` (K, J) |joint speed| / limit; ``singularity`` (K,) the
-    singularity measure (0 at a singularity).
+    singularity measure (0 at a singularity); with a heat model (the trajectory's
+    ``heat_power``): ``heat_power`` (K,) W/m the set-point and ``wire_power`` (K,) W/m the
+    wire's power after the lag, and with a ``[material]`` ``kerf`` (K, 2) m the kerf
+    predicted at the chord's ends (wire start side, end side) by
+    ``Trajectory.face_errors`` (the verdict's model), the widest over the samples since
+    the frame before (NaN: none on the part's face; inf: a burn); else None.
     """
 
     t: FloatArray
@@ -76,6 +81,9 @@ class Timeline:
     feed: FloatArray = field(repr=False)
     speed_ratio: FloatArray = field(repr=False)
     singularity: FloatArray = field(repr=False)
+    kerf: FloatArray | None = field(default=None, repr=False)
+    heat_power: FloatArray | None = field(default=None, repr=False)
+    wire_power: FloatArray | None = field(default=None, repr=False)
 
     @property
     def duration(self) -> float:
@@ -98,7 +106,8 @@ class PlanScene:
     the refined rulings clipped to the stock; ``meshes`` name -> Mesh (world):
     ``surface``, ``part``, ``removed`` when present; ``timeline`` or None;
     ``events`` collisions and near misses; ``checks`` the verdict's table;
-    ``limits``: ``feed_set``, ``feed_min``, ``feed_max`` (m/s), ``singularity``
+    ``limits``: ``feed_set``, ``feed_min``, ``feed_max`` (m/s), ``kerf_set`` (m: the
+    first cut's kerf), ``singularity``
     (the smallest measure allowed), ``near_miss`` (m); ``camera``
     ``(position, target)`` (3,), (3,) world; ``notes`` what the viewer wants
     the user to know (no motion, files worked around).
@@ -151,11 +160,30 @@ def _limits(folder: PlanFolder, near_miss: float) -> dict[str, float]:
     feed_set = float(report.get("feed_speed_mm_s") or np.nan) * 1e-3
     return {
         "feed_set": feed_set,
+        "kerf_set": float(report.get("kerf_mm") or np.nan) * 1e-3,
         "feed_max": limit("feed_max", np.nan, 1e-3),
         "feed_min": limit("feed_min", np.nan, 1e-3),
         "singularity": limit("singularity", 0.02),
         "near_miss": float(near_miss),
     }
+
+
+def _kerf_heat(traj: Trajectory, k: np.ndarray) -> dict[str, FloatArray | None]:
+    """The timeline's ``kerf``, ``heat_power``, ``wire_power`` at samples ``k`` (K,)
+    (:class:`Timeline`): the verdict's model on the trajectory, each cut's face joined."""
+    if traj.heat_power is None:
+        return {}
+    kerf = None
+    if traj.meta.cut is not None and traj.meta.cut.material is not None:
+        faces = traj.face_errors()
+        if faces:
+            kerf = np.full((traj.n, 2), np.nan)
+            for fe in faces.values():
+                kerf = np.where(np.isnan(fe.kerf), kerf, fe.kerf)
+            # per frame the widest since the frame before: a burn between frames shows
+            kerf = np.fmax.reduceat(kerf, np.r_[0, k[:-1] + 1], axis=0)
+    return {"kerf": kerf, "heat_power": np.asarray(traj.heat_power)[k],
+            "wire_power": traj.wire_power()[k]}
 
 
 def _frames(n: int, period: float, fps: float) -> np.ndarray:
@@ -249,7 +277,8 @@ def build_scene(
         vmax = np.asarray(robot.max_velocity, dtype=np.float64)
         speed = np.abs(qd[np.minimum(k, qd.shape[0] - 1)]) / vmax
         timeline = Timeline(traj.t[k], k, traj.q[k], pos, quat, wire, chord, labels[k], feed,
-                            speed, robot.singularity_measure(traj.q[k]))  # fmt: skip
+                            speed, robot.singularity_measure(traj.q[k]),
+                            **_kerf_heat(traj, k))  # fmt: skip
         # where the motion comes close: MuJoCo's collision detection with a margin
         kc = _frames(traj.n, traj.meta.control_period, 1.0 / CLEARANCE_STEP)
         contacts = contacts_along(mj, model, traj.q[kc], max(near_miss, 1e-6))

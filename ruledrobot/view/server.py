@@ -30,6 +30,7 @@ import numpy as np
 from ._viser import viser
 from .draw import Painter, figures_markdown
 from .folder import PlanFolder
+from .kerf import kerf_legend_html
 from .scene import PlanScene, build_scene
 
 __all__ = ["RemoteRefused", "ViewServer", "check_host", "serve"]
@@ -124,6 +125,7 @@ class ViewServer:
         notes = "".join(f"\n- {n}" for n in scene.notes)
         gui.add_markdown(f"**{scene.title}**\n\n**verdict: {verdict}**{notes}")
         tl = scene.timeline
+        legend = kerf_legend_html(scene)  # "" without a predicted kerf
         self.figures = None
         if tl is not None:
             with gui.add_folder("Timeline"):
@@ -137,6 +139,8 @@ class ViewServer:
                                              initial_value=next(iter(self._jumps)))  # fmt: skip
             with gui.add_folder("At this time"):
                 self.figures = gui.add_markdown(figures_markdown(scene, 0))
+                if legend:
+                    gui.add_html(legend)
 
             @self.play_button.on_click
             def _(_: Any) -> None:
@@ -161,7 +165,9 @@ class ViewServer:
         with gui.add_folder("Show", expand_by_default=False):
             for group, label in (("cut", "cut surface swept"), ("trail", "wire trail"),
                                  ("rulings", "rulings"), ("surface", "planned surface"),
-                                 ("stock", "stock"), ("events", "event markers")):  # fmt: skip
+                                 ("stock", "stock"), ("events", "event markers"),
+                                 *((("kerf", "predicted kerf trace"),) if legend else ())
+                                 ):  # fmt: skip
                 box = gui.add_checkbox(label, True)
                 box.on_update(self._toggle(group, box))
 

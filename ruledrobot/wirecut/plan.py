@@ -24,7 +24,7 @@ from ..robot.motion.rates import trajectory_limits_report
 from ..robot.motion.trajectory import Heat, Trajectory, phases_from_labels
 from ..robot.tool import BowTool
 from ..robot.wire.cut import FeedWindow, WireCut
-from ..robot.wire.face import FaceTarget
+from ..robot.wire.face import FaceError, FaceTarget
 from .cut.clearance import SINGULAR_MIN
 from .cut.kerf import face_rulings
 from .cut.order import check_cut_order
@@ -59,6 +59,13 @@ class PlannedMeasures:
     singularity_min: float
     collisions: tuple[dict, ...]
     sentences: tuple[str, ...]
+    #: ``face_error`` per cut name (:meth:`Trajectory.face_errors` of the planned motion,
+    #: computed once: the verdict's figures, report.json's ``predicted_kerf_mm`` and
+    #: ``plots.png``'s kerf panel all read these arrays)
+    faces: dict[str, FaceError] = field(default_factory=dict, repr=False)
+    #: (M,) W/m: the wire's power, the set-points delayed by the heat's lag
+    #: (:meth:`Trajectory.wire_power`, what ``faces`` were judged with); None: no heat model
+    wire_power: FloatArray | None = field(default=None, repr=False)
 
 
 @dataclass(frozen=True, eq=False)
@@ -320,15 +327,6 @@ def make_plan(
     feed = motion.wire.feed
     dev = _deviation_at(flange, tuple(passes), motion)
     collisions, sentences = _bow_outside_cuts(job, bow, motion, flange)
-    cutting = motion.pass_of >= 0
-    measured = PlannedMeasures(
-        flange=flange, feed=feed, deviation=dev,
-        ratios=trajectory_limits_report(timed.t, timed.q, model.max_velocity,
-                                        model.max_acceleration),
-        position_ratio=model.position_ratio(timed.q),
-        singularity_min=float(model.singularity_measure(timed.q[cutting]).min()),
-        collisions=collisions, sentences=sentences,
-    )  # fmt: skip
     robot = model.with_tool(bow.wire_frame()).with_base(np.eye(4))
     robot = dataclasses.replace(robot, tool_mass=job.tool.mass, tool_com=bow.inertia()[0])
     trajectory = Trajectory.from_joints(
@@ -339,6 +337,16 @@ def make_plan(
     power = heat_schedule(job, motion)
     if power is not None:
         trajectory = dataclasses.replace(trajectory, heat_power=power)
+    cutting = motion.pass_of >= 0
+    measured = PlannedMeasures(
+        flange=flange, feed=feed, deviation=dev,
+        ratios=trajectory_limits_report(timed.t, timed.q, model.max_velocity,
+                                        model.max_acceleration),
+        position_ratio=model.position_ratio(timed.q),
+        singularity_min=float(model.singularity_measure(timed.q[cutting]).min()),
+        collisions=collisions, sentences=sentences,
+        faces=trajectory.face_errors(motion.wire), wire_power=trajectory.wire_power(),
+    )  # fmt: skip
     timings["measure_s"] = time.perf_counter() - t2
     return Plan(job, model, tuple(passes), motion, trajectory, measured, reasons,
                 notes + motion.notes, timings, bow, data, ref)  # fmt: skip

@@ -482,16 +482,29 @@ class Trajectory:
         W/m, recorded set-points (default: this trajectory's), delayed by the heat's lag;
         {} when the sidecar names no face."""
         from ..wire.face import face_errors
-        from ..wire.kerf import wire_power
 
         cut = self.meta.cut
         if cut is None or not cut.faces:
             return {}
         wis = self.wire_in_stock() if wis is None else wis
-        hp = self.heat_power if heat_power is None else heat_power
-        lag = 0.0 if self.meta.heat is None else self.meta.heat.lag
-        power = None if hp is None else wire_power(wis.t, hp, lag)
+        power = self.wire_power(wis.t, heat_power)
         return face_errors(wis, power, cut.material, cut.faces)
+
+    def wire_power(
+        self, t: ArrayLike | None = None, heat_power: ArrayLike | None = None
+    ) -> FloatArray | None:
+        """The wire's power (M,) [W/m]: the set-points delayed by the heat's lag.
+
+        At times ``t`` (default: this trajectory's) of the set-points ``heat_power``
+        (default: this trajectory's), by :func:`..wire.kerf.wire_power`: what
+        :meth:`face_errors` judges the kerf with; None without set-points."""
+        from ..wire.kerf import wire_power
+
+        hp = self.heat_power if heat_power is None else heat_power
+        if hp is None:
+            return None
+        lag = 0.0 if self.meta.heat is None else self.meta.heat.lag
+        return wire_power(self.t if t is None else t, hp, lag)
 
     def phase_at(self, k: int) -> str:
         """The name of the phase sample ``k`` belongs to (``"move"`` if none is named)."""

@@ -49,13 +49,15 @@ class Material:
     """A foam's kerf constants (module doc).
 
     ``kerf_base`` m, ``kerf_gain`` m^2/s per W/m, ``power_threshold`` W/m, ``max_speed``
-    (m/s per W/m above the threshold) or None.
+    (m/s per W/m above the threshold) or None; ``drag`` (N/m per m/s, the foam's drag on
+    the moving wire: :mod:`.lag`) or None.
     """
 
     kerf_base: float
     kerf_gain: float
     power_threshold: float = 0.0
     max_speed: float | None = None
+    drag: float | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "kerf_base", _positive("kerf_base", self.kerf_base, True))
@@ -64,6 +66,8 @@ class Material:
                            _positive("power_threshold", self.power_threshold, True))  # fmt: skip
         if self.max_speed is not None:
             object.__setattr__(self, "max_speed", _positive("max_speed", self.max_speed))
+        if self.drag is not None:
+            object.__setattr__(self, "drag", _positive("drag", self.drag, True))
 
     def kerf(self, speed: ArrayLike, power: ArrayLike) -> FloatArray:
         """Return the kerf [m] at ``speed`` [m/s] across the wire and wire ``power`` [W/m].

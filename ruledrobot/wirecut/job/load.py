@@ -37,6 +37,7 @@ metres, radians, seconds)::
     wire_end = [0.2, 0.0, 0.25]
     clearance = 0.02           # wire kept this far beyond the stock at each end
     mass = 1.0
+    # wire_tension = 60.0      # N (optional): with [material] drag, the wire's bow is reported
     # heat = { output = "standard:0", preheat = 2.0 }   # switch the wire's heat (robot IO)
     # heat = { output = "analog:0", mode = "constant_kerf", full_scale = 400.0, lag = 0.2 }
     #                          # the heat model (docs/kerf.md): mode = "on_off" (default) |
@@ -48,6 +49,7 @@ metres, radians, seconds)::
     # kerf_gain = 1.5e-8       # m^2/s per W/m: w = kerf_base + kerf_gain (p - p0) / v
     # power_threshold = 20.0   # W/m: p0, what the wire loses without cutting
     # max_speed = 0.002        # (m/s) per W/m above p0: faster, the wire drags (optional)
+    # drag = 2.0              # N/m per m/s: the foam's drag on the wire (optional, the bow)
 
     [cut]
     feed_speed = 0.01          # m/s, wire speed inside the stock
@@ -126,8 +128,11 @@ def _tool(t: Section) -> ToolSpec:
     heat = None
     if t.get("heat") is not None:
         heat = parse_heat(Section(t.raw, "heat", t.where, title=f"{t.title}.heat"))
+    tension = None if t.get("wire_tension") is None else t.number("wire_tension", lo=0.0,
+                                                                    strict_lo=True)
     tool = ToolSpec(w0, w1, clearance=t.number("clearance", ToolSpec.clearance, lo=0.0),
-                    mass=t.number("mass", ToolSpec.mass, lo=0.0), heat=heat)  # fmt: skip
+                    mass=t.number("mass", ToolSpec.mass, lo=0.0), heat=heat,
+                    wire_tension=tension)  # fmt: skip
     if 2 * tool.clearance >= length:
         raise t.fail(
             "clearance",

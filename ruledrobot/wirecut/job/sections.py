@@ -350,14 +350,16 @@ def parse_material(m: Section) -> Material:
     """Parse ``[material]`` into a :class:`~ruledrobot.robot.wire.kerf.Material`.
 
     See docs/kerf.md: ``kerf_base`` m, ``kerf_gain`` m^2/s per W/m, ``power_threshold`` W/m
-    (default 0), ``max_speed`` (m/s) per W/m (optional).
+    (default 0), ``max_speed`` (m/s) per W/m (optional), ``drag`` N/m per m/s (optional:
+    the wire's bow, information).
     """
-    top = m.get("max_speed")
+    top, drag = m.get("max_speed"), m.get("drag")
     material = Material(
         kerf_base=m.number("kerf_base", lo=0.0),
         kerf_gain=m.number("kerf_gain", lo=0.0, strict_lo=True),
         power_threshold=m.number("power_threshold", 0.0, lo=0.0),
         max_speed=None if top is None else m.number("max_speed", lo=0.0, strict_lo=True),
+        drag=None if drag is None else m.number("drag", lo=0.0),
     )
     m.done()
     return material

@@ -203,10 +203,11 @@ class HeatSpec:
 
 @dataclass(frozen=True)
 class ToolSpec:
-    """The bow: wire ends, clearance, mass and the wire's heat output.
+    """The bow: wire ends, clearance, mass, the wire's heat output and tension.
 
-    Wire end points in the flange frame (m), clearance beyond the stock, mass, and the
-    wire's heat output (None: the heat is not switched by the robot).
+    Wire end points in the flange frame (m), clearance beyond the stock, mass, the wire's
+    heat output (None: the heat is not switched by the robot) and the wire's tension [N]
+    (None: not given; with ``[material] drag`` it predicts the wire's bow).
     """
 
     wire_start: np.ndarray
@@ -214,6 +215,7 @@ class ToolSpec:
     clearance: float = 0.02
     mass: float = 1.0
     heat: HeatSpec | None = None
+    wire_tension: float | None = None
 
     @property
     def wire_length(self) -> float:

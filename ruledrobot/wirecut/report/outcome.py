@@ -13,6 +13,7 @@ import numpy as np
 from ...robot.verdict import Check, Verdict
 from ...robot.wire.cut import feed_measures
 from ...robot.wire.face import FaceError
+from ...robot.wire.lag import corner_dwell, wire_bow
 from ..motion.feed_limit import feed_limit_reason
 from ..plan import SINGULARITY_MARGIN, Plan, job_reference
 from ..reach.explain import reach_reasons
@@ -28,6 +29,9 @@ from .verdict import (
 __all__ = ["REPORT_FORMAT", "plan_outcome"]
 
 REPORT_FORMAT = "ruledrobot.plan-report/1"
+#: what the report says when the wire's bow cannot be predicted (docs/kerf.md, "Wire lag")
+LAG_NEEDS = ("give [material] drag (N/m per m/s) and [tool] wire_tension (N) to predict "
+             "the wire's bow and the corner dwell it asks for")  # fmt: skip
 
 
 def _mm(x: float | None) -> float | None:
@@ -45,7 +49,7 @@ def _cut_sections(plan: Plan, ver: Verification | None) -> tuple[list[dict], lis
     sections, measures = [], []
     cut_meta = plan.trajectory.meta.cut
     feeds = {f.name: f for f in feed_measures(mo.wire, cut_meta)}
-    faces = plan.trajectory.face_errors(mo.wire)
+    faces = me.faces  # computed once with the plan
     for cut in plan.job.cuts:
         ks = [k for k, cp in enumerate(plan.passes) if cp.cut is cut]
         passes = [plan.passes[k] for k in ks]
@@ -64,6 +68,7 @@ def _cut_sections(plan: Plan, ver: Verification | None) -> tuple[list[dict], lis
         t_cut = mo.timed.t[in_pass]
         m0 = passes[0].motion
         fe = faces.get(cut.name)
+        lag = _wire_lag(plan, cut, float(mo.wire.chord_length[rows].max(initial=0.0)))
         cm = CutMeasurements(
             name=cut.name, feed_set_mm_s=cut.feed_speed * 1e3,
             feed_max_mm_s=_mm(None if fm is None or np.isnan(fm.highest) else fm.highest),
@@ -79,6 +84,8 @@ def _cut_sections(plan: Plan, ver: Verification | None) -> tuple[list[dict], lis
             face_error_mm=None if fe is None else _face_mm(fe), tolerance_mm=cut.tolerance * 1e3,
             face_detail="" if fe is None else _face_detail(fe, mo),
             predicted_kerf=None if fe is None else _kerf_words(fe),
+            wire_lag=None if lag["bow_mm"] is None else
+            f"{lag['bow_mm']:.3g} mm / {lag['corner_dwell_s']:.3g} s",
         )  # fmt: skip
         measures.append(cm)
         sections.append({
@@ -105,6 +112,7 @@ def _cut_sections(plan: Plan, ver: Verification | None) -> tuple[list[dict], lis
             "face_burn": None if fe is None else fe.burn,
             "face_tolerance_mm": cm.tolerance_mm,
             "predicted_kerf_mm": None if fe is None else _kerf_range(fe),
+            "wire_lag": lag,
             "roll_deg": float(np.degrees(m0.roll[0])),
             "constant_roll": bool(np.ptp(m0.roll) < 1e-12),
             "slide_m": float(m0.slide[0]),
@@ -114,6 +122,24 @@ def _cut_sections(plan: Plan, ver: Verification | None) -> tuple[list[dict], lis
                                float(me.feed[slits].max() * 1e3)] if slits.any() else None,
         })
     return sections, measures
+
+
+def _wire_lag(plan: Plan, cut, chord: float) -> dict:
+    """The wire's lag on one cut, information (docs/kerf.md, "Wire lag"): its bow behind its
+    ends at the cut's feed on its longest chord in the block ``chord`` [m]
+    (:func:`~ruledrobot.robot.wire.lag.wire_bow`) and the corner dwell that asks for
+    (:func:`~ruledrobot.robot.wire.lag.corner_dwell`); ``bow_mm`` None and ``needs`` saying
+    what to give without ``[material] drag`` and ``[tool] wire_tension``."""
+    job = plan.job
+    drag = None if job.material is None else job.material.drag
+    tension, length = job.tool.wire_tension, job.tool.wire_length
+    out = {"information": True, "speed_mm_s": cut.feed_speed * 1e3, "chord_mm": chord * 1e3,
+           "wire_length_mm": length * 1e3, "drag_n_s_m2": drag, "wire_tension_n": tension}
+    if drag is None or tension is None:
+        return out | {"bow_mm": None, "corner_dwell_s": None, "needs": LAG_NEEDS}
+    bow = float(wire_bow(cut.feed_speed, chord, length, tension, drag))
+    return out | {"bow_mm": bow * 1e3,
+                  "corner_dwell_s": float(corner_dwell(bow, cut.feed_speed))}  # fmt: skip
 
 
 def _face_mm(fe: FaceError) -> float | None:
@@ -204,6 +230,7 @@ def plan_outcome(plan: Plan, ver: Verification | None) -> tuple[dict, Verdict]:
         singularity_min=me.singularity_min,
         tracking_error_mm=None if sim is None else sim["tcp_position_error_mm"]["max"],
         duration_s=float(mo.timed.t[-1]), cuts=tuple(cut_measures),
+        wire_lag_needs=None if any(c.wire_lag for c in cut_measures) else LAG_NEEDS,
     )  # fmt: skip
     verdict = plan_verdict(meas, singularity_margin=SINGULARITY_MARGIN)
     if not mo.surface.any():

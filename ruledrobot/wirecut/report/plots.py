@@ -1,10 +1,12 @@
 """``plots.png`` of a plan: on the left the cut in 3-D (the block, the part, the wire's path
 by phase: :mod:`.plot3d`), on the right the time panels, one under the other on a shared
 time axis with the phases as bands: the joints against their limits and the feed of
-every cut against its set feed.
+every cut against its set feed; when the plan has a heat model, the predicted kerf at both
+wire ends and the heat schedule (:mod:`.plot_heat`).
 
 Each time panel is one function ``panel(ax, plan)`` (:data:`TIME_PANELS`); a panel
-added to the tuple (or handed to :func:`plot_plan`) gets its own row.  The layout is
+added to the tuple (or handed to :func:`plot_plan`) gets its own row; a
+:class:`ShownWhen` panel only when its rule holds for the plan.  The layout is
 matplotlib's constrained layout: no title or label is clipped.
 """
 
@@ -12,6 +14,7 @@ from __future__ import annotations
 
 import io
 from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -23,8 +26,10 @@ from ...io.atomic import atomic_write_bytes
 from ...io.pictures import thinned_series
 from ..plan import Plan
 from .plot3d import PHASE_COLOURS, PHASE_WORDS, phase_runs, scene_panel
+from .plot_heat import has_heat_schedule, has_kerf_model, heat_panel, kerf_panel
 
-__all__ = ["PHASE_COLOURS", "TIME_PANELS", "feed_panel", "joints_panel", "plot_plan"]
+__all__ = ["PHASE_COLOURS", "TIME_PANELS", "ShownWhen", "feed_panel", "joints_panel",
+           "plot_plan"]
 
 #: a time panel: draws on its axes (time [s] along x, shared) from the plan
 TimePanel = Callable[[Any, Plan], None]
@@ -80,8 +85,26 @@ def feed_panel(ax: Any, plan: Plan) -> None:
               fontsize=7, loc="upper right", title="phase")  # fmt: skip
 
 
-#: the time panels, top to bottom
-TIME_PANELS: tuple[TimePanel, ...] = (joints_panel, feed_panel)
+@dataclass(frozen=True)
+class ShownWhen:
+    """A time panel (``panel(ax, plan)``) drawn only for plans where ``rule(plan)`` holds."""
+
+    panel: TimePanel
+    rule: Callable[[Plan], bool]
+
+    def __call__(self, ax: Any, plan: Plan) -> None:
+        self.panel(ax, plan)
+
+
+def _shown(panel: TimePanel, plan: Plan) -> bool:
+    return not isinstance(panel, ShownWhen) or panel.rule(plan)
+
+
+#: the time panels, top to bottom (the kerf and the heat only with a heat model)
+TIME_PANELS: tuple[TimePanel, ...] = (
+    joints_panel, feed_panel, ShownWhen(kerf_panel, has_kerf_model),
+    ShownWhen(heat_panel, has_heat_schedule),
+)  # fmt: skip
 
 
 def plan_figure(plan: Plan, part: Mesh | None = None, surface: Mesh | None = None,
@@ -95,11 +118,13 @@ def plan_figure(plan: Plan, part: Mesh | None = None, surface: Mesh | None = Non
     part, surface : Mesh or None
         The part and the cut surfaces [m, base frame] (:func:`.plot3d.scene_panel`).
     panels : sequence of callables
-        The time panels, top to bottom (:data:`TIME_PANELS`).
+        The time panels, top to bottom (:data:`TIME_PANELS`; a :class:`ShownWhen` panel
+        only where its rule holds).
     """
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
+    panels = [p for p in panels if _shown(p, plan)]
     rows = max(1, len(panels))
     fig = Figure(figsize=(SIZE[0], SIZE[1] + ROW_HEIGHT * max(0, rows - 2)),
                  layout="constrained")  # fmt: skip

@@ -36,7 +36,8 @@ Gating (the plan is feasible only when all hold; ``docs/verdict.md``):
   — the simulated joint torques (MuJoCo, with the bow's mass) at most the limits;
 * ``singularity`` — the singularity measure during the cut at least the margin.
 
-Information only: TCP tracking error, feed within 1 %, kerf, corner stops, duration.
+Information only: TCP tracking error, feed within 1 %, kerf, corner stops, the wire's bow
+and the corner dwell it asks for (``wire_lag``; or what to give to predict it), duration.
 """
 
 from __future__ import annotations
@@ -80,6 +81,9 @@ class CutMeasurements:
     face_detail: str = ""
     #: the predicted kerf's range on the face at the wire's start and end side, in words
     predicted_kerf: str | None = None
+    #: the wire's bow at the feed on the longest chord / the corner dwell it asks for, in
+    #: words (None: not predicted)
+    wire_lag: str | None = None
 
 
 @dataclass(frozen=True)
@@ -103,6 +107,8 @@ class Measurements:
     cuts: tuple[CutMeasurements, ...] = ()
     #: the transits no clear route was found for, in words (:func:`transits_check`)
     transits: tuple[str, ...] = ()
+    #: what to give to predict the wire's bow (None: every cut's is predicted)
+    wire_lag_needs: str | None = None
 
 
 def _cut_checks(c: CutMeasurements, single: bool) -> list[Check]:
@@ -151,6 +157,9 @@ def _cut_info(c: CutMeasurements, single: bool) -> list[Check]:
     if c.predicted_kerf is not None:
         info.append(Check.info("predicted_kerf" + key, "predicted kerf on the face, wire start "
                                "side / end side" + of, c.predicted_kerf))  # fmt: skip
+    if c.wire_lag is not None:
+        info.append(Check.info("wire_lag" + key, "wire bow behind its ends at the feed "
+                               "(longest chord) / corner dwell it asks for" + of, c.wire_lag))
     if c.corner_stops:
         info.append(Check.info(
             "corner_stops" + key, "corners where the wire stops (not in the lowest feed)" + of,
@@ -209,6 +218,9 @@ def plan_verdict(m: Measurements, *, singularity_margin: float) -> Verdict:
                        singularity_margin, detail="the arm comes too close to a singularity"),
         Check.info("tracking_error", "simulated TCP tracking error", m.tracking_error_mm, "mm"),
         *[ch for c in m.cuts for ch in _cut_info(c, single)],
+        *([] if m.wire_lag_needs is None else
+          [Check.info("wire_lag", "wire bow and corner dwell: not predicted",
+                      m.wire_lag_needs)]),
         Check.info("duration", "duration of the whole trajectory", m.duration_s, "s"),
     ]  # fmt: skip
     return Verdict(tuple(checks))

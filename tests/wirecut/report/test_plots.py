@@ -21,7 +21,7 @@ from ruledrobot.wirecut.plan import make_plan
 from ruledrobot.wirecut.report.files import surface_mesh
 from ruledrobot.wirecut.report.part_mesh import part_mesh
 from ruledrobot.wirecut.report.plot3d import PART_COLOUR, PHASE_WORDS, WIRES_PER_PASS
-from ruledrobot.wirecut.report.plots import TIME_PANELS, plan_figure, plot_plan
+from ruledrobot.wirecut.report.plots import TIME_PANELS, ShownWhen, plan_figure, plot_plan
 
 #: the demo's saddle keeping the block below it: a part to draw
 KEPT = DEMO_JOB.replace("kerf = 0.0008", "kerf = 0.0008\nkeep = [0.5, 0.0, 0.2]")
@@ -116,7 +116,10 @@ def test_a_time_panel_added_gets_its_own_row(planned, tmp_path):
     assert [ax.get_title() for ax in flat][-1] == "heat" and seen == [plan]
     assert len({round(ax.get_position().x0, 6) for ax in flat}) == 1  # one column
     ys = [ax.get_position().y0 for ax in flat]
-    assert ys == sorted(ys, reverse=True) and len(flat) == len(TIME_PANELS) + 1
+    # the demo has no heat model: the kerf and heat panels (ShownWhen) take no row
+    shown = [p for p in TIME_PANELS if not isinstance(p, ShownWhen) or p.rule(plan)]
+    assert len(shown) == len(TIME_PANELS) - 2
+    assert ys == sorted(ys, reverse=True) and len(flat) == len(shown) + 1
     out = plot_plan(tmp_path / "plots.png", plan, part, surface)
     assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert isinstance(fig.canvas, FigureCanvasAgg)
