@@ -145,7 +145,8 @@ def path_program(
 
     Waypoints: every phase start, the wire entering and leaving the stock, every heat
     switch, both ends of a dwell; the decimation's tolerances default to a quarter of
-    ``wire_tolerance`` at the wire's ends (position, and angle times half the wire)."""
+    the stricter of ``wire_tolerance`` and the faces' tolerances (``face_error``: the
+    part's millimetres) at the wire's ends (position, and angle times half the wire)."""
     meta = traj.meta
     n = traj.n
     wire_tolerance = plan_wire_tolerance(traj, wire_tolerance)
@@ -160,7 +161,9 @@ def path_program(
         if p.name in HEATED_PHASES:  # the wire near or in the stock: speed within 2 %
             strict[p.start : p.stop] = True
     strict |= traj.inside_stock() | (heat if heat is not None else False)
-    tol = 0.25 * wire_tolerance if tolerance is None else tolerance
+    faces = meta.cut.faces if meta.cut is not None else ()
+    strictest = min([wire_tolerance, *(f.tolerance for f in faces)])
+    tol = 0.25 * strictest if tolerance is None else tolerance
     if angle_tolerance is None:
         half = 0.5 * meta.cut.wire_length if meta.cut is not None else 0.2
         angle_tolerance = tol / half

@@ -83,6 +83,10 @@ def atomic_write_json(path: str | os.PathLike[str], doc: object, *, compact: boo
     """
     import json
 
-    text = (json.dumps(doc, separators=(",", ":")) if compact
-            else json.dumps(doc, indent=JSON_INDENT))  # fmt: skip
+    try:  # strict JSON: NaN and Infinity are not JSON, other readers refuse them
+        text = (json.dumps(doc, separators=(",", ":"), allow_nan=False) if compact
+                else json.dumps(doc, indent=JSON_INDENT, allow_nan=False))  # fmt: skip
+    except ValueError as exc:
+        raise ValueError(f"{path}: {exc} (write null, or a word, for a value that is not a "
+                         "finite number)") from None
     return atomic_write_text(path, text + "\n")

@@ -160,9 +160,16 @@ def _face_detail(fe: FaceError, mo) -> str:
 
 
 def _kerf_range(fe: FaceError) -> dict[str, list[float] | None]:
-    """The predicted kerf's range [min, max] in mm at each chord end on the face."""
+    """The predicted kerf's range [min, max] in mm at each chord end on the face.
+
+    A burn's unbounded kerf is ``null`` (strict JSON has no infinity; ``face_burn`` says it).
+    """
     r = fe.kerf_range() * 1e3
-    return {side: None if np.isnan(r[i]).any() else [float(r[i, 0]), float(r[i, 1])]
+
+    def mm(x: float) -> float | None:
+        return float(x) if np.isfinite(x) else None
+
+    return {side: None if np.isnan(r[i]).any() else [mm(r[i, 0]), mm(r[i, 1])]
             for i, side in enumerate(("wire_start_side", "wire_end_side"))}  # fmt: skip
 
 
