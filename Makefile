@@ -19,14 +19,17 @@ demo: $(STAMP)
 	$(BIN)/ruledrobot demo --out out/demo
 
 ## Run the whole test suite (what CI runs): the tests that are not real-time on both
-## cores (pytest-xdist), then the real-time ones (emulator streams) alone, one at a time.
+## cores (pytest-xdist), then the real-time ones (emulator streams) apart from them, in
+## two groups of whole modules (their tolerances are sized for a loaded 2-core machine;
+## README, "Development").
 test: $(STAMP)
 	$(BIN)/ruff check ruledrobot tests scripts
 	$(BIN)/pytest -q -n 2 -m "not realtime"
-	$(BIN)/pytest -q -m realtime
+	$(BIN)/pytest -q -n 2 --dist loadfile -m realtime
 
 ## The edit loop: ruff and the fast tests on both cores (no real-time streams, no slow
-## planning tests): a few minutes less than the whole suite; CI runs `make test`.
+## tests: SLOW_MODULES and SLOW_TESTS in tests/conftest.py, chosen by measured
+## durations); CI runs `make test`.
 test-fast: $(STAMP)
 	$(BIN)/ruff check ruledrobot tests scripts
 	$(BIN)/pytest -q -n 2 -m "not realtime and not slow"

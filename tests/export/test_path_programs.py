@@ -30,9 +30,6 @@ from ruledrobot.wirecut.planner import plan
 from tests.support.emulators import smooth_trajectory, start_emulator
 from tests.support.rawclient import RawRTDEClient
 
-#: the demo job at 25 mm/s (its own 10 mm/s is planned and verified in tests/wirecut)
-FAST_DEMO_JOB = DEMO_JOB.replace("feed_speed = 0.01 ", "feed_speed = 0.025 ")
-
 
 def _planned(folder, text: str) -> Trajectory:
     """The planned trajectory of job ``text`` with what it cuts (``meta.cut``)."""
@@ -48,13 +45,6 @@ def _planned(folder, text: str) -> Trajectory:
 def demo(tmp_path_factory: pytest.TempPathFactory) -> Trajectory:
     """The demo's planned trajectory with what it cuts (``meta.cut``)."""
     return _planned(tmp_path_factory.mktemp("demo"), DEMO_JOB)
-
-
-@pytest.fixture(scope="module")
-def fast_demo(tmp_path_factory: pytest.TempPathFactory) -> Trajectory:
-    """The demo at 25 mm/s: each mode's program is played in real time (10 s of cut
-    instead of 24 s)."""
-    return _planned(tmp_path_factory.mktemp("fast_demo"), FAST_DEMO_JOB)
 
 
 def _calls(text: str) -> list:

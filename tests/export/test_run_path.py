@@ -21,9 +21,6 @@ from ruledrobot.export.run_program import plan_path_run, run_slice
 from ruledrobot.io.trajectory import write_trajectory
 from ruledrobot.robot.motion.trajectory import Heat, Phase, Trajectory
 from ruledrobot.robot.wire.cut import FeedWindow, WireCut
-from ruledrobot.wirecut.job.demo import DEMO_JOB
-from ruledrobot.wirecut.job.load import load_job
-from ruledrobot.wirecut.planner import plan
 from tests.support.emulators import smooth_trajectory, start_emulator
 
 from .test_run_verdict import _measure, block_trajectory
@@ -32,15 +29,10 @@ pytest.importorskip("rtde_control")
 
 
 @pytest.fixture(scope="module")
-def demo(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """The demo planned (with what it cuts, ``meta.cut``), as a trajectory CSV; at 25 mm/s
-    (it runs in real time: 17 s of motion instead of 27 s)."""
-    folder = tmp_path_factory.mktemp("demo")
-    job = folder / "job.toml"
-    job.write_text(DEMO_JOB.replace("feed_speed = 0.01 ", "feed_speed = 0.025 "))
-    traj = plan(load_job(job), None, simulate=False).trajectory
-    assert traj is not None and traj.meta.cut is not None
-    return write_trajectory(folder / "demo.csv", traj)
+def demo(fast_demo: Trajectory, tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The demo planned at 25 mm/s (``fast_demo``, tests/export/conftest.py: 17 s of motion
+    instead of 27 s, with what it cuts, ``meta.cut``), as a trajectory CSV."""
+    return write_trajectory(tmp_path_factory.mktemp("demo") / "demo.csv", fast_demo)
 
 
 def _span(t: np.ndarray, q: np.ndarray, q0: np.ndarray, q1: np.ndarray) -> float:
