@@ -8,9 +8,7 @@ template of the measurements (``DIR/measured.csv``), into one staged folder.
 **One job per power.** The wire's power is a property of the job's ``[tool] heat``; the job
 format has no per-cut power, so each power is its own job (run them one after the other,
 in the same block).  The power is set on the analog output: ``mode = "constant"`` with
-``power`` and ``full_scale`` where the job format has heat modes (docs/kerf.md), else the
-output's ``value = power / full_scale`` (the same constant set-point).  A digital output
-only switches a supply set by hand, so the robot cannot set the ladder's powers: refused.
+``power`` and ``full_scale`` (docs/kerf.md).  A digital output only switches a supply set by hand, so the robot cannot set the ladder's powers: refused.
 
 **The cuts** are planes through the whole block, normal to its horizontal axis along
 which it is longest (of the two the wire can span); the wire lies along the other
@@ -122,14 +120,10 @@ def _axes(job: Any, where: str) -> tuple[int, int, int]:
     return up, wire, next(k for k in flat if k != wire)
 
 
-def _heat(raw: dict, heat: Any, power: float, full_scale: float) -> tuple[dict, str]:
-    """The ``[tool] heat`` table of one power, and how it sets the power (module doc)."""
+def _heat(raw: dict, power: float, full_scale: float) -> dict:
+    """The ``[tool] heat`` table of one power: ``mode = "constant"`` (module doc)."""
     table = {k: v for k, v in raw.items() if k in ("output", "preheat", "lag")}
-    if hasattr(heat, "mode"):  # the job format has heat modes (docs/kerf.md)
-        table.update(mode="constant", power=float(power), full_scale=float(full_scale))
-        return table, 'mode = "constant", power W/m, full_scale W/m'
-    table["value"] = float(power) / float(full_scale)
-    return table, f"analog value = power / {full_scale:g} W/m (full scale)"
+    return {**table, "mode": "constant", "power": float(power), "full_scale": float(full_scale)}
 
 
 def _rebased_robot(raw: dict, src: Path, out_job: Path) -> dict:
@@ -222,7 +216,8 @@ def write_ladder(job_file: str | os.PathLike[str], out: str | os.PathLike[str],
     fields = {k: getattr(first, k) for k in ("lead_in", "lead_out", "approach_speed",
                                              "wire_tolerance", "feed_tolerance")}  # fmt: skip
     stock = {"centre": c, "size": size, "rotvec": se3.rotvec_from_matrix(R)}
-    heat_words = ""
+    heat_words = (f'output = "{heat.output}", mode = "constant", power W/m, '
+                  f"full_scale = {full_scale:g} W/m")
     jobs = []
     staged = StagedFolder(out)
     if _has_measurements(staged.target):
@@ -233,7 +228,7 @@ def write_ladder(job_file: str | os.PathLike[str], out: str | os.PathLike[str],
         for i, power in enumerate(p):
             folder = staged.path / f"power{i + 1}"
             tool = {k: val for k, val in doc["tool"].items() if k != "heat"}
-            tool["heat"], heat_words = _heat(doc["tool"]["heat"], heat, power, full_scale)
+            tool["heat"] = _heat(doc["tool"]["heat"], power, full_scale)
             text = [f"# kerf ladder, power {i + 1} of {p.size}: {power:g} W/m, "
                     f"{v.size} straight cuts (written by ruledrobot kerf ladder from "
                     f"{job_file.name}; see ../ladder.md)", ""]  # fmt: skip

@@ -33,9 +33,8 @@ def test_the_jobs_load_with_the_speeds_and_powers_asked(job_file, tmp_path):
         job = load_job(job_path)
         assert sorted(c.feed_speed for c in job.cuts) == pytest.approx(SPEEDS)
         heat = job.tool.heat
-        assert heat.output == "analog:0"
-        got = heat.power if hasattr(heat, "mode") else heat.value * FULL
-        assert got == pytest.approx(power)
+        assert (heat.output, heat.mode, heat.full_scale) == ("analog:0", "constant", FULL)
+        assert heat.power == pytest.approx(power)
         for c in job.cuts:
             seen.add((round(c.feed_speed, 6), power))
             assert c.keep is None  # the wire on the plane: nothing compensated
