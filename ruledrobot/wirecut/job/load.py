@@ -244,20 +244,31 @@ def parse_job(doc: dict, where: str = "job", base_dir: Path | None = None) -> Jo
 
 
 def _check_heat_model(tool: ToolSpec, cuts: tuple[CutSpec, ...], material, where: str) -> None:
-    """The heat model's needs across tables (docs/kerf.md): ``constant_kerf`` needs
-    ``[material]`` and every cut's ``kerf`` at least the material's ``kerf_base``."""
+    """Check the heat model's needs across tables (docs/kerf.md).
+
+    ``constant_kerf`` needs ``[material]``; with ``[material]``, a ``power`` must lie above
+    the material's ``power_threshold`` (at or below it the wire melts nothing), and every
+    cut's ``kerf`` that sets the power (``constant_kerf``, or ``on_off`` without ``power``)
+    must be at least the material's ``kerf_base`` (without a heat output too: ``on_off``)."""
     heat = tool.heat
-    if heat is None or heat.mode != "constant_kerf":
-        return
-    if material is None:
+    if heat is not None and heat.mode == "constant_kerf" and material is None:
         raise ValueError(f'{where}: [tool.heat] mode: "constant_kerf" needs a [material] '
                          "table (kerf_base, kerf_gain, power_threshold)")  # fmt: skip
+    if material is None:
+        return
+    power = None if heat is None else heat.power
+    if power is not None and power <= material.power_threshold:
+        raise ValueError(f"{where}: [tool.heat] power: {power:g} W/m is at or below "
+                         f"[material] power_threshold {material.power_threshold:g} W/m: the "
+                         "wire melts nothing (expected a power above it)")  # fmt: skip
+    if power is not None and heat.mode != "constant_kerf":
+        return  # the power is given: the cuts' kerf does not set it
     for cut in cuts:
         if cut.kerf < material.kerf_base:
             title = "cut" if cut.name == "cut" and len(cuts) == 1 else f"cut '{cut.name}'"
             raise ValueError(f"{where}: [{title}] kerf: {cut.kerf * 1e3:g} mm is below "
                              f"[material] kerf_base {material.kerf_base * 1e3:g} mm: no heat "
-                             "melts less than the wire")  # fmt: skip
+                             "melts less than the wire (expected a kerf >= kerf_base)")  # fmt: skip
 
 
 def job_document(text: str, where: str) -> dict:

@@ -353,6 +353,9 @@ def parse_material(m: Section) -> Material:
     (default 0), ``max_speed`` (m/s) per W/m (optional), ``drag`` N/m per m/s (optional:
     the wire's bow, information).
     """
+    for key in ("kerf_base", "kerf_gain", "power_threshold", "max_speed", "drag"):
+        m.get(key)
+    m.done()  # a misspelt field is named as such, not as the one it stands for missing
     top, drag = m.get("max_speed"), m.get("drag")
     material = Material(
         kerf_base=m.number("kerf_base", lo=0.0),
@@ -361,7 +364,6 @@ def parse_material(m: Section) -> Material:
         max_speed=None if top is None else m.number("max_speed", lo=0.0, strict_lo=True),
         drag=None if drag is None else m.number("drag", lo=0.0),
     )
-    m.done()
     return material
 
 
@@ -396,13 +398,20 @@ def parse_heat(h: Section) -> HeatSpec:
         mode=mode, power=power, full_scale=full_scale,
         lag=h.number("lag", 0.0, lo=0.0, hi=10.0),
     )
-    if kind != "analog" and "value" in h.raw:
-        raise h.fail("value", "only for an analog output")
+    for key in ("value", "full_scale"):
+        if kind != "analog" and key in h.raw:
+            raise h.fail(key, f'only for an analog output, got output = "{out}"')
+    if kind != "analog" and mode == "constant_kerf":
+        raise h.fail("mode", f'"constant_kerf" sets the power as the wire\'s speed changes: '
+                     f'it needs an analog output (output = "analog:0"), got output = "{out}"')
     if mode == "constant" and power is None:
         raise h.fail("power", 'missing; mode = "constant" needs the wire\'s power (W/m)')
     if kind == "analog" and mode != "on_off" and full_scale is None:
         raise h.fail("full_scale", f'missing; mode = "{mode}" on an analog output needs the '
                      "power (W/m) at the output's 1.0")  # fmt: skip
+    if kind == "analog" and None not in (power, full_scale) and power > full_scale:
+        raise h.fail("power", f"{power:g} W/m is above full_scale {full_scale:g} W/m: the "
+                     "output cannot set it (expected a power <= full_scale)")
     if kind == "analog" and mode != "on_off" and "value" in h.raw:
         raise h.fail("value", f'not with mode = "{mode}": the power sets the output '
                      "(power / full_scale)")  # fmt: skip

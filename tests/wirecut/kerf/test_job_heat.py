@@ -55,7 +55,7 @@ def test_material_and_heat_model_parse(tmp_path):
          r"\[tool\.heat\] power: missing"),
         ('heat = { output = "analog:0", mode = "constant", power = 50.0 }', MATERIAL, "",
          r"\[tool\.heat\] full_scale: missing"),
-        ('heat = { output = "standard:0", mode = "constant_kerf" }', "", "",
+        ('heat = { output = "analog:0", mode = "constant_kerf", full_scale = 400.0 }', "", "",
          r"\[tool\.heat\] mode: \"constant_kerf\" needs a \[material\]"),
         ('heat = { output = "standard:0", lag = -1 }', MATERIAL, "",
          r"\[tool\.heat\] lag: expected a number >= 0"),
@@ -65,6 +65,17 @@ def test_material_and_heat_model_parse(tmp_path):
          r"\[material\] kerf_base: missing"),
         ("", MATERIAL + "colour = 1\n", "", r"\[material\] unknown field\(s\) colour"),
         ("", MATERIAL, "tolerance = 0\n", r"\[cut\] tolerance: expected a number > 0"),
+        ("", MATERIAL.replace("kerf_gain", "kerf_gian"), "",
+         r"\[material\] unknown field\(s\) kerf_gian; expected some of kerf_base, kerf_gain"),
+        ('heat = { output = "standard:0", mode = "constant_kerf" }', MATERIAL, "",
+         r"\[tool\.heat\] mode: \"constant_kerf\" sets the power .* needs an analog output"),
+        ('heat = { output = "tool:1", mode = "constant", power = 50.0, full_scale = 90.0 }',
+         MATERIAL, "", r"\[tool\.heat\] full_scale: only for an analog output, got output = "
+         r'"tool:1"'),
+        ('heat = { output = "analog:0", mode = "constant", power = 90.0, full_scale = 60.0 }',
+         MATERIAL, "", r"\[tool\.heat\] power: 90 W/m is above full_scale 60 W/m"),
+        ('heat = { output = "standard:0", mode = "constant", power = 20.0 }', MATERIAL, "",
+         r"\[tool\.heat\] power: 20 W/m is at or below \[material\] power_threshold 20 W/m"),
     ],
 )
 def test_bad_heat_model_names_file_table_field(tmp_path, heat, material, cut, message):
@@ -73,10 +84,21 @@ def test_bad_heat_model_names_file_table_field(tmp_path, heat, material, cut, me
         load_job(p)
 
 
-def test_constant_kerf_refuses_a_kerf_below_the_wire(tmp_path):
-    text = job_text('heat = { output = "standard:0", mode = "constant_kerf" }').replace(
-        "kerf = 0.0008", "kerf = 0.0002")
+@pytest.mark.parametrize("heat", [
+    'heat = { output = "analog:0", mode = "constant_kerf", full_scale = 400.0 }',
+    'heat = { output = "standard:0" }',  # on_off without power: the kerf sets the power
+    "",  # no heat output: on_off, the same
+])
+def test_a_kerf_that_sets_the_power_below_the_wire_is_refused(tmp_path, heat):
+    text = job_text(heat).replace("kerf = 0.0008", "kerf = 0.0002")
     p = write(tmp_path, text)
     with pytest.raises(ValueError, match=rf"^{p}: \[cut\] kerf: 0.2 mm is below \[material\] "
-                       "kerf_base 0.3 mm"):
+                       r"kerf_base 0.3 mm: .*\(expected a kerf >= kerf_base\)"):
         load_job(p)
+
+
+def test_a_given_power_makes_the_kerf_below_the_wire_harmless(tmp_path):
+    """With ``power`` given (on_off or constant) the cut's kerf sets nothing: it loads."""
+    heat = 'heat = { output = "standard:0", mode = "constant", power = 50.0 }'
+    job = load_job(write(tmp_path, job_text(heat).replace("kerf = 0.0008", "kerf = 0.0002")))
+    assert job.cut.kerf == 0.0002 and job.tool.heat.power == 50.0
