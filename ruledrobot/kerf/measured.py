@@ -5,7 +5,7 @@ and ignored)::
 
     speed_mm_s   the feed the cut was made at [mm/s]              (> 0)
     power_w_m    the heat put into one metre of wire [W/m]        (>= 0)
-    kerf_mm      the slot's width measured [mm]                    (> 0; empty on a failed row)
+    kerf_mm      the slot's width measured [mm]        (KERF_MM_RANGE; empty on a failed row)
     failed       optional: yes / no (also true/false, 1/0, empty = no): the wire dragged,
                  bowed or snapped; its kerf is not fitted, its speed bounds max_speed
 
@@ -26,11 +26,14 @@ import numpy as np
 
 from ..io.text import read_user_text
 
-__all__ = ["COLUMNS", "Measured", "read_measured"]
+__all__ = ["COLUMNS", "KERF_MM_RANGE", "Measured", "read_measured"]
 
 #: the columns every measured file has (the fit's inputs), in the template's order
 COLUMNS = ("speed_mm_s", "power_w_m", "kerf_mm")
 _FAILED = "failed"
+#: the widths [mm] a hot wire's slot can have: thinner than the thinnest wire, or wider than
+#: a hand, is a reading in another unit (metres, inches) or a slip of the pen
+KERF_MM_RANGE = (0.05, 50.0)
 _YES = ("yes", "true", "1", "y")
 _NO = ("no", "false", "0", "n", "")
 
@@ -100,6 +103,11 @@ def read_measured(path: str | os.PathLike[str]) -> Measured:
                              f"{_FAILED} = yes, or delete it")  # fmt: skip
         else:
             w = _number(cell["kerf_mm"], at, "kerf_mm", 0.0, strict=True)
+            lo, hi = KERF_MM_RANGE
+            if not lo <= w <= hi:
+                raise ValueError(f"{at}, column kerf_mm: expected the slot's width in "
+                                 f"millimetres, {lo:g} to {hi:g}, got {cell['kerf_mm']!r} "
+                                 "(a reading in metres or inches?)")  # fmt: skip
         rows.append((v, pw, w, failed, lineno))
     if header is None:
         raise ValueError(f"{where}: empty file; expected the header {','.join(COLUMNS)}")

@@ -56,6 +56,9 @@ def test_one_power_warns_fails_and_writes_nothing(tmp_path):
     ("-4,25,1.0", "line 4, column speed_mm_s: expected a finite number > 0"),
     ("4,25,", "line 4, column kerf_mm: empty"),
     ("4,25,1.0,7", "line 4: expected 3 values"),
+    ("4,25,0.0012", "line 4, column kerf_mm: expected the slot's width in millimetres, 0.05 "
+                    "to 50, got '0.0012' (a reading in metres or inches?)"),
+    ("4,25,75", "line 4, column kerf_mm: expected the slot's width in millimetres"),
 ])  # fmt: skip
 def test_a_bad_row_exits_2_naming_file_line_and_column(tmp_path, line, match):
     csv = tmp_path / "m.csv"
