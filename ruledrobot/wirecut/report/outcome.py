@@ -79,6 +79,7 @@ def _cut_sections(plan: Plan, ver: Verification | None) -> tuple[list[dict], lis
                                            <= 0.01)) if interior.any() else None,
             wire_deviation_mm=_mm(dev_s), planned_wire_deviation_mm=_mm(dev_p),
             kerf_mm=cut.kerf * 1e3, compensated=compensated,
+            per_point=compensated and plan.job.material is not None,
             kept_surface_error_mm=err * 1e3 if compensated else None,
             wire_tolerance_mm=cut.wire_tolerance * 1e3, feed_tolerance=cut.feed_tolerance,
             face_error_mm=None if fe is None else _face_mm(fe), tolerance_mm=cut.tolerance * 1e3,

@@ -84,6 +84,8 @@ class CutMeasurements:
     #: the wire's bow at the feed on the longest chord / the corner dwell it asks for, in
     #: words (None: not predicted)
     wire_lag: str | None = None
+    #: the compensation follows the kerf ``[material]`` predicts per point, not ``kerf_mm``
+    per_point: bool = False
 
 
 @dataclass(frozen=True)
@@ -148,7 +150,8 @@ def _cut_checks(c: CutMeasurements, single: bool) -> list[Check]:
 def _cut_info(c: CutMeasurements, single: bool) -> list[Check]:
     key = "" if single else f":{c.name}"
     of = "" if single else f" ({c.name})"
-    kerf = "kerf (compensated)" if c.compensated else "kerf (not compensated)"
+    kerf = ("kerf asked (compensated per point: the predicted kerf)" if c.per_point
+            else "kerf (compensated)" if c.compensated else "kerf (not compensated)")
     info = [
         Check.info("feed_within_1pct" + key, "share of the cut within 1 % of the feed" + of,
                    c.feed_within_1pct),

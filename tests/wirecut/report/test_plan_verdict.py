@@ -65,6 +65,14 @@ def test_an_uncompensated_cut_has_no_kept_surface_check():
     assert v["kerf"].label == "kerf (not compensated)"
 
 
+def test_a_kerf_compensated_per_point_is_labelled_as_asked_not_as_compensated():
+    """With [material] the wire follows the predicted kerf; the cut's kerf is what was asked."""
+    v = plan_verdict(_meas(_cut(per_point=True, predicted_kerf="0.92-0.93 / 0.92-0.93 mm")),
+                     singularity_margin=MARGIN)  # fmt: skip
+    assert v["kerf"].label == "kerf asked (compensated per point: the predicted kerf)"
+    assert v["predicted_kerf"].value == "0.92-0.93 / 0.92-0.93 mm"
+
+
 @pytest.mark.parametrize(
     "check, meas",
     [
