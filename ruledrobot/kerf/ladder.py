@@ -219,11 +219,10 @@ def write_ladder(job_file: str | os.PathLike[str], out: str | os.PathLike[str],
     heat_words = (f'output = "{heat.output}", mode = "constant", power W/m, '
                   f"full_scale = {full_scale:g} W/m")
     jobs = []
-    staged = StagedFolder(out)
-    if _has_measurements(staged.target):
-        staged.abort()
-        raise ValueError(f"{staged.target / 'measured.csv'} holds measurements: copy it "
+    if _has_measurements(Path(out)):  # before the folder's own check: say what matters
+        raise ValueError(f"{Path(out) / 'measured.csv'} holds measurements: copy it "
                          "elsewhere, or write the ladder into another folder")  # fmt: skip
+    staged = StagedFolder(out)
     with staged:
         for i, power in enumerate(p):
             folder = staged.path / f"power{i + 1}"

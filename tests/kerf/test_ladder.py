@@ -84,9 +84,13 @@ def test_the_template_filled_with_the_model_fits_back(job_file, tmp_path):
     fit = fit_kerf(read_measured(path))
     assert fit.verdict.ok
     assert fit.material.kerf_gain == pytest.approx(truth.kerf_gain, rel=0.01)
-    # and the folder is not written over while it holds measurements
-    with pytest.raises(ValueError, match="holds measurements"):
-        write_ladder(job_file(), lad.out, SPEEDS, POWERS, full_scale=FULL)
+    # and the folder is not written over while it holds measurements, said as such also
+    # when `kerf fit` has put its material.toml beside them (a file the ladder did not write)
+    for extra in (False, True):
+        if extra:
+            (lad.out / "material.toml").write_text("[material]\n", encoding="utf-8")
+        with pytest.raises(ValueError, match="measured.csv holds measurements"):
+            write_ladder(job_file(), lad.out, SPEEDS, POWERS, full_scale=FULL)
 
 
 def test_a_digital_heat_output_is_refused_saying_why(job_file, tmp_path):
