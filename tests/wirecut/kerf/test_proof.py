@@ -87,7 +87,8 @@ def test_constant_kerf_heat_power_follows_the_formula(tmp_path):
 @pytest.mark.parametrize("mode, ok", [("constant", False), ("constant_kerf", True)])
 def test_corner_stop_burns_with_constant_heat_only(tmp_path, mode, ok):
     power = ", power = 50.0" if mode == "constant" else ""
-    job = write_corner(tmp_path, f'heat = {{ output = "standard:0", mode = "{mode}"{power} }}')
+    job = write_corner(tmp_path, f'heat = {{ output = "analog:0", mode = "{mode}", '
+                                 f"full_scale = 200.0{power} }}")  # fmt: skip
     plan = _plan(job)
     assert plan.motion.corner_stop.any()  # the wire stops in the block
     _, verdict = plan_outcome(plan, None)
