@@ -8,7 +8,8 @@ template of the measurements (``DIR/measured.csv``), into one staged folder.
 **One job per power.** The wire's power is a property of the job's ``[tool] heat``; the job
 format has no per-cut power, so each power is its own job (run them one after the other,
 in the same block).  The power is set on the analog output: ``mode = "constant"`` with
-``power`` and ``full_scale`` (docs/kerf.md).  A digital output only switches a supply set by hand, so the robot cannot set the ladder's powers: refused.
+``power`` and ``full_scale`` (docs/kerf.md).  A digital output only switches a supply set
+by hand, so the robot cannot set the ladder's powers: refused.
 
 **The cuts** are planes through the whole block, normal to its horizontal axis along
 which it is longest (of the two the wire can span); the wire lies along the other

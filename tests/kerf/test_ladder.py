@@ -89,7 +89,7 @@ def test_the_template_filled_with_the_model_fits_back(job_file, tmp_path):
     for extra in (False, True):
         if extra:
             (lad.out / "material.toml").write_text("[material]\n", encoding="utf-8")
-        with pytest.raises(ValueError, match="measured.csv holds measurements"):
+        with pytest.raises(ValueError, match=r"measured\.csv holds measurements"):
             write_ladder(job_file(), lad.out, SPEEDS, POWERS, full_scale=FULL)
 
 

@@ -66,7 +66,7 @@ def test_material_and_heat_model_parse(tmp_path):
         ("", MATERIAL + "colour = 1\n", "", r"\[material\] unknown field\(s\) colour"),
         ("", MATERIAL, "tolerance = 0\n", r"\[cut\] tolerance: expected a number > 0"),
         ("", MATERIAL.replace("kerf_gain", "kerf_gian"), "",
-         r"\[material\] unknown field\(s\) kerf_gian; expected some of kerf_base, kerf_gain"),
+         r"\[material\] unknown field\(s\) kerf_gian; expected some of .*kerf_gain"),
         ('heat = { output = "standard:0", mode = "constant_kerf" }', MATERIAL, "",
          r"\[tool\.heat\] mode: \"constant_kerf\" sets the power .* needs an analog output"),
         ('heat = { output = "tool:1", mode = "constant", power = 50.0, full_scale = 90.0 }',
