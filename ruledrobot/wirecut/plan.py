@@ -181,9 +181,18 @@ def wire_cut(job: Job, motion: Motion, bow: BowTool | None = None) -> WireCut:
         feeds.append(FeedWindow(cut.name, int(rows[0]), int(rows[-1]) + 1, cut.feed_speed,
                                 cut.feed_tolerance, runs_of(held_all & mask),
                                 cut.wire_tolerance))  # fmt: skip
-        on_face = runs_of(motion.surface & mask)
+        # the face: the surface's own rulings (a lead-in/out or slit that runs in the block
+        # to reach a profile inside it cuts waste), the extrapolation too when it is cut on
+        # through the block (extend = true)
+        a, z = (0, 0) if cut.extend and not cp.closed else cp.extended
+        own = np.zeros(len(cp.s), dtype=bool)
+        own[a : len(cp.s) - z] = True
+        s_lo, s_hi = cp.s[a], cp.s[len(cp.s) - 1 - z]
+        on_surface = (motion.s >= s_lo - 1e-9) & (motion.s <= s_hi + 1e-9)
+        on_face = runs_of(motion.surface & mask & on_surface)
         if cut.keep is not None and on_face:  # the part's side is known: its face is judged
-            lines = face_rulings(cp.target_frames, cp.frames, job.stock, cut.keep, cp.closed)
+            lines = face_rulings(cp.target_frames, cp.frames, job.stock, cut.keep, cp.closed,
+                                 own)  # fmt: skip
             faces.append(FaceTarget(cut.name, **lines, ranges=on_face, kerf=cut.kerf,
                                     tolerance=cut.tolerance))  # fmt: skip
     bow = BowTool.of(job.tool if bow is None else bow)

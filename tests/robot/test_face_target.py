@@ -66,3 +66,23 @@ def test_chord_ends_mid_ruling_are_judged_on_their_ruling(extra):
     np.testing.assert_allclose(e.error[ok], truth[ok], atol=2e-6)
     assert e.worst == pytest.approx(truth.max(), abs=2e-6)
     assert (e.worst > 1e-4) == (extra > 0)  # the wire 0.2 mm further off fails 0.1 mm
+
+
+def test_a_wire_at_a_thin_trailing_edge_is_judged_on_its_own_face():
+    # a wedge 0.3 mm thick at most: face A (z = 0, waste above) and face B (z = -x / 300,
+    # waste below), rulings along y, dense as a refined profile; the wire cuts A half a
+    # kerf above it, nearer B's rulings than most of A's
+    xa, xb = np.linspace(0.0, 0.09, 181), np.linspace(0.0, 0.09, 9001)  # B the denser
+    o = np.concatenate([np.stack([xa, -0.15 + 0 * xa, 0 * xa], 1),
+                        np.stack([xb, -0.15 + 0 * xb, -xb / 300], 1)])  # fmt: skip
+    d = np.tile([0.0, 1.0, 0.0], (len(o), 1))
+    a = np.concatenate([np.tile([0.0, 0.0, 1.0], (xa.size, 1)),
+                        np.tile([-1 / 300, 0.0, -1.0], (xb.size, 1))])  # fmt: skip
+    target = FaceTarget("wedge", o, d, a, 0 * a, np.tile([0.0, 0.3], (len(o), 1)),
+                        ranges=((0, 50),), kerf=KERF)  # fmt: skip
+    x = np.linspace(0.0005, 0.003, 50)  # along face A near the edge
+    ends = np.stack([np.stack([x, -0.2 + 0 * x, 0.5 * KERF + 0 * x], 1),
+                     np.stack([x, 0.2 + 0 * x, 0.5 * KERF + 0 * x], 1)], 1)  # fmt: skip
+    stock = Box(np.array([0.05, 0.0, 0.0]), np.array([0.2, 0.15, 0.1]))  # chord ends on sample rows
+    e = face_error(wire_in_stock(np.arange(50) * 0.01, ends, stock), None, None, target)
+    assert e.worst < 1e-9

@@ -14,10 +14,11 @@ the cut's rulings as lines (origin ``o``, unit direction ``z``) with the surface
 normal field along each, which is exact on a ruled surface: the unnormalised normal
 ``z x (o' + t z')`` is affine in the ruling parameter ``t`` (``a + t b``), and the
 ruling lies in every tangent plane along it, so ``s`` is the chord end's foot on the
-ruling and ``(x - s) . n = (x - o) . n``.  The candidate rulings of a chord end are those
-of the nearest sampled points of the target (a k-d tree over :data:`SAMPLES` points per
-chord); the plane nearest the face decides (at a corner of the path the corner ruling's
-normal bisects the faces; a neighbour's plane is the face).  The kerf ``w`` at each
+ruling and ``(x - s) . n = (x - o) . n``.  The candidate rulings of a sample are those of
+the nearest sampled wire positions (:meth:`FaceTarget.samples`: :data:`SAMPLES` points per
+chord half a kerf off the surface, in a k-d tree) to either chord end; the plane nearest
+the face decides (at a corner of the path the corner ruling's normal bisects the faces;
+a neighbour's plane is the face).  The kerf ``w`` at each
 end: the cut's constant ``kerf`` without a material; with one, ``material.kerf(v, p)``
 with ``v`` the end's speed across the wire (:func:`.in_stock.across_speeds` in time)
 and ``p`` the wire's power (:func:`.kerf.wire_power` of the set-points).  A wire that
@@ -110,10 +111,16 @@ class FaceTarget:
         return ranges_mask(self.ranges, n)
 
     def samples(self) -> FloatArray:
-        """(K, SAMPLES, 3) m: points evenly along each chord, its ends included."""
+        """(K, SAMPLES, 3) m: where the wire belongs along each chord, its ends included.
+
+        Points evenly along the chord moved half the cut's ``kerf`` into the waste: a wire
+        is nearer its own ruling's than another face's where two faces run close (both
+        sides of a thin trailing edge lie a kerf apart there)."""
         u = np.linspace(0.0, 1.0, SAMPLES)
         t = self.chord[:, :1] + u * (self.chord[:, 1:] - self.chord[:, :1])
-        return self.origins[:, None, :] + t[..., None] * self.directions[:, None, :]
+        k = np.broadcast_to(np.arange(len(t))[:, None], t.shape)
+        on = self.origins[:, None, :] + t[..., None] * self.directions[:, None, :]
+        return on + 0.5 * self.kerf * self.normals(k, t)
 
     def normals(self, k: np.ndarray, t: FloatArray) -> FloatArray:
         """Unit normals (..., 3) into the waste on rulings ``k`` (...) at ``t`` (...) m."""
@@ -226,7 +233,9 @@ def face_error(
     pts = face.samples().reshape(-1, 3)
     near = min(NEAREST, len(pts))
     _, idx = cKDTree(pts).query(np.array(x.reshape(-1, 3)), k=near)  # writable copy
-    k = (np.asarray(idx).reshape(*x.shape[:2], near) // SAMPLES)  # (R, 2, near) rulings
+    # the candidates of both chord ends serve both: the wire lies on one ruling
+    k = (np.asarray(idx).reshape(len(x), 2 * near) // SAMPLES)[:, None, :]  # (R, 1, 2 near)
+    k = np.broadcast_to(k, (len(x), 2, 2 * near))
     rel = x[:, :, None, :] - face.origins[k]
     t = np.einsum("rjni,rjni->rjn", rel, face.directions[k])
     with np.errstate(invalid="ignore"):

@@ -339,7 +339,8 @@ def cut_offsets(
 
 
 def face_rulings(
-    target: FloatArray, wire: FloatArray, stock: Box, keep: str | FloatArray, closed: bool = False
+    target: FloatArray, wire: FloatArray, stock: Box, keep: str | FloatArray, closed: bool = False,
+    own: np.ndarray | None = None,
 ) -> dict[str, FloatArray]:
     """The part's surface along a pass (``face_error``'s target, :class:`FaceTarget`'s fields).
 
@@ -349,8 +350,11 @@ def face_rulings(
     the chord in the block (``chord`` (K, 2) m along ``z``).  Each ruling's normals point
     the way its wire (``wire`` (M, 4, 4), the compensated rulings) is moved off it at the
     chord's middle -- a pass that goes out and back along a loop turns its normals round
-    halfway -- and by ``keep`` (:func:`waste_sign`) where the wire is not moved."""
+    halfway -- and by ``keep`` (:func:`waste_sign`) where the wire is not moved.  ``own``
+    (M,) bool: the rulings that are the surface (not a lead-in/out or slit; None: all)."""
     c0, c1, hit = chords(target, stock)
+    if own is not None:
+        hit = hit & own
     o, z = target[:, :3, 3], target[:, :3, 2]
     a = np.cross(z, _derivative(o, closed))
     b = np.cross(z, _derivative(z, closed))
