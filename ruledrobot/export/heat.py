@@ -62,18 +62,20 @@ def heat_levels(traj: Trajectory) -> np.ndarray | None:
 def written_levels(levels: np.ndarray, step: float = HEAT_STEP) -> np.ndarray:
     """The set-points (M,) as a program or a run writes them.
 
-    ``levels[k]`` at each sample where its band of width ``step`` changes (zero is a band
-    of its own: off and on are always written) and where it comes to rest (a held value
-    after a change: a ramp ends on its exact value, e.g. the threshold of a corner stop,
-    where a wire a band above it would burn), held until the next: within ``step`` of
-    ``levels`` everywhere, equal to it where it holds."""
+    A value is written at each sample where the band of width ``step`` changes (zero is
+    a band of its own: off and on are always written) and where ``levels`` comes to rest
+    (a held value after a change), and held until the next: the smallest set-point of
+    the samples it holds for.  So the output is within ``step`` of ``levels`` everywhere,
+    never above it (a wire a band hotter than planned where it stands at a corner stop
+    would burn), and equal to it where it holds (a ramp ends on its exact value, e.g.
+    the threshold)."""
     lv = np.asarray(levels, dtype=np.float64)
     if lv.size == 0:
         return lv.copy()
     band = np.where(lv > 0.0, np.floor(lv / step) + 1.0, 0.0)
     change = np.r_[True, band[1:] != band[:-1]]
     change[1:-1] |= (lv[1:-1] != lv[:-2]) & (lv[1:-1] == lv[2:])
-    return lv[np.flatnonzero(change)][np.cumsum(change) - 1]
+    return np.minimum.reduceat(lv, np.flatnonzero(change))[np.cumsum(change) - 1]
 
 
 def servo_levels(levels: np.ndarray, dt: float, lookahead: float, gain: float,
@@ -86,10 +88,11 @@ def servo_levels(levels: np.ndarray, dt: float, lookahead: float, gain: float,
     plan's speed, written on the command's clock, heats the wire for a speed it does not
     have yet (docs/kerf.md, "The heat on the robot").  Where the response is within a
     quarter ``step`` of the set-point it tracks, the set-point itself (an exponential
-    tail never reaches a threshold it approaches)."""
+    tail never reaches a threshold it approaches); off (0) where the set-point is off:
+    the heat switches off on the command's clock, as it does on a digital output."""
     lv = np.asarray(levels, dtype=np.float64)
     y = servo_track(lv, dt, servo_time_constant(lookahead, gain))
-    return np.where(np.abs(y - lv) < 0.25 * step, lv, y)
+    return np.where((np.abs(y - lv) < 0.25 * step) | (lv <= 0.0), lv, y)
 
 
 def urscript_heat(heat: Heat, on: bool, value: float | None = None) -> str:
