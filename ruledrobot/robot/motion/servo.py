@@ -46,8 +46,9 @@ def servo_time_constant(lookahead: float = SERVO_LOOKAHEAD, gain: float = SERVO_
 
 
 def servo_settle_time(lookahead: float = SERVO_LOOKAHEAD, gain: float = SERVO_GAIN) -> float:
-    """Return how long [s] a stopped command waits for the arm: :data:`SETTLE_TIMES` time
-    constants."""
+    """Return how long [s] a stopped command waits for the arm to settle.
+
+    :data:`SETTLE_TIMES` time constants (:func:`servo_time_constant`)."""
     return SETTLE_TIMES * servo_time_constant(lookahead, gain)
 
 
