@@ -136,8 +136,10 @@ def time_between_corners(
 
 def corner_dwell(before: TimedPath, vel_limits: FloatArray, acc_limits: FloatArray,
                  dt: float, duration: float = CORNER_DWELL) -> TimedPath:  # fmt: skip
-    """Return the wait at a corner stop in the stock: ``before``'s last pose held
-    ``duration`` s, on its path parameter, a corner stop's samples (``feed_limited``)."""
+    """Return the wait at a corner stop in the stock.
+
+    ``before``'s last pose held ``duration`` s, on its path parameter, a corner stop's
+    samples (``feed_limited``)."""
     d = dwell(before.q[-1], duration, vel_limits, acc_limits, dt)
     return dataclasses.replace(d, s_of_t=np.full(d.t.size, before.s_of_t[-1]),
                                feed_limited=np.ones(d.t.size, dtype=bool))  # fmt: skip
