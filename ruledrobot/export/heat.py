@@ -8,7 +8,8 @@ on an analog output in mode ``constant`` or ``constant_kerf`` (docs/kerf.md) set
 output along the motion instead:
 :func:`heat_levels` are its set-points (``heat_power / full_scale``), and
 :func:`written_levels` the ones a program or a run writes (where they change by more
-than :data:`HEAT_STEP`).
+than :data:`HEAT_STEP`), and along a servoj motion :func:`servo_levels` (the set-points
+as the arm, trailing its command, reaches them).
 
 * :func:`urscript_heat` — the URScript statement (``set_standard_digital_out(0,
   True)`` ...), for exported programs and for the secondary program that turns the
@@ -30,10 +31,12 @@ from typing import Any
 import numpy as np
 
 from ..protocol.primary import SECONDARY_PORT
+from ..robot.motion.servo import servo_time_constant, servo_track
 from ..robot.motion.trajectory import Heat, Trajectory
 
 __all__ = ["HEAT_STEP", "heat_from_outputs", "heat_levels", "heat_off_program",
-           "heat_power_from_outputs", "motion_power", "send_heat_off", "set_heat_rtde",
+           "heat_power_from_outputs", "motion_power", "send_heat_off", "servo_levels",
+           "set_heat_rtde",
            "urscript_heat", "written_levels"]
 
 #: the smallest change of an analog heat set-point that a program or a run writes, as a
@@ -59,15 +62,37 @@ def heat_levels(traj: Trajectory) -> np.ndarray | None:
 def written_levels(levels: np.ndarray, step: float = HEAT_STEP) -> np.ndarray:
     """The set-points (M,) as a program or a run writes them.
 
-    ``levels[k]`` at each sample where its band of width ``step`` changes (zero is a band
-    of its own: off and on are always written), held until the next: within ``step`` of
-    ``levels`` everywhere."""
+    A value is written at each sample where the band of width ``step`` changes (zero is
+    a band of its own: off and on are always written) and where ``levels`` comes to rest
+    (a held value after a change), and held until the next: the smallest set-point of
+    the samples it holds for.  So the output is within ``step`` of ``levels`` everywhere,
+    never above it (a wire a band hotter than planned where it stands at a corner stop
+    would burn), and equal to it where it holds (a ramp ends on its exact value, e.g.
+    the threshold)."""
     lv = np.asarray(levels, dtype=np.float64)
     if lv.size == 0:
         return lv.copy()
     band = np.where(lv > 0.0, np.floor(lv / step) + 1.0, 0.0)
     change = np.r_[True, band[1:] != band[:-1]]
-    return lv[np.flatnonzero(change)][np.cumsum(change) - 1]
+    change[1:-1] |= (lv[1:-1] != lv[:-2]) & (lv[1:-1] == lv[2:])
+    return np.minimum.reduceat(lv, np.flatnonzero(change))[np.cumsum(change) - 1]
+
+
+def servo_levels(levels: np.ndarray, dt: float, lookahead: float, gain: float,
+                 step: float = HEAT_STEP) -> np.ndarray:  # fmt: skip
+    """The set-points (M,) of a servoj motion's samples, set as the arm reaches them.
+
+    ``levels`` (M,), one per control period ``dt`` [s] commanded, passed through the
+    servo's tracking law (:func:`~ruledrobot.robot.motion.servo.servo_track` with
+    ``lookahead`` [s], ``gain``): the arm trails its command, so a power scheduled for the
+    plan's speed, written on the command's clock, heats the wire for a speed it does not
+    have yet (docs/kerf.md, "The heat on the robot").  Where the response is within a
+    quarter ``step`` of the set-point it tracks, the set-point itself (an exponential
+    tail never reaches a threshold it approaches); off (0) where the set-point is off:
+    the heat switches off on the command's clock, as it does on a digital output."""
+    lv = np.asarray(levels, dtype=np.float64)
+    y = servo_track(lv, dt, servo_time_constant(lookahead, gain))
+    return np.where((np.abs(y - lv) < 0.25 * step) | (lv <= 0.0), lv, y)
 
 
 def urscript_heat(heat: Heat, on: bool, value: float | None = None) -> str:

@@ -52,6 +52,7 @@ from .heat import (
     heat_levels,
     heat_power_from_outputs,
     send_heat_off,
+    servo_levels,
     written_levels,
 )
 from .limits import check_trajectory
@@ -418,7 +419,7 @@ def _move(
         "cog": [float(x) for x in traj.meta.payload.cog],
         "checked_q": state["q"],
         "moved_tolerance": 1e-3,
-        "heat": _heat_message(traj, k0, grid_to_input),
+        "heat": _heat_message(traj, k0, grid_to_input, mode, dt, o),
         "buffer": o["buffer"],
         "stop_time": o["stop_time"],
     }
@@ -536,14 +537,21 @@ def _write_run(path: Path, result: RunResult, measures: RunMeasures, source: Pat
     atomic_write_json(side, doc)
 
 
-def _heat_message(traj: Trajectory, k0: int, grid_to_input: np.ndarray) -> dict | None:
+def _heat_message(traj: Trajectory, k0: int, grid_to_input: np.ndarray, mode: str,
+                  dt: float, o: dict) -> dict | None:  # fmt: skip
     """The heat the child switches: the output and, per grid sample, on or off, and with
-    a scheduled power on an analog output the set-points as written (``levels``)."""
+    a scheduled power on an analog output the set-points as written (``levels``): on a
+    servo motion (streamed, forwarded) as the arm reaches the samples
+    (:func:`~.heat.servo_levels`, grid period ``dt``)."""
     heat = traj.meta.heat
     if heat is None:
         return None
     levels = heat_levels(traj)
-    written = None if levels is None else written_levels(levels[k0 + grid_to_input])
+    if levels is not None:
+        levels = levels[k0 + grid_to_input]
+        if mode != "path":
+            levels = servo_levels(levels, dt, o["lookahead"], o["gain"])
+    written = None if levels is None else written_levels(levels)
     on = heat.on(traj.n)[k0 + grid_to_input] if written is None else written > 0.0
     return {"kind": heat.kind, "index": heat.index, "value": heat.value,
             "preheat": heat.preheat, "hot": on.tolist(),

@@ -5,6 +5,9 @@ they are checked against live beside them in :mod:`.urscript`."""
 
 from __future__ import annotations
 
+#: servoj's lookahead time [s] and gain: the servo's tracking law's home
+from ..robot.motion.servo import SERVO_GAIN, SERVO_LOOKAHEAD
+
 __all__ = [
     "APPROACH_ACCELERATION",
     "APPROACH_SPEED",
@@ -16,10 +19,6 @@ __all__ = [
     "SERVO_LOOKAHEAD",
 ]
 
-#: s: servoj's lookahead time (URScript ``lookahead_time``)
-SERVO_LOOKAHEAD = 0.1
-#: servoj's proportional gain (URScript ``gain``)
-SERVO_GAIN = 300.0
 #: rad/s and rad/s²: the joint move (``movej``) to the first sample
 APPROACH_SPEED = 0.25
 APPROACH_ACCELERATION = 0.5

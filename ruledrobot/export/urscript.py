@@ -59,7 +59,7 @@ from ..robot import model_for
 from ..robot.motion.trajectory import HEATED_PHASES, Trajectory
 from ..robot.wire.cut import WIRE_TOLERANCE
 from .decimate import path_steps
-from .heat import HEAT_STEP, heat_levels, urscript_heat, written_levels
+from .heat import HEAT_STEP, heat_levels, servo_levels, urscript_heat, written_levels
 from .limits import check_trajectory
 from .settings import (
     APPROACH_ACCELERATION,
@@ -297,8 +297,9 @@ def urscript_program(
         dts = np.append(np.diff(t), settle) if t.size > 1 else np.array([settle])
         la, g = _num(lookahead, digits), _num(gain, digits)
         was = False
-        levels = heat_levels(traj)
-        written = None if levels is None else written_levels(levels)
+        levels = heat_levels(traj)  # set as the arm, trailing its servoj, reaches them
+        written = None if levels is None else written_levels(
+            servo_levels(levels, traj.period, lookahead, gain))
         level = 0.0  # the program set the output to 0 first
         for k, (qk, dt) in enumerate(zip(q, dts, strict=True)):
             if written is not None:

@@ -12,7 +12,8 @@ import pytest
 
 from ruledrobot.export import run_trajectory
 from ruledrobot.export.forward.program import REG_SAMPLE, REG_STATE, State
-from ruledrobot.export.heat import HEAT_STEP, written_levels
+from ruledrobot.export.heat import HEAT_STEP, servo_levels, written_levels
+from ruledrobot.export.settings import SERVO_GAIN, SERVO_LOOKAHEAD
 from ruledrobot.io.trajectory import read_trajectory
 from ruledrobot.robot.motion.trajectory import Heat, Phase, Trajectory
 from tests.support.emulators import smooth_trajectory, start_emulator
@@ -53,7 +54,9 @@ def _record(host: str, done: threading.Event, rows: list) -> None:
 
 def test_a_forwarded_run_sets_the_analog_output_with_each_sample(request, tmp_path):
     traj = _ramp_trajectory()
-    want = written_levels(traj.heat_power / FULL_SCALE)  # the set-points as sent
+    # the set-points as sent: as the arm, trailing its servoj, reaches each sample
+    want = written_levels(servo_levels(traj.heat_power / FULL_SCALE, traj.period,
+                                       SERVO_LOOKAHEAD, SERVO_GAIN))
     emu = start_emulator(request.node.nodeid, model="ur5e", unlock_delay=0.0, q0=traj.q[0])
     rows: list = []
     done = threading.Event()

@@ -24,6 +24,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ...robot import RobotModel
+from ...robot.motion.servo import servo_time_constant
 
 __all__ = ["HARDWARE_ACCELERATION", "ArmBackend", "ArmState", "KinematicBackend"]
 
@@ -174,17 +175,15 @@ class KinematicBackend:
     def servo(self, q: ArrayLike, lookahead_time: float, gain: float) -> None:
         """Servo mode (servoJ): approach ``q`` [rad] through a first-order filter.
 
-        Time constant ``lookahead_time * clip(300 / gain, 0.2, 1)`` [s], with ``lookahead_time``
-        clipped to [0, 1] s and a ``gain`` <= 0 taken as 300.  Entering the mode starts the filter
+        Time constant :func:`~ruledrobot.robot.motion.servo.servo_time_constant` [s]
+        (``lookahead_time * clip(300 / gain, 0.2, 1)``).  Entering the mode starts the filter
         at the current setpoint.
         """
         if self._mode != "servo":
             self._ref = self._state.target_q.copy()
             self._mode = "servo"
         self._goal = np.asarray(q, dtype=float)
-        la = min(max(float(lookahead_time), 0.0), 1.0)
-        g = float(gain) if gain > 0 else 300.0
-        self._tau = la * min(max(300.0 / g, 0.2), 1.0)
+        self._tau = servo_time_constant(lookahead_time, gain)
 
     def speed(self, qd: ArrayLike, acceleration: float) -> None:
         """Speed mode (speedJ): ramp the joint speeds to ``qd`` [rad/s] and keep them.

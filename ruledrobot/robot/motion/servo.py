@@ -1,0 +1,65 @@
+"""How an arm under servoj follows its commanded samples: the servo's tracking law, shared
+by the emulator's arm, the runs that set the wire's heat along a servo motion, and the
+planner's corner dwell (docs/kerf.md, "The heat on the robot").
+
+servoj smooths the stream it is given: UR's controller follows with a lag of about
+``lookahead_time`` (a shorter one at a higher ``gain``; /work/shared/research/ur_rtde.md,
+"servoJ lag and jitter").  The project models it as a first-order tracker of time
+constant :func:`servo_time_constant`, stepped once per control period::
+
+    ref_k = ref_{k-1} + a (goal_k - ref_{k-1}),    a = min(1, dt / tau)
+
+the emulator's :class:`~ruledrobot.ursim.arm.backend.KinematicBackend` per joint, and
+:func:`servo_track` for any sampled series (a set-point that must follow the arm, not the
+command).  At a steady speed the arm trails its command by ``tau`` seconds; where the
+command stops, the arm creeps on for several ``tau`` (its residual falls by ``e`` per
+``tau``).  Units: s.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import ArrayLike
+from scipy.signal import lfilter
+
+from .._checks import FloatArray
+
+__all__ = ["SERVO_GAIN", "SERVO_LOOKAHEAD", "SETTLE_TIMES", "servo_settle_time",
+           "servo_time_constant", "servo_track"]
+
+#: s: servoj's lookahead time (URScript ``lookahead_time``), the runs' and programs' default
+SERVO_LOOKAHEAD = 0.1
+#: servoj's proportional gain (URScript ``gain``), the runs' and programs' default
+SERVO_GAIN = 300.0
+#: time constants a stopped command waits for the arm to settle: its residual falls to
+#: ``e^-5`` (0.7 %): 2 mm of lag at 20 mm/s leaves 13 um
+SETTLE_TIMES = 5.0
+
+
+def servo_time_constant(lookahead: float = SERVO_LOOKAHEAD, gain: float = SERVO_GAIN) -> float:
+    """Return the servo's time constant [s]: ``lookahead * clip(300 / gain, 0.2, 1)``.
+
+    ``lookahead`` [s] clipped to [0, 1]; a ``gain`` <= 0 is taken as 300 (module doc)."""
+    la = min(max(float(lookahead), 0.0), 1.0)
+    g = float(gain) if gain > 0 else 300.0
+    return la * min(max(300.0 / g, 0.2), 1.0)
+
+
+def servo_settle_time(lookahead: float = SERVO_LOOKAHEAD, gain: float = SERVO_GAIN) -> float:
+    """Return how long [s] a stopped command waits for the arm to settle.
+
+    :data:`SETTLE_TIMES` time constants (:func:`servo_time_constant`)."""
+    return SETTLE_TIMES * servo_time_constant(lookahead, gain)
+
+
+def servo_track(x: ArrayLike, dt: float, tau: float) -> FloatArray:
+    """Return the servo's response (N, ...) to commands ``x`` (N, ...), one per period ``dt``.
+
+    The tracker's state after each period (module doc), starting at rest on ``x[0]``:
+    the arm's position at the end of the period that commanded ``x[k]``.  ``dt``, ``tau``
+    [s]; ``tau <= dt`` follows at once."""
+    v = np.asarray(x, dtype=np.float64)
+    if v.shape[0] == 0 or tau <= dt:
+        return v.copy()
+    a = dt / tau
+    return lfilter([a], [1.0, a - 1.0], v - v[0], axis=0) + v[0]
