@@ -86,3 +86,32 @@ def test_a_wire_at_a_thin_trailing_edge_is_judged_on_its_own_face():
     stock = Box(np.array([0.05, 0.0, 0.0]), np.array([0.2, 0.15, 0.1]))  # chord ends on sample rows
     e = face_error(wire_in_stock(np.arange(50) * 0.01, ends, stock), None, None, target)
     assert e.worst < 1e-9
+
+
+@pytest.mark.parametrize(("excess", "burns"), [(0.01, False), (20.0, True)])
+def test_a_standing_wire_burns_only_when_its_melt_moves_the_face_past_the_tolerance(
+    excess, burns
+):
+    from ruledrobot.robot.wire.kerf import Material
+
+    # plane z = 0, waste above, rulings along y; the wire cuts at 10 mm/s, then stands
+    # with the power at the threshold plus ``excess`` W/m
+    mat = Material(kerf_base=0.0003, kerf_gain=1e-7, power_threshold=10.0)
+    x = np.concatenate([np.linspace(0.0, 0.01, 101), np.full(50, 0.01)])
+    t = np.arange(x.size) * 0.01
+    v = np.gradient(x, t)  # the power holds the kerf while the wire moves (constant_kerf)
+    power = np.where(v > 0.0, mat.power_for_kerf(KERF, v), 10.0 + excess)
+    ends = np.stack([np.stack([x, -0.2 + 0 * x, 0.5 * KERF + 0 * x], 1),
+                     np.stack([x, 0.2 + 0 * x, 0.5 * KERF + 0 * x], 1)], 1)  # fmt: skip
+    xs = np.linspace(-0.01, 0.03, 401)
+    o = np.stack([xs, -0.15 + 0 * xs, 0 * xs], 1)
+    target = FaceTarget("plane", o, np.tile([0.0, 1.0, 0.0], (xs.size, 1)),
+                        np.tile([0.0, 0.0, 1.0], (xs.size, 1)), np.zeros((xs.size, 3)),
+                        np.tile([0.0, 0.3], (xs.size, 1)), ranges=((0, x.size),),
+                        kerf=KERF)  # fmt: skip
+    stock = Box(np.array([0.0, 0.0, 0.0]), np.array([0.1, 0.2, 0.1]))
+    e = face_error(wire_in_stock(t, ends, stock), power, mat, target)
+    standing = e.error[102:]  # sample 101 on: still (the stop itself is a step in speed)
+    assert bool(np.isinf(standing).any()) == burns == e.burn
+    if not burns:  # 0.01 W/m at 1 mm/s melts 1 um more: a hair, not a hole
+        assert standing.max() < 2e-6

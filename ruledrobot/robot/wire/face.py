@@ -24,8 +24,9 @@ with ``v`` the end's speed across the wire (:func:`.in_stock.across_speeds` in t
 and ``p`` the wire's power (:func:`.kerf.wire_power` of the set-points).  A wire that
 melts nothing new (power at or below the threshold) stands in the channel it melted
 before: the kerf of the last sample that melted carries on; so does a wire that stands
-(slower than :data:`STILL`) -- unless at that speed it melts wider than the channel: a
-hot wire that stops is a burn, ``e = inf``.
+(slower than :data:`STILL`) -- unless at that speed it melts wider than the channel:
+the wider kerf when that moves the face by at most the tolerance, else a burn (a hot
+wire that stops), ``e = inf``.
 
 Everyone who holds a motion and its heat calls :func:`face_error` with the
 :class:`FaceTarget` of the trajectory's sidecar: the plan, an export's verification,
@@ -193,18 +194,22 @@ def _carried(w: FloatArray, moves: np.ndarray) -> FloatArray:
     return out
 
 
-def _kerf(v: FloatArray, p: FloatArray, material: Material) -> FloatArray:
-    """The kerf (R, 2) [m] at the chord ends' speeds ``v`` (R, 2) and the wire's power
-    ``p`` (R,) (module doc): where the wire moves and melts, the model; where it melts
-    nothing new or stands still, the channel it melted last -- unless, standing, it melts
-    wider than that at :data:`STILL`: a burn (inf)."""
+def _kerf(v: FloatArray, p: FloatArray, material: Material, tolerance: float) -> FloatArray:
+    """Return the kerf (R, 2) [m] at the chord ends' speeds ``v`` (R, 2) and power ``p`` (R,).
+
+    Module doc: where the wire moves and melts, the model; where it melts nothing new
+    or stands still, the channel it melted last -- unless, standing, it melts wider than
+    that at :data:`STILL`: the wider kerf when the face moves by at most ``tolerance``
+    [m] for it (a set-point a hair above the threshold while the arm settles), else a
+    burn (inf)."""
     melts = (p > material.power_threshold + MELT_SLACK)[:, None]
     still = v < STILL
     w = material.kerf(np.where(still, STILL, v), p[:, None])
     channel = _carried(w, melts & ~still)
     channel = np.where(np.isnan(channel), material.kerf_base, channel)
-    burn = melts & still & (w > channel * (1.0 + 1e-9))
-    return np.where(burn, np.inf, np.where(melts & ~still, w, channel))
+    wider = melts & still & (w > channel)
+    burn = wider & (0.5 * (w - channel) > tolerance)
+    return np.where(burn, np.inf, np.where((melts & ~still) | wider, w, channel))
 
 
 def face_error(
@@ -229,7 +234,7 @@ def face_error(
     else:
         p = np.asarray(power, dtype=np.float64)[rows]
         v = across_speeds(wis.t, wis.ends, wis.fractions())[rows]  # (R, 2)
-        w = _kerf(v, p, material)
+        w = _kerf(v, p, material, face.tolerance)
     pts = face.samples().reshape(-1, 3)
     near = min(NEAREST, len(pts))
     _, idx = cKDTree(pts).query(np.array(x.reshape(-1, 3)), k=near)  # writable copy
