@@ -12,6 +12,7 @@ and every later loop needs the piece clamped again (a setup of its own).
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -77,10 +78,30 @@ def _unfitted(fit: Fit) -> str:
     return f"not a ruled quadric within tolerance ({fit.residual * 1e3:.3g} mm)"
 
 
+def _robot_accepts(check: Callable[[CarveCut], str] | None, centre: FloatArray,
+                   notes: list[str]) -> Callable[[Loop], bool] | None:
+    """Whether the robot can cut a roughing loop (``check`` on its cut); a refusal noted."""
+    if check is None:
+        return None
+
+    def accept(loop: Loop) -> bool:
+        why = check(CarveCut("rough", "rough", loop_lines(loop, centre), True, "inside",
+                             loop.describe()))  # fmt: skip
+        if why:
+            notes.append(f"roughing loop {loop.describe()}: not chosen, the arm cannot cut it "
+                         f"where the block stands ({why})")  # fmt: skip
+        return not why
+
+    return accept
+
+
 def find_cuts(part: PartMesh, stock: Box, query: MeshQuery, tolerance: float,
-              rough_cuts: int, lead: float = 0.02,
-              progress=lambda msg: None) -> CutPlan:  # fmt: skip
-    """The cuts of a part in a block (module doc)."""
+              rough_cuts: int, lead: float = 0.02, progress=lambda msg: None,
+              check: Callable[[CarveCut], str] | None = None) -> CutPlan:  # fmt: skip
+    """The cuts of a part in a block (module doc).  ``check(cut)``: why the robot cannot
+    make a cut where the block stands ("" when it can; :class:`.robotcheck.RobotCheck`):
+    an exact cut it refuses leaves its face to the roughing loops, a loop it refuses is
+    not chosen, and both are named in the notes."""
     regions = segment(part)
     prefer = prefer_direction(stock)
     faces: dict[int, str] = {}
@@ -107,6 +128,14 @@ def find_cuts(part: PartMesh, stock: Box, query: MeshQuery, tolerance: float,
             faces[r.index] = why
             notes.append(why)
             continue
+        why = check(got) if check is not None else ""
+        if why:
+            why = (f"region {r.index}: the arm cannot make its cut where the block stands "
+                   f"({why}): roughed instead; `ruledrobot place` searches for a placement "
+                   "or turn of the block where it can")  # fmt: skip
+            faces[r.index] = why
+            notes.append(why)
+            continue
         faces[r.index] = "exact"
         exact.append((got, m))
     rough_needed = any(v not in ("exact", "block face") for v in faces.values())
@@ -119,14 +148,15 @@ def find_cuts(part: PartMesh, stock: Box, query: MeshQuery, tolerance: float,
 
         hull = part.vertices[ConvexHull(part.vertices).vertices]
         standoff = 0.5 * tolerance
+        centre = part.vertices.mean(axis=0)
         progress(f"choosing {rough_cuts} roughing loops")
         loops, k1 = choose_loops(hull, stock, rough_cuts, standoff, seams=SEAMS,
-                                 radial=radial_direction(stock))
+                                 radial=radial_direction(stock),
+                                 accept=_robot_accepts(check, centre, notes))  # fmt: skip
         progress("choosing the baseline's directions")
         base, k2 = choose_loops(hull, stock, rough_cuts, standoff, seams=False)
         kept = k1[-1] if k1 else kept
         base_kept = k2[-1] if k2 else base_kept
-        centre = part.vertices.mean(axis=0)
         for k, loop in enumerate(loops):
             cut = CarveCut(f"rough{k + 1}", "rough", loop_lines(loop, centre), True, "inside",
                            loop.describe())  # fmt: skip
