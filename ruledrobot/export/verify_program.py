@@ -15,7 +15,8 @@ block (:meth:`WireCut.measure <ruledrobot.robot.wire.cut.WireCut.measure>`,
   windows (sample ranges) are carried over to the program's samples through the
   matching below;
 * **wire deviation**: each program sample is matched to the plan sample whose wire is
-  nearest (both wire ends, within :data:`MATCH_WINDOW` s of the same time); the
+  nearest (both wire ends, within :data:`MATCH_WINDOW` s of the same time on the plan's
+  clock: the program's time carried by the drift measured so far, ``_match``); the
   deviation is the largest distance of the program's chord ends (the wire's part in the
   block) from the matched plan sample's wire line, over the samples with the wire in
   the stock, against ``wire_tolerance``.  Its resolution is half the plan's step along
