@@ -19,6 +19,7 @@ import numpy as np
 
 from ..geometry.box import Box
 from ..geometry.checks import FloatArray
+from .carved import cut_away
 from .exact import block_face, exact_cut
 from .measure import measure_cut
 from .meshquery import MeshQuery
@@ -150,11 +151,20 @@ def find_cuts(part: PartMesh, stock: Box, query: MeshQuery, tolerance: float,
         standoff = 0.5 * tolerance
         centre = part.vertices.mean(axis=0)
         progress(f"choosing {rough_cuts} roughing loops")
+        made = tuple(c for c, _ in exact)
+
+        def gone(points: FloatArray, shape: tuple[int, int, int]) -> np.ndarray:
+            return cut_away(made, stock, points, shape)
+
         loops, k1 = choose_loops(hull, stock, rough_cuts, standoff, seams=SEAMS,
                                  radial=radial_direction(stock),
-                                 accept=_robot_accepts(check, centre, notes))  # fmt: skip
+                                 accept=_robot_accepts(check, centre, notes),
+                                 gone=gone)  # fmt: skip
+        if not loops:
+            notes.append("no roughing loop: the exact cuts leave nothing outside the part's "
+                         "convex hull that a loop could take, or the robot can make none")
         progress("choosing the baseline's directions")
-        base, k2 = choose_loops(hull, stock, rough_cuts, standoff, seams=False)
+        base, k2 = choose_loops(hull, stock, rough_cuts, standoff, seams=False, gone=gone)
         kept = k1[-1] if k1 else kept
         base_kept = k2[-1] if k2 else base_kept
         for k, loop in enumerate(loops):

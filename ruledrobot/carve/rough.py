@@ -214,31 +214,38 @@ def _candidates(hull: FloatArray, standoff: float, axes: FloatArray, seams: bool
     return out
 
 
-def _voxels(stock: Box, count: int) -> tuple[FloatArray, float]:
+def _voxels(stock: Box, count: int) -> tuple[FloatArray, float, tuple[int, int, int]]:
+    """The centres (N, 3) [m, base frame] of about ``count`` voxels of the block, their
+    step [m] and the grid's shape."""
     h = float((np.prod(stock.size) / count) ** (1 / 3))
     axes = [np.arange(0.5 * h, s, h) - 0.5 * s for s in stock.size]
     X, Y, Z = np.meshgrid(*axes, indexing="ij")
     local = np.stack([X, Y, Z], axis=-1).reshape(-1, 3)
-    return local @ stock.rotation.T + stock.centre, h
+    return local @ stock.rotation.T + stock.centre, h, X.shape
 
 
 def choose_loops(hull: FloatArray, stock: Box, count: int, standoff: float,
                  seams: bool = True, axes: FloatArray | None = None,
                  radial: FloatArray | None = None, max_tilt: float = MAX_TILT,
                  accept: Callable[[Loop], bool] | None = None,
+                 gone: Callable[[FloatArray, tuple[int, int, int]], np.ndarray] | None = None,
                  ) -> tuple[list[Loop], list[float]]:  # fmt: skip
     """``count`` loops about the part's hull vertices ``hull`` (H, 3) [m], chosen greedily
     (module doc); with ``seams=False`` great circles only (the baseline).  Also the
     block's kept volume [m^3] on the voxel grid after each loop.  ``accept(loop)``: whether
     the robot can cut a loop (asked of the best loop of a round, then of the next best
-    while it says no; each loop asked once): a loop it refuses is never chosen."""
+    while it says no; each loop asked once): a loop it refuses is never chosen.
+    ``gone(points, shape)``: which voxels of the grid (N, 3), ``shape``, the exact cuts
+    take away already (they count for no loop: a part whose exact cuts leave nothing
+    outside its hull gets no loop)."""
     from scipy.spatial import ConvexHull
 
     axes = fibonacci_axes(24) if axes is None else axes
-    pts, h = _voxels(stock, VOXELS)
+    pts, h, shape = _voxels(stock, VOXELS)
     eq = ConvexHull(hull).equations
     in_hull = np.all(pts @ eq[:, :3].T + eq[:, 3] <= 0.0, axis=1)
-    alive = (pts[~in_hull] - stock.centre).astype(np.float32)
+    left = ~in_hull if gone is None else ~in_hull & ~gone(pts, shape)
+    alive = (pts[left] - stock.centre).astype(np.float32)
     cands = _candidates(hull, standoff, axes, seams, radial, max_tilt)
     planes = [(c.normals.T.astype(np.float32), (c.support - c.normals @ stock.centre)
                .astype(np.float32)) for c in cands]  # fmt: skip
