@@ -29,7 +29,10 @@ from .readers import PartMesh
 from .rough import SEAMS, Loop, choose_loops, loop_lines
 from .segment import Region, segment
 
-__all__ = ["CutPlan", "find_cuts", "prefer_direction"]
+__all__ = ["MAX_REFUSED", "CutPlan", "find_cuts", "prefer_direction"]
+
+#: roughing loops the robot may refuse in one carve before no further loop is asked
+MAX_REFUSED = 4
 
 
 @dataclass(frozen=True)
@@ -81,16 +84,23 @@ def _unfitted(fit: Fit) -> str:
 
 def _robot_accepts(check: Callable[[CarveCut], str] | None, centre: FloatArray,
                    notes: list[str]) -> Callable[[Loop], bool] | None:
-    """Whether the robot can cut a roughing loop (``check`` on its cut); a refusal noted."""
+    """Whether the robot can cut a roughing loop (``check`` on its cut); a refusal noted.
+    After :data:`MAX_REFUSED` refusals no loop is asked (nor chosen)."""
     if check is None:
         return None
+    refused: list[str] = []
 
     def accept(loop: Loop) -> bool:
+        if len(refused) >= MAX_REFUSED:
+            return False
         why = check(CarveCut("rough", "rough", loop_lines(loop, centre), True, "inside",
                              loop.describe()))  # fmt: skip
         if why:
+            refused.append(why)
             notes.append(f"roughing loop {loop.describe()}: not chosen, the arm cannot cut it "
-                         f"where the block stands ({why})")  # fmt: skip
+                         f"where the block stands ({why})"
+                         + (f"; {MAX_REFUSED} loops refused, no further loop is tried"
+                            if len(refused) == MAX_REFUSED else ""))  # fmt: skip
         return not why
 
     return accept

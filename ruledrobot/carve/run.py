@@ -82,6 +82,13 @@ def _checks(plan: CutPlan, carved, part_volume: float, closed_ok: bool, tol: flo
     ]  # fmt: skip
     if not exact:
         out.pop(1)
+    left = [v for v in plan.faces.values() if v not in ("exact", "block face")]
+    if not plan.cuts and left:
+        why = [n for n in plan.notes if "the arm cannot" in n]
+        out.insert(0, {"name": "cuts", "ok": False, "what": "the robot can make a cut of the part",
+                       "detail": "no cut: " + ("; ".join(why) if why else left[0])
+                       + ("; `ruledrobot place` searches for a placement or turn of the block "
+                          "where the arm can" if why else "")})  # fmt: skip
     return out
 
 
