@@ -266,9 +266,10 @@ def _model(cuts: tuple[CarveCut, ...], stock: Box) -> tuple[_Job, tuple[SurfaceP
 
 def cut_away(cuts: tuple[CarveCut, ...], stock: Box, world: FloatArray,
              shape: tuple[int, int, int]) -> np.ndarray:  # fmt: skip
-    """(N,) whether the exact ``cuts`` take away each point of the regular grid ``world``
-    (N, 3) [m, base frame] of ``shape``: the planner's part model (``part_sdf``) positive
-    there (what the roughing loops need not take)."""
+    """Which points of a grid the exact cuts take away (what no roughing loop need take).
+
+    ``world`` (N, 3) [m, base frame]: a regular grid of ``shape``; returns (N,) bool, the
+    planner's part model (``part_sdf``) of ``cuts`` positive there."""
     from ..wirecut import part_sdf
 
     if not cuts:

@@ -109,10 +109,11 @@ def _robot_accepts(check: Callable[[CarveCut], str] | None, centre: FloatArray,
 def find_cuts(part: PartMesh, stock: Box, query: MeshQuery, tolerance: float,
               rough_cuts: int, lead: float = 0.02, progress=lambda msg: None,
               check: Callable[[CarveCut], str] | None = None) -> CutPlan:  # fmt: skip
-    """The cuts of a part in a block (module doc).  ``check(cut)``: why the robot cannot
-    make a cut where the block stands ("" when it can; :class:`.robotcheck.RobotCheck`):
-    an exact cut it refuses leaves its face to the roughing loops, a loop it refuses is
-    not chosen, and both are named in the notes."""
+    """The cuts of a part in a block (module doc).
+
+    ``check(cut)``: why the robot cannot make a cut where the block stands ("" when it
+    can; :class:`.robotcheck.RobotCheck`): an exact cut it refuses leaves its face to the
+    roughing loops, a loop it refuses is not chosen, and both are named in the notes."""
     regions = segment(part)
     prefer = prefer_direction(stock)
     faces: dict[int, str] = {}

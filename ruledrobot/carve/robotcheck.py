@@ -30,7 +30,9 @@ MAX_CHECKS = 24
 
 
 class RobotCheck:
-    """``check(cut)``: "" when the planner's wire-pose search finds a motion for every pass
+    """The planner's wire-pose search on one cut at a time, in the cell of ``tables``.
+
+    ``check(cut)``: "" when the planner's wire-pose search finds a motion for every pass
     of ``cut`` in the cell of ``tables`` (the cell file's job tables), else why (module
     doc).  ``calls``: the cuts checked; ``seconds``: their time; ``unchecked``: the cuts let
     through unchecked once :data:`MAX_CHECKS` were checked."""

@@ -125,14 +125,16 @@ def _corners(n: FloatArray, h: FloatArray) -> FloatArray:
 
 def silhouette(axis: FloatArray, hull: FloatArray, standoff: float,
                min_edge: float = MIN_EDGE) -> Loop:  # fmt: skip
-    """The great-circle loop along ``axis`` on the part's own silhouette: its planes the
-    edges of the convex polygon of the hull vertices ``hull`` (H, 3) seen along the axis,
-    each moved out by ``standoff`` [m], so that the loop's corners are the polygon's
-    (mitred), not clusters of rulings on a tiny arc round each vertex (a sampled circle of
-    normals puts many of them within ``standoff`` of a vertex and none along a long edge:
-    the planner's refinement of so uneven a loop wiggles, and the arm cannot hold the feed
-    through it).  Edges shorter than ``min_edge`` go (the lines beside them extended where
-    they turn by less than 120 degrees together): the polygon only grows."""
+    """The great-circle loop along ``axis`` on the part's own silhouette.
+
+    Its planes are the edges of the convex polygon of the hull vertices ``hull`` (H, 3)
+    seen along the axis, each moved out by ``standoff`` [m], so that the loop's corners
+    are the polygon's (mitred), not clusters of rulings on a tiny arc round each vertex
+    (a sampled circle of normals puts many of them within ``standoff`` of a vertex and
+    none along a long edge: the planner's refinement of so uneven a loop wiggles, and the
+    arm cannot hold the feed through it).  Edges shorter than ``min_edge`` go (the lines
+    beside them extended where they turn by less than 120 degrees together): the polygon
+    only grows."""
     from scipy.spatial import ConvexHull
 
     a, e1, e2 = _across(np.asarray(axis, dtype=float))

@@ -38,8 +38,10 @@ Mesh = tuple[FloatArray, FloatArray]
 
 
 def weld(tris: FloatArray) -> Mesh:
-    """A triangle soup (T, 3, 3) as shared vertices and faces turned away from the origin
-    (the part must be star-shaped about it); degenerate triangles dropped."""
+    """A triangle soup (T, 3, 3) as shared vertices and faces, turned outwards.
+
+    Faces are turned away from the origin (the part must be star-shaped about it);
+    degenerate triangles are dropped."""
     n = np.cross(tris[:, 1] - tris[:, 0], tris[:, 2] - tris[:, 0])
     flip = np.einsum("ij,ij->i", n, tris.mean(axis=1)) < 0
     tris = np.where(flip[:, None, None], tris[:, ::-1], tris)
@@ -50,7 +52,8 @@ def weld(tris: FloatArray) -> Mesh:
 
 
 def grid_triangles(P: FloatArray, closed_u: bool = False) -> FloatArray:
-    """Triangles (T, 3, 3) of a grid of points ``P`` (nu, nv, 3), each quad split in two;
+    """Triangles (T, 3, 3) of a grid of points ``P`` (nu, nv, 3), each quad split in two.
+
     ``closed_u``: the last row joins the first."""
     if closed_u:
         P = np.concatenate([P, P[:1]], axis=0)
@@ -71,8 +74,10 @@ def _caps(P: FloatArray) -> list[FloatArray]:
 
 def twisted_column(half: float = 0.05, height: float = 0.12, twist: float = 0.5,
                    n: int = 8) -> Mesh:  # fmt: skip
-    """The twisted square column (module doc): bottom square of half-width ``half`` at
-    ``z = -height / 2``, the top one turned by ``twist`` [rad]; each side ``n`` x ``n``."""
+    """The twisted square column (module doc).
+
+    Bottom square of half-width ``half`` at ``z = -height / 2``, the top one turned by
+    ``twist`` [rad]; each side ``n`` x ``n``."""
     ang = np.pi / 4 + np.arange(4) * np.pi / 2
     r = half * np.sqrt(2.0)
     bot = np.stack([r * np.cos(ang), r * np.sin(ang), np.full(4, -height / 2)], 1)
@@ -103,9 +108,11 @@ def cooling_tower(a: float = 0.05, c: float = 0.08, h: float = 0.06, nu: int = 6
 
 def fairing(half: float = 0.08, a0: float = 0.08, b0: float = 0.05, nu: int = 64,
             ny: int = 24) -> Mesh:  # fmt: skip
-    """The lofted fairing: ellipses ``x = a(y) cos u``, ``z = b(y) sin u`` for
-    ``|y| <= half`` with ``a = a0 (1 - 0.4 t^2)``, ``b = b0 (1 - 0.5 t^2)``, ``t = y / half``
-    (not ruled: no line lies on it), capped."""
+    """The lofted fairing (not ruled), capped.
+
+    Ellipses ``x = a(y) cos u``, ``z = b(y) sin u`` for ``|y| <= half`` with
+    ``a = a0 (1 - 0.4 t^2)``, ``b = b0 (1 - 0.5 t^2)``, ``t = y / half`` (no line lies
+    on it)."""
     u = np.linspace(0, 2 * np.pi, nu, endpoint=False)
     y = np.linspace(-half, half, ny)
     t = y / half
@@ -132,14 +139,18 @@ def _saddle_solid(size, z0: float, c: float, n: int, up: bool) -> Mesh:
 
 
 def saddle_top(size=(0.16, 0.16, 0.12), z0: float = 0.03, c: float = 0.4, n: int = 17) -> Mesh:
-    """The block ``|x|, |y| <= size / 2`` from ``z = -size_z / 2`` up to the saddle
-    ``z = z0 + x y / c``: six faces, none a face of the demo block."""
+    """A block with a saddle top: six faces, none a face of the demo block.
+
+    The block ``|x|, |y| <= size / 2`` from ``z = -size_z / 2`` up to the saddle
+    ``z = z0 + x y / c``."""
     return _saddle_solid(size, z0, c, n, up=False)
 
 
 def channel_block(size=(0.18, 0.18, 0.12), width: float = 0.08, z0: float = 0.02,
                   c: float = 0.4, hole: float = 0.03, n: int = 17) -> Mesh:  # fmt: skip
-    """The block of ``size`` less a channel along x of ``width`` whose floor is the saddle
+    """A block with a saddle channel and a round hole (manifold3d booleans).
+
+    The block of ``size`` less a channel along x of ``width`` whose floor is the saddle
     ``z = z0 + x y / c``, less a hole of diameter ``hole`` along y through its lower half
     (manifold3d booleans)."""
     import manifold3d as m3d
@@ -158,8 +169,10 @@ def channel_block(size=(0.18, 0.18, 0.12), width: float = 0.08, z0: float = 0.02
 
 
 def box(size=(0.12, 0.1, 0.08), n: int = 1) -> Mesh:
-    """The box ``|x_k| <= size_k / 2``, each face an ``n`` x ``n`` grid of squares split in
-    two: ``12 n^2`` triangles (n = 1: the 12 of a CAD export, n = 4: 192)."""
+    """The box ``|x_k| <= size_k / 2`` of ``12 n^2`` triangles.
+
+    Each face an ``n`` x ``n`` grid of squares split in two (n = 1: the 12 of a CAD
+    export, n = 4: 192)."""
     h = 0.5 * np.asarray(size, dtype=float)
     faces = []
     for axis in range(3):
@@ -187,9 +200,10 @@ PARTS: dict[str, tuple[str, Callable[[], Mesh]]] = {
 
 def write_part_cell(folder: str | Path, name: str, rough_cuts: int = 4,
                     extra: str = "") -> Path:  # fmt: skip
-    """Write part ``name`` of :data:`PARTS` as ``NAME.stl`` (mm) and ``cell.toml`` (the demo
-    cell, the part's centre at the block's) into ``folder``; the cell file.  ``extra``:
-    text appended to the cell (more tables or keys)."""
+    """Write part ``name`` of :data:`PARTS` and its cell file into ``folder``; the cell file.
+
+    ``NAME.stl`` in mm and ``cell.toml``: the demo cell, the part's centre at the block's.
+    ``extra``: text appended to the cell (more tables or keys)."""
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
     what, build = PARTS[name]

@@ -25,8 +25,9 @@ __all__ = ["cut_reasons"]
 
 def cut_reasons(job: Job, model: RobotModel | None = None,
                 names: tuple[str, ...] | None = None) -> dict[str, str]:  # fmt: skip
-    """Per cut of ``job`` (or of those ``names``), why the planner's wire-pose search
-    finds no motion for one of its passes ("" when it finds one for every pass); a
+    """Why the planner's wire-pose search finds no motion for each cut of ``job``.
+
+    Per cut (or those ``names``): "" when it finds one for every pass of the cut; a
     cut the planner refuses outright (a ValueError: no ruling near the block, a
     surface short of it) gives the refusal's words."""
     model = job.robot_model() if model is None else model
