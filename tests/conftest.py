@@ -32,6 +32,7 @@ SLOW_MODULES: frozenset[str] = frozenset({
     "tests/carve/test_cad_meshes.py", "tests/carve/test_carved_exact.py",
     "tests/carve/test_demo_carve.py", "tests/carve/test_developables.py",
     "tests/carve/test_exact.py", "tests/carve/test_rough_and_input.py",
+    "tests/carve/test_samples_made.py",
     "tests/carve/test_tessellation.py", "tests/cli/test_cli.py", "tests/formats/test_cad.py",
     "tests/gallery/test_gallery.py", "tests/make/test_make_column.py",
     "tests/make/test_make_input.py", "tests/make/test_make_parts.py",

@@ -240,19 +240,41 @@ def grid_carved_mesh(cuts: tuple[CarveCut, ...], stock: Box, loops: tuple[Loop, 
     """The block kept by the exact ``cuts`` and the roughing ``loops`` meshed on the grid
     of ``resolution`` [m] (module doc, "The grid") [m, base frame]; None when nothing is
     kept."""
-    from ..subdivision import subdivide
     from ..wirecut import part_sdf, stock_mesh
 
-    passes = []
-    for c in cuts:
-        fine = subdivide(c.lines, scheme="four_point", steps=STEPS, closed=c.closed)
-        passes.append(SurfacePass(c.name, ruling_frames(fine, stock.centre), c.closed))
-    job = _Job(tuple(_Cut(c.name, c.keep) for c in cuts), stock)
+    job, passes = _model(cuts, stock)
 
     def sdf(world: FloatArray, shape: tuple[int, ...], h: float) -> FloatArray:
-        f = part_sdf(job, tuple(passes), world, shape, 3.0 * h)  # type: ignore[arg-type]
+        f = part_sdf(job, passes, world, shape, 3.0 * h)  # type: ignore[arg-type]
         for loop in loops:
             f = np.maximum(f, (world @ loop.normals.T - loop.support).max(axis=1).reshape(shape))
         return f
 
     return stock_mesh(stock, resolution, sdf)
+
+
+def _model(cuts: tuple[CarveCut, ...], stock: Box) -> tuple[_Job, tuple[SurfacePass, ...]]:
+    """The cuts as the planner's part model reads them (refined rulings, keep sides)."""
+    from ..subdivision import subdivide
+
+    passes = []
+    for c in cuts:
+        fine = subdivide(c.lines, scheme="four_point", steps=STEPS, closed=c.closed)
+        passes.append(SurfacePass(c.name, ruling_frames(fine, stock.centre), c.closed))
+    return _Job(tuple(_Cut(c.name, c.keep) for c in cuts), stock), tuple(passes)
+
+
+def cut_away(cuts: tuple[CarveCut, ...], stock: Box, world: FloatArray,
+             shape: tuple[int, int, int]) -> np.ndarray:  # fmt: skip
+    """Which points of a grid the exact cuts take away (what no roughing loop need take).
+
+    ``world`` (N, 3) [m, base frame]: a regular grid of ``shape``; returns (N,) bool, the
+    planner's part model (``part_sdf``) of ``cuts`` positive there."""
+    from ..wirecut import part_sdf
+
+    if not cuts:
+        return np.zeros(len(world), bool)
+    job, passes = _model(cuts, stock)
+    step = max(float(np.linalg.norm(world[1] - world[0])), 1e-6)
+    f = part_sdf(job, passes, world, shape, 3.0 * step)  # type: ignore[arg-type]
+    return np.asarray(f).reshape(-1) > 0.0

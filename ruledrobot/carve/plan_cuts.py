@@ -12,12 +12,14 @@ and every later loop needs the piece clamped again (a setup of its own).
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..geometry.box import Box
 from ..geometry.checks import FloatArray
+from .carved import cut_away
 from .exact import block_face, exact_cut
 from .measure import measure_cut
 from .meshquery import MeshQuery
@@ -27,7 +29,10 @@ from .readers import PartMesh
 from .rough import SEAMS, Loop, choose_loops, loop_lines
 from .segment import Region, segment
 
-__all__ = ["CutPlan", "find_cuts", "prefer_direction"]
+__all__ = ["MAX_REFUSED", "CutPlan", "find_cuts", "prefer_direction"]
+
+#: roughing loops the robot may refuse in one carve before no further loop is asked
+MAX_REFUSED = 4
 
 
 @dataclass(frozen=True)
@@ -77,10 +82,38 @@ def _unfitted(fit: Fit) -> str:
     return f"not a ruled quadric within tolerance ({fit.residual * 1e3:.3g} mm)"
 
 
+def _robot_accepts(check: Callable[[CarveCut], str] | None, centre: FloatArray,
+                   notes: list[str]) -> Callable[[Loop], bool] | None:
+    """Whether the robot can cut a roughing loop (``check`` on its cut); a refusal noted.
+    After :data:`MAX_REFUSED` refusals no loop is asked (nor chosen)."""
+    if check is None:
+        return None
+    refused: list[str] = []
+
+    def accept(loop: Loop) -> bool:
+        if len(refused) >= MAX_REFUSED:
+            return False
+        why = check(CarveCut("rough", "rough", loop_lines(loop, centre), True, "inside",
+                             loop.describe()))  # fmt: skip
+        if why:
+            refused.append(why)
+            notes.append(f"roughing loop {loop.describe()}: not chosen, the arm cannot cut it "
+                         f"where the block stands ({why})"
+                         + (f"; {MAX_REFUSED} loops refused, no further loop is tried"
+                            if len(refused) == MAX_REFUSED else ""))  # fmt: skip
+        return not why
+
+    return accept
+
+
 def find_cuts(part: PartMesh, stock: Box, query: MeshQuery, tolerance: float,
-              rough_cuts: int, lead: float = 0.02,
-              progress=lambda msg: None) -> CutPlan:  # fmt: skip
-    """The cuts of a part in a block (module doc)."""
+              rough_cuts: int, lead: float = 0.02, progress=lambda msg: None,
+              check: Callable[[CarveCut], str] | None = None) -> CutPlan:  # fmt: skip
+    """The cuts of a part in a block (module doc).
+
+    ``check(cut)``: why the robot cannot make a cut where the block stands ("" when it
+    can; :class:`.robotcheck.RobotCheck`): an exact cut it refuses leaves its face to the
+    roughing loops, a loop it refuses is not chosen, and both are named in the notes."""
     regions = segment(part)
     prefer = prefer_direction(stock)
     faces: dict[int, str] = {}
@@ -107,6 +140,14 @@ def find_cuts(part: PartMesh, stock: Box, query: MeshQuery, tolerance: float,
             faces[r.index] = why
             notes.append(why)
             continue
+        why = check(got) if check is not None else ""
+        if why:
+            why = (f"region {r.index}: the arm cannot make its cut where the block stands "
+                   f"({why}): roughed instead; `ruledrobot place` searches for a placement "
+                   "or turn of the block where it can")  # fmt: skip
+            faces[r.index] = why
+            notes.append(why)
+            continue
         faces[r.index] = "exact"
         exact.append((got, m))
     rough_needed = any(v not in ("exact", "block face") for v in faces.values())
@@ -119,14 +160,24 @@ def find_cuts(part: PartMesh, stock: Box, query: MeshQuery, tolerance: float,
 
         hull = part.vertices[ConvexHull(part.vertices).vertices]
         standoff = 0.5 * tolerance
+        centre = part.vertices.mean(axis=0)
         progress(f"choosing {rough_cuts} roughing loops")
+        made = tuple(c for c, _ in exact)
+
+        def gone(points: FloatArray, shape: tuple[int, int, int]) -> np.ndarray:
+            return cut_away(made, stock, points, shape)
+
         loops, k1 = choose_loops(hull, stock, rough_cuts, standoff, seams=SEAMS,
-                                 radial=radial_direction(stock))
+                                 radial=radial_direction(stock),
+                                 accept=_robot_accepts(check, centre, notes),
+                                 gone=gone)  # fmt: skip
+        if not loops:
+            notes.append("no roughing loop: the exact cuts leave nothing outside the part's "
+                         "convex hull that a loop could take, or the robot can make none")
         progress("choosing the baseline's directions")
-        base, k2 = choose_loops(hull, stock, rough_cuts, standoff, seams=False)
+        base, k2 = choose_loops(hull, stock, rough_cuts, standoff, seams=False, gone=gone)
         kept = k1[-1] if k1 else kept
         base_kept = k2[-1] if k2 else base_kept
-        centre = part.vertices.mean(axis=0)
         for k, loop in enumerate(loops):
             cut = CarveCut(f"rough{k + 1}", "rough", loop_lines(loop, centre), True, "inside",
                            loop.describe())  # fmt: skip

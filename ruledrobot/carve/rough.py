@@ -25,6 +25,7 @@ among great circles only, over the same axes: the visual hull of as many directi
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -33,10 +34,14 @@ from ..geometry.box import Box
 from ..geometry.checks import FloatArray
 from ..geometry.lines import Lines
 
-__all__ = ["Loop", "choose_loops", "fibonacci_axes", "loop_lines", "ruling_elevation",
-           "ruling_tilt", "seam_normals"]
+__all__ = ["LOOP_STEP", "Loop", "choose_loops", "fibonacci_axes", "loop_lines",
+           "ruling_elevation", "ruling_tilt", "seam_normals", "silhouette"]
 
 SAMPLES = 96
+#: largest gap [m] between a great-circle loop's rulings along its polygon
+LOOP_STEP = 0.005
+#: shortest edge [m] of a great-circle loop's polygon (shorter ones are merged)
+MIN_EDGE = 0.001
 AMPLITUDES = (0.0, 0.3, 0.6, 0.9)
 WAVES = (2, 3)
 PHASES = (0.0, 0.5)  # fractions of a half wave
@@ -60,7 +65,7 @@ MAX_TILT = 40.0
 class Loop:
     """A loop's curve of normals: ``axis`` (3,), ``amplitude`` (0: a great circle),
     ``waves`` round the loop, ``phase`` (fraction of a half wave); ``normals``
-    (SAMPLES, 3) and ``support`` (SAMPLES,) [m] the planes' offsets (standoff added)."""
+    (K, 3) and ``support`` (K,) [m] the planes' offsets (standoff added)."""
 
     axis: FloatArray = field(repr=False)
     amplitude: float
@@ -92,22 +97,70 @@ def fibonacci_axes(n: int) -> FloatArray:
     return np.stack([r * np.cos(phi), r * np.sin(phi), z], axis=1)
 
 
-def seam_normals(axis: FloatArray, amplitude: float, waves: int, phase: float,
-                 samples: int = SAMPLES) -> FloatArray:  # fmt: skip
-    """(samples, 3) unit normals of a seam about ``axis`` (module doc)."""
+def _across(axis: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """``(a, e1, e2)``: the unit ``axis`` and two unit vectors completing a right-handed
+    orthonormal frame."""
     a = axis / np.linalg.norm(axis)
     e1 = np.cross(a, [1.0, 0.0, 0.0] if abs(a[0]) < 0.9 else [0.0, 1.0, 0.0])
     e1 /= np.linalg.norm(e1)
-    e2 = np.cross(a, e1)
+    return a, e1, np.cross(a, e1)
+
+
+def seam_normals(axis: FloatArray, amplitude: float, waves: int, phase: float,
+                 samples: int = SAMPLES) -> FloatArray:  # fmt: skip
+    """(samples, 3) unit normals of a seam about ``axis`` (module doc)."""
+    a, e1, e2 = _across(axis)
     s = np.linspace(0.0, 2 * np.pi, samples, endpoint=False)
     g = (np.cos(s)[:, None] * e1 + np.sin(s)[:, None] * e2
          + amplitude * np.sin(waves * s + phase * np.pi / max(waves, 1))[:, None] * a)  # fmt: skip
     return g / np.linalg.norm(g, axis=1)[:, None]
 
 
-def loop_lines(loop: Loop, centre: FloatArray) -> Lines:
+def _corners(n: FloatArray, h: FloatArray) -> FloatArray:
+    """(K, 2) the corners of the convex polygon ``n_i . x <= h_i`` (normals (K, 2) in
+    order round it): corner ``i`` where lines ``i`` and ``i + 1`` meet."""
+    M = np.stack([n, np.roll(n, -1, axis=0)], axis=1)
+    return np.linalg.solve(M, np.stack([h, np.roll(h, -1)], axis=1)[..., None])[..., 0]
+
+
+def silhouette(axis: FloatArray, hull: FloatArray, standoff: float,
+               min_edge: float = MIN_EDGE) -> Loop:  # fmt: skip
+    """The great-circle loop along ``axis`` on the part's own silhouette.
+
+    Its planes are the edges of the convex polygon of the hull vertices ``hull`` (H, 3)
+    seen along the axis, each moved out by ``standoff`` [m], so that the loop's corners
+    are the polygon's (mitred), not clusters of rulings on a tiny arc round each vertex
+    (a sampled circle of normals puts many of them within ``standoff`` of a vertex and
+    none along a long edge: the planner's refinement of so uneven a loop wiggles, and the
+    arm cannot hold the feed through it).  Edges shorter than ``min_edge`` go (the lines
+    beside them extended where they turn by less than 120 degrees together): the polygon
+    only grows."""
+    from scipy.spatial import ConvexHull
+
+    a, e1, e2 = _across(np.asarray(axis, dtype=float))
+    P = hull @ np.stack([e1, e2], axis=1)
+    v = P[ConvexHull(P).vertices]  # counter-clockwise
+    e = np.roll(v, -1, axis=0) - v
+    n = np.stack([e[:, 1], -e[:, 0]], axis=1) / np.linalg.norm(e, axis=1)[:, None]
+    h = np.einsum("ij,ij->i", n, v) + standoff
+    keep = np.ones(len(n), bool)
+    while keep.sum() > 3:
+        idx = np.flatnonzero(keep)
+        c = _corners(n[idx], h[idx])
+        length = np.linalg.norm(c - np.roll(c, 1, axis=0), axis=1)  # edge i: c[i-1] to c[i]
+        beside = np.einsum("ij,ij->i", np.roll(n[idx], 1, axis=0), np.roll(n[idx], -1, axis=0))
+        short = np.flatnonzero((length < min_edge) & (beside > -0.5))
+        if not short.size:
+            break
+        keep[idx[short[np.argmin(length[short])]]] = False
+    n, h = n[keep], h[keep]
+    return Loop(a, 0.0, 2, 0.0, n[:, :1] * e1 + n[:, 1:] * e2, h)
+
+
+def loop_lines(loop: Loop, centre: FloatArray, step: float = LOOP_STEP) -> Lines:
     """The loop's rulings: consecutive planes' lines of intersection (point nearest
-    ``centre``), oriented alike."""
+    ``centre``), oriented alike; a great circle's also along its polygon's edges, evenly,
+    at most ``step`` [m] apart (its corners kept)."""
     n0, n1 = loop.normals, np.roll(loop.normals, -1, axis=0)
     h0, h1 = loop.support, np.roll(loop.support, -1)
     d = np.cross(n0, n1)
@@ -117,6 +170,15 @@ def loop_lines(loop: Loop, centre: FloatArray) -> Lines:
     p = np.linalg.solve(M, rhs[..., None])[..., 0]
     if np.mean(d @ loop.axis) < 0.0:
         d = -d
+    if loop.parallel:
+        d = np.broadcast_to(loop.axis / np.linalg.norm(loop.axis), p.shape)
+        p -= np.outer((p - centre) @ d[0], d[0])  # the corners in the plane through centre
+        edge = np.roll(p, -1, axis=0) - p
+        parts = np.maximum(1, np.ceil(np.linalg.norm(edge, axis=1) / step)).astype(int)
+        k = np.repeat(np.arange(len(p)), parts)
+        t = np.arange(len(k)) - np.repeat(np.cumsum(parts) - parts, parts)
+        p = p[k] + (t / parts[k])[:, None] * edge[k]
+        d = np.broadcast_to(d[0], p.shape)
     return Lines.from_point_direction(p, d)
 
 
@@ -146,47 +208,66 @@ def _candidates(hull: FloatArray, standoff: float, axes: FloatArray, seams: bool
             if radial is not None and (ruling_tilt(n, radial) > max_tilt
                                        or ruling_elevation(n) > MAX_ELEVATION):
                 continue
+            if A == 0.0:
+                out.append(silhouette(a, hull, standoff))
+                continue
             h = (hull @ n.T).max(axis=0) + standoff
             out.append(Loop(a, A, k, ph, n, h))
     return out
 
 
-def _voxels(stock: Box, count: int) -> tuple[FloatArray, float]:
+def _voxels(stock: Box, count: int) -> tuple[FloatArray, float, tuple[int, int, int]]:
+    """The centres (N, 3) [m, base frame] of about ``count`` voxels of the block, their
+    step [m] and the grid's shape."""
     h = float((np.prod(stock.size) / count) ** (1 / 3))
     axes = [np.arange(0.5 * h, s, h) - 0.5 * s for s in stock.size]
     X, Y, Z = np.meshgrid(*axes, indexing="ij")
     local = np.stack([X, Y, Z], axis=-1).reshape(-1, 3)
-    return local @ stock.rotation.T + stock.centre, h
+    return local @ stock.rotation.T + stock.centre, h, X.shape
 
 
 def choose_loops(hull: FloatArray, stock: Box, count: int, standoff: float,
                  seams: bool = True, axes: FloatArray | None = None,
-                 radial: FloatArray | None = None, max_tilt: float = MAX_TILT
+                 radial: FloatArray | None = None, max_tilt: float = MAX_TILT,
+                 accept: Callable[[Loop], bool] | None = None,
+                 gone: Callable[[FloatArray, tuple[int, int, int]], np.ndarray] | None = None,
                  ) -> tuple[list[Loop], list[float]]:  # fmt: skip
     """``count`` loops about the part's hull vertices ``hull`` (H, 3) [m], chosen greedily
     (module doc); with ``seams=False`` great circles only (the baseline).  Also the
-    block's kept volume [m^3] on the voxel grid after each loop."""
+    block's kept volume [m^3] on the voxel grid after each loop.  ``accept(loop)``: whether
+    the robot can cut a loop (asked of the best loop of a round, then of the next best
+    while it says no; each loop asked once): a loop it refuses is never chosen.
+    ``gone(points, shape)``: which voxels of the grid (N, 3), ``shape``, the exact cuts
+    take away already (they count for no loop: a part whose exact cuts leave nothing
+    outside its hull gets no loop)."""
     from scipy.spatial import ConvexHull
 
     axes = fibonacci_axes(24) if axes is None else axes
-    pts, h = _voxels(stock, VOXELS)
+    pts, h, shape = _voxels(stock, VOXELS)
     eq = ConvexHull(hull).equations
     in_hull = np.all(pts @ eq[:, :3].T + eq[:, 3] <= 0.0, axis=1)
-    alive = (pts[~in_hull] - stock.centre).astype(np.float32)
+    left = ~in_hull if gone is None else ~in_hull & ~gone(pts, shape)
+    alive = (pts[left] - stock.centre).astype(np.float32)
     cands = _candidates(hull, standoff, axes, seams, radial, max_tilt)
     planes = [(c.normals.T.astype(np.float32), (c.support - c.normals @ stock.centre)
                .astype(np.float32)) for c in cands]  # fmt: skip
     chosen, kept = [], []
+    verdict: dict[int, bool] = {}
     for _ in range(count):
-        best, best_gain, best_keep = None, -1, None
-        for c, (nt, sup) in zip(cands, planes, strict=True):
-            keep = np.all(alive @ nt <= sup, axis=1)
-            gain = len(alive) - int(keep.sum())
-            if gain > best_gain:
-                best, best_gain, best_keep = c, gain, keep
-        if best is None or best_gain <= 0:
+        keeps = [np.all(alive @ nt <= sup, axis=1) for nt, sup in planes]
+        gains = np.array([len(alive) - int(k.sum()) for k in keeps])
+        best = None
+        for i in np.argsort(-gains, kind="stable"):
+            if gains[i] <= 0:
+                break
+            if accept is not None and i not in verdict:
+                verdict[i] = bool(accept(cands[i]))
+            if accept is None or verdict[i]:
+                best = i
+                break
+        if best is None:
             break
-        chosen.append(best)
-        alive = alive[best_keep]
+        chosen.append(cands[best])
+        alive = alive[keeps[best]]
         kept.append(float((len(alive) + in_hull.sum()) * h**3))
     return chosen, kept

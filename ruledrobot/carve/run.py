@@ -11,6 +11,7 @@ closed mesh that holds the part.
 
 from __future__ import annotations
 
+import dataclasses
 import os
 import time
 from dataclasses import dataclass, field
@@ -81,6 +82,13 @@ def _checks(plan: CutPlan, carved, part_volume: float, closed_ok: bool, tol: flo
     ]  # fmt: skip
     if not exact:
         out.pop(1)
+    left = [v for v in plan.faces.values() if v not in ("exact", "block face")]
+    if not plan.cuts and left:
+        why = [n for n in plan.notes if "the arm cannot" in n]
+        out.insert(0, {"name": "cuts", "ok": False, "what": "the robot can make a cut of the part",
+                       "detail": "no cut: " + ("; ".join(why) if why else left[0])
+                       + ("; `ruledrobot place` searches for a placement or turn of the block "
+                          "where the arm can" if why else "")})  # fmt: skip
     return out
 
 
@@ -100,8 +108,19 @@ def carve(cell_path: str | os.PathLike[str], out: str | os.PathLike[str],
         from ..wirecut import CutSpec  # its defaults: the lead the planner uses
 
         lead = float(cell.tables.get("cut", {}).get("lead_in", CutSpec.lead_in))
-        plan = find_cuts(part, cell.stock, query, cell.part.tolerance, cell.part.rough_cuts,
-                         lead, progress)  # fmt: skip
+        from .robotcheck import RobotCheck
+
+        check = RobotCheck(cell.tables)
+        try:
+            plan = find_cuts(part, cell.stock, query, cell.part.tolerance, cell.part.rough_cuts,
+                             lead, progress, check)  # fmt: skip
+        finally:
+            check.close()
+        times["robot_check"] = check.seconds
+        if check.unchecked:
+            plan = dataclasses.replace(plan, notes=(*plan.notes, (
+                f"{check.unchecked} cuts were not checked with the robot: {check.calls} were "
+                "(the most carve checks); the plan judges them")))  # fmt: skip
         times["cuts"] = time.perf_counter() - t
         t = time.perf_counter()
         progress("meshing the carved block")

@@ -15,7 +15,8 @@ block (:meth:`WireCut.measure <ruledrobot.robot.wire.cut.WireCut.measure>`,
   windows (sample ranges) are carried over to the program's samples through the
   matching below;
 * **wire deviation**: each program sample is matched to the plan sample whose wire is
-  nearest (both wire ends, within :data:`MATCH_WINDOW` s of the same time); the
+  nearest (both wire ends, within :data:`MATCH_WINDOW` s of the same time on the plan's
+  clock: the program's time carried by the drift measured so far, ``_match``); the
   deviation is the largest distance of the program's chord ends (the wire's part in the
   block) from the matched plan sample's wire line, over the samples with the wire in
   the stock, against ``wire_tolerance``.  Its resolution is half the plan's step along
@@ -70,6 +71,9 @@ __all__ = [
 
 #: s: a program sample is matched to plan samples at most this far from its own time
 MATCH_WINDOW = 1.0
+#: m/s: the time gap's weight in the match, against the wires' distance (m): it only
+#: breaks ties between equal poses (1 um per second of gap)
+TIE_SPEED = 1e-6
 
 
 @dataclass(frozen=True)
@@ -258,23 +262,36 @@ def _simulate(traj: Trajectory, ops: Sequence[Op], q0: np.ndarray | None = None
 def _match(plan_t: np.ndarray, plan_x: np.ndarray, t: np.ndarray, x: np.ndarray,
            window: float) -> np.ndarray:  # fmt: skip
     """(N,) the plan sample nearest each program sample (features ``x`` (N, F) against
-    ``plan_x`` (M, F)) among those within ``window`` s of its time."""
+    ``plan_x`` (M, F)) among those within ``window`` s of its time on the plan's clock.
+
+    The clocks drift apart over a long program (its free-air ``movej`` transits run
+    faster or slower than the plan's: 4.9 s over the wedge's 273 s), so the program's
+    time is carried to the plan's by the drift measured so far: after each chunk of
+    samples, the median of (plan time - program time) over its matches (equal poses, as in
+    a dwell, matched nearest in time: :data:`TIE_SPEED`).  The window
+    then bounds only the error of that estimate within one chunk (half a second at
+    500 Hz), and still keeps a loop's start from matching its end."""
     out = np.empty(t.size, dtype=np.int64)
     chunk = 256
+    drift = 0.0
     for j0 in range(0, t.size, chunk):
         j1 = min(j0 + chunk, t.size)
-        lo = int(np.searchsorted(plan_t, t[j0] - window))
-        hi = int(np.searchsorted(plan_t, t[j1 - 1] + window, side="right"))
+        tc = t[j0:j1] + drift
+        lo = int(np.searchsorted(plan_t, tc[0] - window))
+        hi = int(np.searchsorted(plan_t, tc[-1] + window, side="right"))
         lo, hi = min(lo, plan_t.size - 1), max(hi, lo + 1)
         xs, ps = x[j0:j1] - plan_x[lo], plan_x[lo:hi] - plan_x[lo]  # small numbers: exact
         d = (xs * xs).sum(1)[:, None] + (ps * ps).sum(1)[None, :] - 2.0 * (xs @ ps.T)
-        far = np.abs(t[j0:j1, None] - plan_t[None, lo:hi]) > window
-        d[far] = np.inf
+        gap = np.abs(tc[:, None] - plan_t[None, lo:hi])
+        d += (TIE_SPEED * gap) ** 2  # equal poses (a dwell): the one nearest in time
+        d[gap > window] = np.inf
         k = np.argmin(d, axis=1)
         # a sample with no plan sample in its window (the program ran long): nearest in time
         none = ~np.isfinite(d[np.arange(j1 - j0), k])
-        k[none] = np.clip(np.searchsorted(plan_t, t[j0:j1][none]), 0, plan_t.size - 1) - lo
+        k[none] = np.clip(np.searchsorted(plan_t, tc[none]), 0, plan_t.size - 1) - lo
         out[j0:j1] = lo + k
+        if (~none).any():
+            drift = float(np.median(plan_t[out[j0:j1]][~none] - t[j0:j1][~none]))
     return out
 
 

@@ -1,4 +1,4 @@
-"""Parts made from closed forms, in the tests themselves (not the product's meshes).
+"""Parts made from closed forms (the meshes of :mod:`ruledrobot.carve.samples`, or made here).
 
 Each returns ``(vertices (V, 3), faces (F, 3))`` in metres in the part's own frame,
 closed, faces turned outwards (every part here is star-shaped about its origin), and
@@ -10,41 +10,14 @@ from __future__ import annotations
 
 import numpy as np
 
-
-def _weld(tris: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """A triangle soup (T, 3, 3) as shared vertices and faces turned outwards (star-shaped
-    about the origin)."""
-    n = np.cross(tris[:, 1] - tris[:, 0], tris[:, 2] - tris[:, 0])
-    flip = np.einsum("ij,ij->i", n, tris.mean(axis=1)) < 0
-    tris = np.where(flip[:, None, None], tris[:, ::-1], tris)
-    v, inv = np.unique(np.round(tris.reshape(-1, 3), 10), axis=0, return_inverse=True)
-    f = inv.reshape(-1, 3)
-    good = (f[:, 0] != f[:, 1]) & (f[:, 1] != f[:, 2]) & (f[:, 0] != f[:, 2])
-    return v, f[good]
-
-
-def _grid(P: np.ndarray, closed_u: bool = False) -> np.ndarray:
-    """Triangles (T, 3, 3) of a grid of points P (nu, nv, 3)."""
-    if closed_u:
-        P = np.concatenate([P, P[:1]], axis=0)
-    a, b, c, d = P[:-1, :-1], P[1:, :-1], P[1:, 1:], P[:-1, 1:]
-    return np.concatenate([np.stack([a, b, c], -2).reshape(-1, 3, 3),
-                           np.stack([a, c, d], -2).reshape(-1, 3, 3)])
+from ruledrobot.carve import samples
+from ruledrobot.carve.samples import grid_triangles as _grid
+from ruledrobot.carve.samples import weld as _weld
 
 
 def hyperboloid_column(a=0.06, c=0.3, h=0.1, nu=96, nz=24):
     """``x^2 + y^2 = a^2 (1 + z^2 / c^2)`` for ``|z| <= h``, capped (axis z)."""
-    u = np.linspace(0, 2 * np.pi, nu, endpoint=False)
-    z = np.linspace(-h, h, nz)
-    r = a * np.sqrt(1 + z**2 / c**2)
-    P = np.stack([np.cos(u)[:, None] * r, np.sin(u)[:, None] * r, np.broadcast_to(z, (nu, nz))], -1)
-    side = _grid(P, closed_u=True)
-    caps = []
-    for k in (0, -1):
-        ring = P[:, k]
-        centre = np.broadcast_to([0.0, 0.0, z[k]], ring.shape)
-        caps.append(np.stack([centre, ring, np.roll(ring, -1, axis=0)], 1))
-    v, f = _weld(np.concatenate([side, *caps]))
+    v, f = samples.cooling_tower(a, c, h, nu, nz)
 
     def distance(x):
         F = x[:, 0] ** 2 + x[:, 1] ** 2 - a**2 * (1 + x[:, 2] ** 2 / c**2)
@@ -56,16 +29,7 @@ def hyperboloid_column(a=0.06, c=0.3, h=0.1, nu=96, nz=24):
 
 def saddle_block(size=(0.2, 0.2, 0.15), z0=0.035, c=0.4, n=25):
     """The block ``|x|, |y| <= size/2``, from its bottom to the saddle ``z = z0 + x y / c``."""
-    hx, hy, hz = 0.5 * np.asarray(size)
-    x, y = np.linspace(-hx, hx, n), np.linspace(-hy, hy, n)
-    X, Y = np.meshgrid(x, y, indexing="ij")
-    top = np.stack([X, Y, z0 + X * Y / c], -1)
-    bot = np.stack([X, Y, np.full_like(X, -hz)], -1)
-    walls = []
-    for edge_top, edge_bot in ((top[0], bot[0]), (top[-1], bot[-1]),
-                               (top[:, 0], bot[:, 0]), (top[:, -1], bot[:, -1])):
-        walls.append(_grid(np.stack([edge_bot, edge_top], 1)))
-    v, f = _weld(np.concatenate([_grid(top), _grid(bot), *walls]))
+    v, f = samples.saddle_top(size, z0, c, n)
 
     def distance(p):
         F = p[:, 2] - z0 - p[:, 0] * p[:, 1] / c
@@ -107,19 +71,9 @@ def write_obj(path, v, f, scale=1.0):
 
 
 def box(size=(0.12, 0.1, 0.08), n=1):
-    """The box ``|x_k| <= size_k / 2``, each face an ``n`` x ``n`` grid of squares split
-    in two: ``12 n^2`` triangles (n = 1: the 12 of a CAD export, n = 4: 192)."""
+    """The box ``|x_k| <= size_k / 2`` of ``12 n^2`` triangles (:func:`samples.box`)."""
+    v, f = samples.box(size, n)
     h = 0.5 * np.asarray(size)
-    faces = []
-    for axis in range(3):
-        u, v = [k for k in range(3) if k != axis]
-        A, B = np.meshgrid(np.linspace(-h[u], h[u], n + 1), np.linspace(-h[v], h[v], n + 1),
-                           indexing="ij")  # fmt: skip
-        for sign in (-1.0, 1.0):
-            P = np.zeros((*A.shape, 3))
-            P[..., u], P[..., v], P[..., axis] = A, B, sign * h[axis]
-            faces.append(_grid(P))
-    v, f = _weld(np.concatenate(faces))
 
     def inside(x):
         return np.all(np.abs(x) < h, axis=1)

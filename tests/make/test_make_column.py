@@ -49,14 +49,23 @@ def test_make_on_the_demo_column_writes_a_program_per_setup(tmp_path):
                                                 "setup1/trajectory.csv", "make.json"}
 
 
-def test_a_block_out_of_reach_fails_by_reach_and_leaves_no_program(tmp_path):
+def test_a_block_out_of_reach_fails_in_carve_with_the_planners_words_and_no_program(tmp_path):
+    """carve asks the planner's wire-pose search about every cut (issue 32, "cuts chosen
+    with the robot"): 1 m on, the column's loop and every roughing loop offered are out of
+    reach, so carve writes no job and names why; before, carve wrote the loop and its plan
+    failed reach."""
     cell = write_demo_cell(tmp_path / "part")
     cell.write_text(cell.read_text().replace("[0.5, 0.0, 0.3", "[1.5, 0.0, 0.3"))  # 1 m on
     out = tmp_path / "made"
     res, text = _make(cell, out)
     assert res.exit_code == 1, res.output
-    assert "make: FAIL — setup 1 fails (reach)" in text and "out of reach by up to" in text
+    assert "make: FAIL" in text and "carve" in text
     doc = json.loads((out / "make.json").read_text())
-    assert doc["failed_setups"] == [1] and doc["setups"][0]["failed"][0]["name"] == "reach"
-    assert not [p for p in out.rglob("*") if p.name in ("cut.script", "trajectory.csv")]
-    assert (out / "setup1" / "report.json").is_file() and read_manifest(out)["ok"] is False
+    assert "cuts" in doc["carve"]["failed"] and doc["setups"] == []
+    report = json.loads((out / "carve" / "carve.json").read_text())
+    (check,) = [c for c in report["checks"] if c["name"] == "cuts"]
+    assert "the arm cannot make its cut" in check["detail"]
+    assert "no continuous IK solution" in check["detail"] and "ruledrobot place" in check["detail"]
+    assert not [p for p in out.rglob("*") if p.name in ("cut.script", "trajectory.csv",
+                                                         "job.toml")]  # fmt: skip
+    assert read_manifest(out)["ok"] is False

@@ -263,13 +263,18 @@ def search_wire_pose(
                              cell.W)  # fmt: skip
             poses.append(P)
             iks.append(path_ik(model, P, q_start=q_start, jump_threshold=jump_threshold * stride))
-        checks = clearance(cell, np.stack([ik.q for ik in iks]), np.stack(poses))
+        # the clearance of a candidate counts only where its IK holds: those with none
+        # (a cut out of reach) are left out of the batch, exactly
+        live = [c for c, ik in enumerate(iks) if ik.ok.any()]
+        checks = clearance(cell, np.stack([iks[c].q for c in live]),
+                           np.stack([poses[c] for c in live])) if live else {}  # fmt: skip
+        row = {c: r for r, c in enumerate(live)}
         out = []
         for c, ((psi, reverse, k), ik) in enumerate(zip(cands, iks, strict=True)):
             masks = {
                 "no continuous IK solution": ~ik.ok,
                 "near a singularity": ik.ok & (ik.measure < singular_min),
-                **{key: ik.ok & v[c] for key, v in checks.items()},
+                **{key: ik.ok & v[row[c]] for key, v in checks.items() if c in row},
             }
             lost = {key: int(v.sum()) for key, v in masks.items()}
             ok_c = all(v == 0 for v in lost.values())
@@ -369,6 +374,8 @@ def _ladder_roll(
     valid = ~np.isnan(q).any(axis=-1)
     meas = np.where(valid, model.singularity_measure(np.nan_to_num(q)), 0.0)
     valid &= meas >= cell.singular_min
+    if not valid.any(axis=(1, 2)).all():  # a sampled ruling with no node: no path (exact),
+        return None  # and the clearance of every node (most of the time) is not needed
     for bad in clearance(cell, q, np.broadcast_to(P[:, :, None], (n, k, 8, 4, 4))).values():
         valid &= ~bad
     qn = np.nan_to_num(q).reshape(n, k * 8, 6)
