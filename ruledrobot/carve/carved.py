@@ -116,9 +116,10 @@ class Carved:
     resolution: float = 0.002
 
     def as_dict(self) -> dict[str, object]:
-        """For ``carve.json``: ``method``, ``grid_cuts`` (cut name -> why on the grid),
-        ``why`` (the whole on the grid), ``triangles`` of the mesh, ``solid_triangles``,
-        ``planes``."""
+        """Return the carve's fields for ``carve.json``.
+
+        ``method``, ``grid_cuts`` (cut name -> why on the grid), ``why`` (the whole on the
+        grid), ``triangles`` of the mesh, ``solid_triangles``, ``planes``."""
         return {"method": self.method, "grid_cuts": dict(self.grid), "why": self.why or None,
                 "triangles": 0 if self.mesh is None else len(self.mesh.faces),
                 "solid_triangles": self.solid_triangles, "planes": self.planes}  # fmt: skip
@@ -230,16 +231,19 @@ def _grid_kept(cut: CarveCut, stock: Box, resolution: float):
 
 def carved_mesh(cuts: tuple[CarveCut, ...], stock: Box, loops: tuple[Loop, ...] = (),
                 resolution: float = 0.002) -> Mesh | None:  # fmt: skip
-    """The block kept by the exact ``cuts`` and the roughing ``loops`` as a closed mesh
-    [m, base frame] (:func:`carve_block`'s mesh); None when nothing is kept."""
+    """Return the block kept by the exact cuts and the roughing loops as a closed mesh.
+
+    The block kept by the exact ``cuts`` and the roughing ``loops`` [m, base frame]
+    (:func:`carve_block`'s mesh); None when nothing is kept."""
     return carve_block(cuts, stock, loops, resolution).mesh
 
 
 def grid_carved_mesh(cuts: tuple[CarveCut, ...], stock: Box, loops: tuple[Loop, ...] = (),
                      resolution: float = 0.002) -> Mesh | None:  # fmt: skip
-    """The block kept by the exact ``cuts`` and the roughing ``loops`` meshed on the grid
-    of ``resolution`` [m] (module doc, "The grid") [m, base frame]; None when nothing is
-    kept."""
+    """Return the block kept by the exact cuts and the roughing loops, meshed on a grid.
+
+    The block kept by the exact ``cuts`` and the roughing ``loops`` meshed on the grid of
+    ``resolution`` [m] (module doc, "The grid") [m, base frame]; None when nothing is kept."""
     from ..wirecut import part_sdf, stock_mesh
 
     job, passes = _model(cuts, stock)

@@ -37,7 +37,9 @@ MAX_REFUSED = 4
 
 @dataclass(frozen=True)
 class CutPlan:
-    """The cuts in the order they are made with their measures, the roughing loops and the
+    """A carve's cut plan: the cuts in order, the roughing loops, the regions and notes.
+
+    The cuts in the order they are made with their measures, the roughing loops and the
     baseline's (great circles), the regions and what became of each (``faces``: region
     index -> ``"block face"``, ``"exact"``, or why it was roughed), notes, the voxel
     estimates of the block kept after the roughing loops [m^3] (``kept_voxel``,
@@ -55,8 +57,9 @@ class CutPlan:
 
 
 def prefer_direction(stock: Box) -> FloatArray:
-    """The horizontal direction across the line from the robot base to the block: the
-    wire held sideways in front of the arm, as in the demo jobs."""
+    """Return the horizontal direction across the line from the robot base to the block.
+
+    The wire held sideways in front of the arm, as in the demo jobs."""
     c = np.array([stock.centre[0], stock.centre[1], 0.0])
     if np.linalg.norm(c) < 1e-6:
         return np.array([0.0, 1.0, 0.0])

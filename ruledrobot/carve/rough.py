@@ -63,9 +63,11 @@ MAX_TILT = 40.0
 
 @dataclass(frozen=True)
 class Loop:
-    """A loop's curve of normals: ``axis`` (3,), ``amplitude`` (0: a great circle),
-    ``waves`` round the loop, ``phase`` (fraction of a half wave); ``normals``
-    (K, 3) and ``support`` (K,) [m] the planes' offsets (standoff added)."""
+    """A roughing loop's curve of normals and its planes' offsets.
+
+    ``axis`` (3,), ``amplitude`` (0: a great circle), ``waves`` round the loop, ``phase``
+    (fraction of a half wave); ``normals`` (K, 3) and ``support`` (K,) [m] the planes'
+    offsets (standoff added)."""
 
     axis: FloatArray = field(repr=False)
     amplitude: float
@@ -80,7 +82,9 @@ class Loop:
         return self.amplitude == 0.0
 
     def describe(self) -> str:
-        """The loop in words: ``"silhouette along (+0.00, +0.00, +1.00)"`` for a great circle,
+        """Return the loop in words.
+
+        ``"silhouette along (+0.00, +0.00, +1.00)"`` for a great circle,
         ``"seam about (...), amplitude 0.3, 2 waves"`` for a seam."""
         a = ", ".join(f"{x:+.2f}" for x in self.axis)
         if self.parallel:
@@ -158,9 +162,10 @@ def silhouette(axis: FloatArray, hull: FloatArray, standoff: float,
 
 
 def loop_lines(loop: Loop, centre: FloatArray, step: float = LOOP_STEP) -> Lines:
-    """The loop's rulings: consecutive planes' lines of intersection (point nearest
-    ``centre``), oriented alike; a great circle's also along its polygon's edges, evenly,
-    at most ``step`` [m] apart (its corners kept)."""
+    """Return the loop's rulings: consecutive planes' lines of intersection, oriented alike.
+
+    Each line by its point nearest ``centre``; a great circle's also along its polygon's
+    edges, evenly, at most ``step`` [m] apart (its corners kept)."""
     n0, n1 = loop.normals, np.roll(loop.normals, -1, axis=0)
     h0, h1 = loop.support, np.roll(loop.support, -1)
     d = np.cross(n0, n1)
@@ -183,8 +188,10 @@ def loop_lines(loop: Loop, centre: FloatArray, step: float = LOOP_STEP) -> Lines
 
 
 def ruling_tilt(normals: FloatArray, radial: FloatArray) -> float:
-    """The largest angle [deg] between a loop's rulings (consecutive planes of
-    ``normals`` (K, 3) meet in them) and the plane normal to ``radial`` (3,)."""
+    """Return the largest tilt [deg] of a loop's rulings from the plane normal to ``radial``.
+
+    The largest angle [deg] between a loop's rulings (consecutive planes of ``normals``
+    (K, 3) meet in them) and the plane normal to ``radial`` (3,)."""
     d = np.cross(normals, np.roll(normals, -1, axis=0))
     d /= np.linalg.norm(d, axis=1)[:, None]
     return float(np.degrees(np.arcsin(np.clip(np.abs(d @ radial).max(), 0.0, 1.0))))
@@ -232,14 +239,15 @@ def choose_loops(hull: FloatArray, stock: Box, count: int, standoff: float,
                  accept: Callable[[Loop], bool] | None = None,
                  gone: Callable[[FloatArray, tuple[int, int, int]], np.ndarray] | None = None,
                  ) -> tuple[list[Loop], list[float]]:  # fmt: skip
-    """``count`` loops about the part's hull vertices ``hull`` (H, 3) [m], chosen greedily
-    (module doc); with ``seams=False`` great circles only (the baseline).  Also the
-    block's kept volume [m^3] on the voxel grid after each loop.  ``accept(loop)``: whether
-    the robot can cut a loop (asked of the best loop of a round, then of the next best
-    while it says no; each loop asked once): a loop it refuses is never chosen.
-    ``gone(points, shape)``: which voxels of the grid (N, 3), ``shape``, the exact cuts
-    take away already (they count for no loop: a part whose exact cuts leave nothing
-    outside its hull gets no loop)."""
+    """Choose ``count`` roughing loops about the part's hull, greedily (module doc).
+
+    Loops about the part's hull vertices ``hull`` (H, 3) [m]; with ``seams=False`` great
+    circles only (the baseline).  Also the block's kept volume [m^3] on the voxel grid after
+    each loop.  ``accept(loop)``: whether the robot can cut a loop (asked of the best loop
+    of a round, then of the next best while it says no; each loop asked once): a loop it
+    refuses is never chosen.  ``gone(points, shape)``: which voxels of the grid (N, 3),
+    ``shape``, the exact cuts take away already (they count for no loop: a part whose exact
+    cuts leave nothing outside its hull gets no loop)."""
     from scipy.spatial import ConvexHull
 
     axes = fibonacci_axes(24) if axes is None else axes

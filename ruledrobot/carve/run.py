@@ -37,8 +37,10 @@ FORMAT = "ruledrobot.carve/1"
 
 @dataclass(frozen=True)
 class CarveResult:
-    """What :func:`carve` did: ``report`` (the content of ``carve.json``), the cut plan,
-    ``files`` (name -> path) and ``ok`` (every check holds)."""
+    """What :func:`carve` did: its report, cut plan, files and verdict.
+
+    ``report`` (the content of ``carve.json``), the cut plan, ``files`` (name -> path) and
+    ``ok`` (every check holds)."""
 
     report: dict[str, Any] = field(repr=False)
     plan: CutPlan = field(repr=False)
