@@ -45,12 +45,13 @@ def export_targets(path: str | os.PathLike[str], fmt: str) -> list[Path]:
 
 
 def file_kind(path: Path) -> str | None:
-    """What an existing file is, as far as exports go: ``"csv"`` (first line the trajectory
-    header), ``"sidecar"`` (a JSON object of format ``ruledrobot.trajectory-meta/1``),
-    ``"json"`` (``ruledrobot.trajectory/1``), ``"npz"`` (arrays ``t``, ``q``, ``tcp``,
-    ``meta``), ``"urscript"`` (a program ruledrobot wrote: its second line), or
-    ``"recording"`` (a run's recording: ``<stem>.run-NNN.csv/json`` or a sidecar with
-    ``"run"``); None: anything else -- a file ruledrobot did not write."""
+    """Return what an existing file is, as far as exports go, or None.
+
+    ``"csv"`` (first line the trajectory header), ``"sidecar"`` (a JSON object of format
+    ``ruledrobot.trajectory-meta/1``), ``"json"`` (``ruledrobot.trajectory/1``), ``"npz"``
+    (arrays ``t``, ``q``, ``tcp``, ``meta``), ``"urscript"`` (a program ruledrobot wrote: its
+    second line), or ``"recording"`` (a run's recording: ``<stem>.run-NNN.csv/json`` or a
+    sidecar with ``"run"``); None: anything else -- a file ruledrobot did not write."""
     if _RECORDING_NAME.fullmatch(path.name):
         return "recording"
     try:
@@ -92,11 +93,12 @@ def _size(n: int) -> str:
 
 
 def check_export_targets(path: str | os.PathLike[str], fmt: str) -> None:
-    """Refuse (:class:`WouldReplace`) an export of ``fmt`` at ``path`` that would replace a
-    file it did not write: each existing target must be of the kind the export writes
-    there (:func:`file_kind`: a CSV over a trajectory CSV, a sidecar over a sidecar, a
-    JSON export over a JSON export, ...).  Never over a recording of a run, a folder, a
-    JSON export in the place of a sidecar, or a file of the user's."""
+    """Refuse an export that would replace a file it did not write (:class:`WouldReplace`).
+
+    An export of ``fmt`` at ``path``: each existing target must be of the kind the export
+    writes there (:func:`file_kind`: a CSV over a trajectory CSV, a sidecar over a sidecar, a
+    JSON export over a JSON export, ...).  Never over a recording of a run, a folder, a JSON
+    export in the place of a sidecar, or a file of the user's."""
     wanted = _EXPORT_KINDS.get(fmt)
     if wanted is None:
         return

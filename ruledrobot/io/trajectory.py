@@ -366,8 +366,9 @@ def _header(traj: Trajectory) -> list[str]:
 
 
 def csv_text(traj: Trajectory) -> str:
-    """The CSV of ``traj``: the header line, then one row per sample (``%.10g`` each,
-    the text ``numpy.savetxt`` writes, formatted ``_CSV_BLOCK`` rows at a time)."""
+    """Return the CSV of ``traj``: the header line, then one row per sample.
+
+    ``%.10g`` each, the text ``numpy.savetxt`` writes, formatted ``_CSV_BLOCK`` rows at a time."""
     cols = [traj.t[:, None], traj.q, traj.tcp]
     if traj.heat_power is not None:
         cols.append(traj.heat_power[:, None])
@@ -381,8 +382,9 @@ def csv_text(traj: Trajectory) -> str:
 
 
 def write_trajectory(path: str | os.PathLike[str], traj: Trajectory) -> Path:
-    """Write ``traj`` as ``path`` (CSV) and its sidecar (``.json``), each atomically;
-    the sidecar, written last, holds the CSV's SHA-256.  Returns the CSV path."""
+    """Write ``traj`` as ``path`` (CSV) and its sidecar (``.json``), each atomically.
+
+    The sidecar, written last, holds the CSV's SHA-256.  Returns the CSV path."""
     p = Path(path)
     if p.suffix.lower() != ".csv":
         raise ValueError(f"{p}: a trajectory CSV needs the suffix .csv")
@@ -400,11 +402,12 @@ def write_trajectory(path: str | os.PathLike[str], traj: Trajectory) -> Path:
 
 
 def write_trajectory_json(path: str | os.PathLike[str], traj: Trajectory) -> Path:
-    """Write ``traj`` as one JSON document (atomically): ``{"format":
-    "ruledrobot.trajectory/1", "units": {...}, "meta": {sidecar fields}, "header": [...],
-    "t": [...], "q": [[...]], "tcp": [[...]]}`` (and ``"heat_power": [...]`` W/m when
-    the trajectory has one).  Refuses a name whose ``.csv`` sibling
-    exists (the JSON would take the place of that CSV's sidecar)."""
+    """Write ``traj`` as one JSON document (atomically).
+
+    ``{"format": "ruledrobot.trajectory/1", "units": {...}, "meta": {sidecar fields},
+    "header": [...], "t": [...], "q": [[...]], "tcp": [[...]]}`` (and ``"heat_power": [...]``
+    W/m when the trajectory has one).  Refuses a name whose ``.csv`` sibling exists (the JSON
+    would take the place of that CSV's sidecar)."""
     p = Path(path)
     if p.with_suffix(".csv").exists():
         raise ValueError(f"{p}: would replace the metadata of {p.with_suffix('.csv').name} "
@@ -425,9 +428,10 @@ def write_trajectory_json(path: str | os.PathLike[str], traj: Trajectory) -> Pat
 
 
 def write_trajectory_npz(path: str | os.PathLike[str], traj: Trajectory) -> Path:
-    """Write ``traj`` as a compressed NPZ (atomically): arrays ``t``, ``q``, ``tcp``,
-    ``heat_power`` (when the trajectory has one) and ``meta`` (the sidecar fields as JSON
-    text)."""
+    """Write ``traj`` as a compressed NPZ (atomically).
+
+    Arrays ``t``, ``q``, ``tcp``, ``heat_power`` (when the trajectory has one) and ``meta``
+    (the sidecar fields as JSON text)."""
     buf = io.BytesIO()
     extra = {} if traj.heat_power is None else {HEAT_POWER: traj.heat_power}
     np.savez_compressed(buf, t=traj.t, q=traj.q, tcp=traj.tcp,

@@ -300,9 +300,10 @@ class TrajectoryMeta:
 
     @classmethod
     def for_model(cls, model: RobotModel, **fields: object) -> TrajectoryMeta:
-        """Metadata for a trajectory of ``model``: its name, period, tool (as TCP
-        offset), tool mass and COM (as payload) and nominal kinematics; ``fields``
-        override any of them."""
+        """Return the metadata for a trajectory of ``model``.
+
+        Its name, period, tool (as TCP offset), tool mass and COM (as payload) and nominal
+        kinematics; ``fields`` override any of them."""
         kw: dict[str, object] = {
             "robot": model.name,
             "control_period": model.control_period,
@@ -322,10 +323,11 @@ class TrajectoryMeta:
 
 
 def model_for(meta: TrajectoryMeta) -> RobotModel:
-    """The robot a trajectory was planned for: the catalogue model ``meta.robot`` with
-    the trajectory's kinematics, its TCP offset as tool, its payload and the joint
-    acceleration limits it was planned within; no base (the trajectory's poses are in the
-    robot base frame)."""
+    """Return the robot a trajectory was planned for.
+
+    The catalogue model ``meta.robot`` with the trajectory's kinematics, its TCP offset as
+    tool, its payload and the joint acceleration limits it was planned within; no base (the
+    trajectory's poses are in the robot base frame)."""
     from ..arm.catalogue import load
 
     model = load(meta.robot)
@@ -429,8 +431,9 @@ class Trajectory:
     def from_joints(
         cls, t: ArrayLike, q: ArrayLike, model: RobotModel, **meta_fields: object
     ) -> Trajectory:
-        """Samples of ``model`` with the TCP column computed as FK(q) · tool in the
-        robot base frame (``model.base`` is recorded in the metadata, not applied)."""
+        """Return the samples of ``model`` with the TCP column computed as FK(q) · tool.
+
+        In the robot base frame (``model.base`` is recorded in the metadata, not applied)."""
         meta = TrajectoryMeta.for_model(model, **meta_fields)
         robot = model.with_base(np.eye(4))
         q = as_array(q, "q", (6,))
@@ -467,8 +470,9 @@ class Trajectory:
         return mask
 
     def wire_in_stock(self) -> WireInStock | None:
-        """The wire against the block along these samples (the one model,
-        :mod:`..wire.in_stock`); None when the metadata names no cut."""
+        """Return the wire against the block along these samples, or None.
+
+        The one model, :mod:`..wire.in_stock`; None when the metadata names no cut."""
         if self.meta.cut is None:
             return None
         return self.meta.cut.measure(self.t, self.tcp_poses())
@@ -476,11 +480,12 @@ class Trajectory:
     def face_errors(
         self, wis: WireInStock | None = None, heat_power: ArrayLike | None = None
     ) -> dict:
-        """``face_error`` per cut (:func:`..wire.face.face_errors`) of this motion -- or of
-        ``wis``, the wire of a motion measured against this trajectory's block (an exported
-        program's, a run's recording) -- with the wire's power from ``heat_power`` (M,)
-        W/m, recorded set-points (default: this trajectory's), delayed by the heat's lag;
-        {} when the sidecar names no face."""
+        """Return ``face_error`` per cut (:func:`..wire.face.face_errors`) of a motion.
+
+        Of this motion -- or of ``wis``, the wire of a motion measured against this
+        trajectory's block (an exported program's, a run's recording) -- with the wire's power
+        from ``heat_power`` (M,) W/m, recorded set-points (default: this trajectory's), delayed
+        by the heat's lag; {} when the sidecar names no face."""
         from ..wire.face import face_errors
 
         cut = self.meta.cut
@@ -514,9 +519,10 @@ class Trajectory:
         return "move"
 
     def tcp_error(self, model: RobotModel | None = None) -> tuple[float, float, int]:
-        """Largest distance between the TCP column and FK(q) · tcp_offset: (metres,
-        radians, the sample where the position error is largest).  ``model``
-        defaults to :func:`model_for` of the metadata."""
+        """Return the largest distance between the TCP column and FK(q) · tcp_offset.
+
+        (metres, radians, the sample where the position error is largest).  ``model`` defaults
+        to :func:`model_for` of the metadata."""
         robot = (model_for(self.meta) if model is None else model).with_base(np.eye(4))
         T = robot.fk(self.q)
         P = self.tcp_poses()
@@ -526,8 +532,10 @@ class Trajectory:
         return float(dp[k]), float(ang.max()), k
 
     def sliced(self, start: int, stop: int | None = None) -> Trajectory:
-        """Samples ``start:stop`` with times from 0; phases, ``in_stock`` ranges, the cut's
-        feed windows and the heat's windows clipped and renumbered to them."""
+        """Return samples ``start:stop`` with times from 0.
+
+        Phases, ``in_stock`` ranges, the cut's feed windows and the heat's windows clipped and
+        renumbered to them."""
         stop = self.n if stop is None else stop
         if not 0 <= start < stop <= self.n:
             raise ValueError(f"slice [{start}, {stop}) outside the {self.n} samples")
