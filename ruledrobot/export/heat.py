@@ -107,9 +107,11 @@ def urscript_heat(heat: Heat, on: bool, value: float | None = None) -> str:
 
 
 def heat_from_outputs(heat: Heat, outputs: np.ndarray) -> np.ndarray:
-    """(M,) bool: ``heat`` on in recorded outputs ``outputs`` (M, 3): RTDE's
-    ``actual_digital_output_bits`` (standard 0-7, configurable 8-15, tool 16-17) and
-    ``standard_analog_output0/1`` (on above zero).  NaN rows (not read) count as off."""
+    """Return (M,) bool: whether ``heat`` is on in recorded outputs ``outputs`` (M, 3).
+
+    The outputs: RTDE's ``actual_digital_output_bits`` (standard 0-7, configurable 8-15,
+    tool 16-17) and ``standard_analog_output0/1`` (on above zero).  NaN rows (not read)
+    count as off."""
     o = np.asarray(outputs, dtype=float).reshape(-1, 3)
     if heat.kind == "analog":
         return np.nan_to_num(o[:, 1 + heat.index], nan=0.0) > 0.0
@@ -152,9 +154,11 @@ def motion_power(traj: Trajectory, idx: np.ndarray, power: np.ndarray | None,
 
 
 def heat_off_program(heat: Heat) -> str:
-    """A secondary program (runs beside whatever program runs, stops nothing) that turns
-    the heat off: sent to the primary/secondary port when a run ends without its client
-    (crash, disconnect), because a controller keeps its outputs when a program stops."""
+    """Return a secondary program that turns the heat off.
+
+    A secondary program runs beside whatever program runs and stops nothing.  It is sent to
+    the primary/secondary port when a run ends without its client (crash, disconnect),
+    because a controller keeps its outputs when a program stops."""
     return f"sec ruledrobot_heat_off():\n  {urscript_heat(heat, False)}\nend\n"
 
 
@@ -174,8 +178,9 @@ def set_heat_rtde(io: Any, heat: Heat, on: bool, value: float | None = None) -> 
 
 
 def send_heat_off(host: str, heat: Heat, timeout: float = 2.0) -> str:
-    """Send :func:`heat_off_program` to the controller's secondary interface; returns what
-    happened in words (never raises: it runs on the way out of a failed run)."""
+    """Send :func:`heat_off_program` to the controller's secondary interface.
+
+    Returns what happened in words (never raises: it runs on the way out of a failed run)."""
     try:
         with socket.create_connection((host, SECONDARY_PORT), timeout=timeout) as sock:
             sock.sendall(heat_off_program(heat).encode())

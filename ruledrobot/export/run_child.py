@@ -50,10 +50,12 @@ NICE = -10
 
 
 def raise_priority(rt_priority: int = RT_PRIORITY, nice: int = NICE) -> tuple[bool, str]:
-    """Raise the calling thread's scheduling priority (threads it starts later inherit
-    it): ``SCHED_RR`` ``rt_priority`` where the OS allows (Linux, root or CAP_SYS_NICE),
-    else nice ``nice``; nothing when the environment says ``RULEDROBOT_RUN_PRIORITY=normal``
-    (to measure what the priority does).  Returns (real-time, what it got in words)."""
+    """Raise the calling thread's scheduling priority.
+
+    Threads it starts later inherit it: ``SCHED_RR`` ``rt_priority`` where the OS allows
+    (Linux, root or CAP_SYS_NICE), else nice ``nice``; nothing when the environment says
+    ``RULEDROBOT_RUN_PRIORITY=normal`` (to measure what the priority does).  Returns
+    (real-time, what it got in words)."""
     if os.environ.get("RULEDROBOT_RUN_PRIORITY") == "normal":  # measurements (scripts/)
         return False, "normal priority (RULEDROBOT_RUN_PRIORITY=normal)"
     why = "not supported on this OS"

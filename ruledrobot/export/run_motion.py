@@ -22,8 +22,9 @@ SPIN = 0.0004
 
 
 def wait_until(deadline: float) -> None:
-    """Return at ``time.monotonic()`` >= ``deadline``: sleep, then spin the last
-    :data:`SPIN` seconds (as ur_rtde's ``waitPeriod`` does)."""
+    """Return at ``time.monotonic()`` >= ``deadline``.
+
+    Sleep, then spin the last :data:`SPIN` seconds (as ur_rtde's ``waitPeriod`` does)."""
     while True:
         left = deadline - time.monotonic()
         if left <= 0.0:
@@ -68,8 +69,10 @@ def approach(
 
 
 def preheat(s: Session, seconds: float, heartbeat: float, level: float | None = None) -> None:
-    """Heat the wire (an analog output to the set-point ``level`` when given) and hold still
-    ``seconds`` (a run that starts inside a heat window: the resume of a cut), monitored."""
+    """Heat the wire and hold still ``seconds``, monitored.
+
+    The heat: an analog output to the set-point ``level`` when given.  For a run that starts
+    inside a heat window (the resume of a cut)."""
     s.set_heat(True, level)
     s.link.stage("preheat", heartbeat)
     deadline = time.monotonic() + seconds
@@ -89,10 +92,12 @@ def stream(
     hot: np.ndarray | None = None,
     levels: np.ndarray | None = None,
 ) -> None:
-    """servoJ every controller period, monitored, then hold the last sample until settled.
-    ``hot`` (K,): the wire's heat at each grid sample (switched where it changes);
-    ``levels`` (K,): an analog output's set-points as written (:func:`~.heat.written_levels`
-    of a scheduled power; set where they change), instead.
+    """Stream ``q_grid`` by servoJ every controller period, monitored, then settle.
+
+    After the last sample the arm holds it until settled.  ``hot`` (K,): the wire's heat at
+    each grid sample (switched where it changes); ``levels`` (K,): an analog output's
+    set-points as written (:func:`~.heat.written_levels` of a scheduled power; set where
+    they change), instead.
 
     The stream keeps the plan's schedule on the wall clock: sample ``k`` goes out at
     ``k`` periods after the start.  A period that overran (a switch of the heat, the
@@ -235,11 +240,12 @@ def _play_path(s: Session, q_grid: np.ndarray, block: list[tuple], heartbeat: fl
 
 
 def run_program(s: Session, q_grid: np.ndarray, ops: list[tuple], heartbeat: float) -> None:
-    """A path program (:meth:`~.run_program.PathRun.child_ops`), monitored: the moves
-    between two sleeps as one ur_rtde path, a sleep as a hold, a heat switch through RTDE
-    IO.  The hold before a path is shortened by the shortest time a path of this run took
-    to upload (ur_rtde re-uploads the control script for each path): the arm rests about as
-    long as the plan says, and never less (a longer path takes longer to upload: the
+    """Run a path program (:meth:`~.run_program.PathRun.child_ops`), monitored.
+
+    The moves between two sleeps as one ur_rtde path, a sleep as a hold, a heat switch
+    through RTDE IO.  The hold before a path is shortened by the shortest time a path of this
+    run took to upload (ur_rtde re-uploads the control script for each path): the arm rests
+    about as long as the plan says, and never less (a longer path takes longer to upload: the
     emulator builds its moves before it starts, 0.02 s for 19 moves, 0.8 s for 300)."""
     if not ops:
         return

@@ -37,9 +37,10 @@ __all__ = ["PathRun", "plan_path_run", "run_slice"]
 
 
 def run_slice(traj: Trajectory, start: int, speed_scale: float = 1.0) -> Trajectory:
-    """The samples a run plays, ``start`` to the end, with times from 0 divided by
-    ``speed_scale``: phases, stock ranges, the cut's feed windows (their speeds times
-    ``speed_scale``) and the heat windows carried to the slice's samples."""
+    """Return the samples a run plays, ``start`` to the end, with times from 0.
+
+    Times divided by ``speed_scale``: phases, stock ranges, the cut's feed windows (their
+    speeds times ``speed_scale``) and the heat windows carried to the slice's samples."""
     part = traj.sliced(start)
     meta = part.meta
     cut = meta.cut
@@ -72,10 +73,12 @@ def _move_samples(part: Trajectory, ops: tuple[Op, ...]) -> list[int]:
 
 @dataclass(frozen=True)
 class PathRun:
-    """A run's path program: ``part`` (:func:`run_slice`: the samples from input sample
-    ``start``), its statements ``ops`` (:func:`~.urscript.path_program`), the sample of
-    ``part`` each move goes to (``samples``), and ``check``: the program's motion measured
-    against ``part`` (:func:`~.verify_program.check_path_program`)."""
+    """A run's path program, with the samples it plays and its measured motion.
+
+    ``part`` (:func:`run_slice`: the samples from input sample ``start``), its statements
+    ``ops`` (:func:`~.urscript.path_program`), the sample of ``part`` each move goes to
+    (``samples``), and ``check``: the program's motion measured against ``part``
+    (:func:`~.verify_program.check_path_program`)."""
 
     part: Trajectory = field(repr=False)
     start: int
@@ -115,11 +118,12 @@ class PathRun:
         return Check("path_program", label, c.summary(), limit, "", "", c.ok, True, detail)
 
     def child_ops(self, grid_of: Callable[[int], int]) -> list[tuple]:
-        """The statements for the streaming child: ``("move", joint, target, v, a, r,
-        grid, q_end)`` (``grid``: the controller-period grid sample of the move's end,
-        ``grid_of(sample of part)``; ``q_end``: the plan's joints there), ``("sleep",
-        seconds, grid)`` (grid: where the hold ends) and ``("heat", on, value)`` (value: an
-        analog set-point of a scheduled power, or None)."""
+        """Return the statements for the streaming child.
+
+        ``("move", joint, target, v, a, r, grid, q_end)`` (``grid``: the controller-period grid
+        sample of the move's end, ``grid_of(sample of part)``; ``q_end``: the plan's joints
+        there), ``("sleep", seconds, grid)`` (grid: where the hold ends) and ``("heat", on,
+        value)`` (value: an analog set-point of a scheduled power, or None)."""
         out: list[tuple] = []
         samples = iter(self.samples)
         k = 0
@@ -148,9 +152,10 @@ def plan_path_run(
     acceleration: float = PATH_ACCELERATION,
     wire_tolerance: float,
 ) -> PathRun:
-    """The path program of ``traj`` from sample ``start`` at ``speed_scale``
-    (:func:`~.urscript.path_program`, the same program ``ruledrobot export --mode movel``
-    writes for these samples) and its motion measured against them with
+    """Return the path program of ``traj`` from sample ``start`` and its measured motion.
+
+    At ``speed_scale`` (:func:`~.urscript.path_program`, the same program ``ruledrobot export
+    --mode movel`` writes for these samples); its motion measured against these samples with
     ``wire_tolerance`` m (the plan's unless overridden)."""
     part = run_slice(traj, start, speed_scale)
     ops = tuple(path_program(part, tolerance=tolerance, blend=blend, acceleration=acceleration,

@@ -63,18 +63,19 @@ class Link:
         self.stop: Stop | None = None
 
     def send(self, *msg: Any) -> None:
-        """Send the tuple ``msg``; when the pipe is gone, remember a ``supervisor_lost``
-        :class:`Stop` (raised by the next :meth:`check`) instead of raising.
-        """
+        """Send the tuple ``msg``, remembering a lost pipe instead of raising.
+
+        When the pipe is gone, remember a ``supervisor_lost`` :class:`Stop` (raised by the next
+        :meth:`check`) instead of raising."""
         try:
             self.conn.send(msg)
         except (OSError, EOFError):
             self.stop = self.stop or Stop("supervisor_lost", "the runner's supervisor went away")
 
     def stage(self, name: str, timeout: float) -> None:
-        """Announce step ``name``: the supervisor kills the child when no message
-        follows within ``timeout`` [s].
-        """
+        """Announce step ``name`` to the supervisor.
+
+        The supervisor kills the child when no message follows within ``timeout`` [s]."""
         self.send("stage", name, float(timeout))
 
     def check(self) -> None:
@@ -147,10 +148,10 @@ class Session:
             raise SessionError(f"controller at {self.host} not reachable: {exc}") from None
 
     def state(self) -> dict:
-        """The controller's state before motion: ``robot_mode``, ``safety_mode``,
-        ``runtime_state`` (ints), ``protective``, ``emergency`` (bools) and ``q``, the
-        actual joint angles [rad] (6 floats).
-        """
+        """Return the controller's state before motion.
+
+        ``robot_mode``, ``safety_mode``, ``runtime_state`` (ints), ``protective``,
+        ``emergency`` (bools) and ``q``, the actual joint angles [rad] (6 floats)."""
         r = self.r
         return {
             "robot_mode": int(r.getRobotMode()),
@@ -220,8 +221,9 @@ class Session:
 
     def record(self, ts: float, q: list[float], tcp: list[float],
                outputs: list[float] | None = None) -> None:  # fmt: skip
-        """Append one data package while recording (packages not newer than the
-        last are skipped).
+        """Append one data package while recording.
+
+        Packages not newer than the last are skipped.
 
         Parameters
         ----------
@@ -245,10 +247,11 @@ class Session:
             self._fresh = True
 
     def snapshot(self) -> tuple[float, list[float], list[float], list[float]]:
-        """(controller time, actual q, actual TCP, outputs) of one data package (outputs:
-        the digital output bits and the two standard analog outputs, where the wire's
-        heat is switched): ur_rtde's getters each read the newest package, so a package
-        arriving between them would mix two; the timestamp read again tells."""
+        """Return (controller time, actual q, actual TCP, outputs) of one data package.
+
+        Outputs: the digital output bits and the two standard analog outputs, where the wire's
+        heat is switched.  ur_rtde's getters each read the newest package, so a package arriving
+        between them would mix two; the timestamp read again tells."""
         r = self.r
         for _ in range(4):
             ts = r.getTimestamp()
@@ -260,20 +263,22 @@ class Session:
         return ts, q, tcp, outs
 
     def info(self) -> dict:
-        """The progress so far: ``k_match`` (matched grid sample), ``sent``,
-        ``max_dev`` (largest joint deviation [rad]), ``recording_t0`` (controller time [s]
-        of the recording's first sample, None before), ``skipped``, ``skipped_ranges``
-        (half-open grid sample ranges) and ``max_slip`` [s].
-        """
+        """Return the progress so far.
+
+        ``k_match`` (matched grid sample), ``sent``, ``max_dev`` (largest joint deviation
+        [rad]), ``recording_t0`` (controller time [s] of the recording's first sample, None
+        before), ``skipped``, ``skipped_ranges`` (half-open grid sample ranges) and
+        ``max_slip`` [s]."""
         return {"k_match": self.k_match, "sent": self.sent, "max_dev": self.max_dev,
                 "recording_t0": self._ts0, "skipped": self.skipped,
                 "skipped_ranges": list(self.skipped_ranges),
                 "max_slip": self.max_slip}  # fmt: skip
 
     def keep_schedule(self, k: int, elapsed: float, n: int) -> int:
-        """The sample to send after sample ``k``, ``elapsed`` seconds into a stream of
-        ``n`` samples: ``k + 1``, or the sample due now when periods overran (the ones
-        passed are skipped; the last sample is always sent).  Raises :class:`Stop`
+        """Return the sample to send after sample ``k``, ``elapsed`` seconds into the stream.
+
+        In a stream of ``n`` samples: ``k + 1``, or the sample due now when periods overran (the
+        ones passed are skipped; the last sample is always sent).  Raises :class:`Stop`
         (``client_slow``) when the stream is more than ``max_latency`` behind."""
         due = int(elapsed * self.frequency)  # the sample whose period has begun
         slip = elapsed - (k + 1) / self.frequency
@@ -325,9 +330,9 @@ class Session:
         self._last_poll = self._wall0
 
     def connected(self) -> bool:
-        """Whether the receive interface (and the control one, when made) is connected;
-        False when asking fails.
-        """
+        """Whether the receive interface (and the control one, when made) is connected.
+
+        False when asking fails."""
         try:
             return bool(self.r.isConnected() and (self.c is None or self.c.isConnected()))
         except Exception:
@@ -366,10 +371,12 @@ class Session:
 
     def check_deviation(self, plan: np.ndarray, qa: np.ndarray, upto: int,
                         timed: bool = True, anchored: bool = False) -> None:  # fmt: skip
-        """Deviation of ``qa`` from the nearest plan sample in ``[k_high - window / 4,
-        upto]`` (at most ``window`` ahead of ``k_match``), ``k_high`` the furthest sample
-        matched so far; moves ``k_match`` there.  ``timed`` (streaming: sample ``upto``
-        was commanded now): the arm must also be at most ``window`` samples behind it.
+        """Match ``qa`` to the nearest plan sample; raise :class:`Stop` when it deviates.
+
+        The deviation of ``qa`` from the nearest plan sample in ``[k_high - window / 4, upto]``
+        (at most ``window`` ahead of ``k_match``), ``k_high`` the furthest sample matched so far;
+        moves ``k_match`` there.  ``timed`` (streaming: sample ``upto`` was commanded now): the
+        arm must also be at most ``window`` samples behind it.
 
         The match may step back a little behind the furthest it reached (a quarter of the
         window, about the servo's lag): where the plan creeps (the start of a move from
@@ -431,7 +438,9 @@ class Session:
         return arm > plan_then + 0.1 * self.deviation_limit
 
     def classify(self, what: str, exc: Exception | None = None) -> Stop:
-        """Why did a command fail or return False?  (The stream may be a period behind.)"""
+        """Return the :class:`Stop` that says why a command failed or returned False.
+
+        The stream may be a period behind."""
         deadline = time.monotonic() + 0.1
         while time.monotonic() < deadline:
             try:
@@ -450,8 +459,10 @@ class Session:
     # ------------------------------------------------------------ stopping
 
     def safe_stop(self, mode: str, deceleration: float, budget: float) -> None:
-        """servoStop / stopJ, then stopScript; each best effort, the whole within
-        ``budget`` seconds (else the supervisor kills this process)."""
+        """Stop the arm: servoStop / stopJ, then stopScript, within ``budget`` seconds.
+
+        Each best effort, the whole within ``budget`` seconds (else the supervisor kills this
+        process)."""
         self.link.stage("stopping", budget)
         if self.hot or self.heat is not None:  # the heat first: a still wire burns the foam
             try:
@@ -515,7 +526,9 @@ class Session:
         self.flush(force=True)
 
     def disconnect(self) -> None:
-        """Destroy the interfaces (control first).  ur_rtde's ``disconnect()`` sleeps
-        0.5 s and its destructor calls it again: dropping the last reference is one."""
+        """Destroy the interfaces (control first).
+
+        ur_rtde's ``disconnect()`` sleeps 0.5 s and its destructor calls it again: dropping the
+        last reference is one."""
         self.c = None
         self.r = None

@@ -124,8 +124,10 @@ def _vec(v: np.ndarray, digits: int) -> str:
 
 
 def plan_wire_tolerance(traj: Trajectory, wire_tolerance: float | None = None) -> float:
-    """``wire_tolerance`` [m], or the plan's (the strictest of its cuts', from the
-    sidecar's ``cut``), or 0.5 mm for a trajectory that names no cut."""
+    """Return the wire tolerance [m]: ``wire_tolerance``, or the plan's, or 0.5 mm.
+
+    The plan's: the strictest of its cuts', from the sidecar's ``cut``; 0.5 mm for a
+    trajectory that names no cut."""
     if wire_tolerance is not None:
         return float(wire_tolerance)
     return traj.meta.cut.wire_tolerance if traj.meta.cut is not None else WIRE_TOLERANCE
@@ -140,8 +142,9 @@ def path_program(
     acceleration: float = PATH_ACCELERATION,
     wire_tolerance: float | None = None,
 ) -> list[Op]:
-    """The statements of a movel/movep program of ``traj`` after its initial ``movej``:
-    moves, sleeps and heat switches (:func:`~.decimate.path_steps`; docs/rtde.md).
+    """Return the statements of a movel/movep program of ``traj`` after its initial ``movej``.
+
+    Moves, sleeps and heat switches (:func:`~.decimate.path_steps`; docs/rtde.md).
 
     Waypoints: every phase start, the wire entering and leaving the stock, every heat
     switch, both ends of a dwell; the decimation's tolerances default to a quarter of

@@ -78,7 +78,9 @@ TIE_SPEED = 1e-6
 
 @dataclass(frozen=True)
 class Move:
-    """``movel``/``movep`` to UR pose vector ``pose`` with ``a`` m/s^2, ``v`` m/s, ``r`` m;
+    """A ``movel``/``movep`` (or, with ``joint``, ``movej``) statement of a path program.
+
+    ``movel``/``movep`` to UR pose vector ``pose`` with ``a`` m/s^2, ``v`` m/s, ``r`` m;
     with ``joint`` a ``movej`` to the joints ``pose`` (rad/s^2, rad/s, r m)."""
 
     pose: np.ndarray
@@ -110,9 +112,10 @@ Op = Move | Sleep | Switch
 
 
 class ProgramRefused(ValueError):
-    """A path program would not cut as planned (feed or wire beyond the plan's
-    tolerances): not written.  ``check`` holds the numbers.  The CLI exits 1 (a check
-    fails), not 2: the trajectory is valid, this program of it is not."""
+    """A path program would not cut as planned (feed or wire beyond the plan's tolerances).
+
+    Not written.  ``check`` holds the numbers.  The CLI exits 1 (a check fails), not 2: the
+    trajectory is valid, this program of it is not."""
 
     def __init__(self, message: str, check: ProgramCheck) -> None:
         super().__init__(message)
@@ -147,9 +150,10 @@ class ProgramCheck:
 
     @property
     def ok(self) -> bool:
-        """Whether the program passes: the wire deviation, every cut's face (where the wire
-        is on it) and the feed of every cut without a measured face within tolerance.
-        """
+        """Whether the program passes every check within tolerance.
+
+        The wire deviation, every cut's face (where the wire is on it) and the feed of every
+        cut without a measured face, each within tolerance."""
         return (self.deviation_ok
                 and all(f.max_ok and f.min_ok for f in self.feeds if f.name not in self._faced)
                 and all(f.ok or np.isnan(f.worst) for f in self.faces))  # fmt: skip
@@ -207,10 +211,12 @@ class ProgramCheck:
 def simulate_path_program(
     traj: Trajectory, ops: Sequence[Op], q0: np.ndarray | None = None
 ) -> tuple[np.ndarray, np.ndarray]:
-    """The joint setpoints ``(t, q)`` of a path program's ``ops`` on ``traj``'s robot with
-    its TCP, one per control period from rest at ``q0`` (default the first sample), as
-    the controller generates them: consecutive moves with ``r > 0`` form one blended
-    path (:class:`~ruledrobot.robot.motion.ur_motion.PathMotion`), a move with ``r = 0`` or any
+    """Return the joint setpoints ``(t, q)`` a controller generates for a path program.
+
+    The path program's ``ops`` on ``traj``'s robot with its TCP, one setpoint per control
+    period from rest at ``q0`` (default the first sample), as the controller generates them:
+    consecutive moves with ``r > 0`` form one blended path
+    (:class:`~ruledrobot.robot.motion.ur_motion.PathMotion`), a move with ``r = 0`` or any
     other statement ends it; a sleep holds for whole periods."""
     t, q, _ = _simulate(traj, ops, q0)
     return t, q
@@ -329,10 +335,12 @@ def measure_motion(
     window: float = MATCH_WINDOW,
     level: np.ndarray | None = None,
 ) -> ProgramCheck:
-    """Measure a joint motion ``(t, q)`` of ``traj``'s robot and TCP — a program's
-    generated motion, or what a controller recorded, ``t`` from the start of the plan's
-    first sample — against the plan (module doc); ``level`` (N,): the heat output at each
-    sample (an analog fraction, or 1 / 0 for on / off; None: the plan's power)."""
+    """Measure a joint motion ``(t, q)`` of ``traj``'s robot and TCP against the plan.
+
+    A program's generated motion, or what a controller recorded, ``t`` from the start of
+    the plan's first sample, measured against the plan (module doc); ``level`` (N,): the
+    heat output at each sample (an analog fraction, or 1 / 0 for on / off; None: the plan's
+    power)."""
     t = np.asarray(t, dtype=float)
     robot = model_for(traj.meta)
     poses = robot.fk(np.asarray(q, dtype=float))
@@ -384,9 +392,10 @@ def check_path_program(
     wire_tolerance: float = WIRE_TOLERANCE,
     window: float = MATCH_WINDOW,
 ) -> ProgramCheck:
-    """Generate the motion of ``ops`` (:func:`simulate_path_program`) and measure it
-    against ``traj`` (:func:`measure_motion`).  Returns the figures; raises nothing (see
-    :meth:`ProgramCheck.failures`)."""
+    """Generate the motion of ``ops`` and measure it against ``traj``.
+
+    :func:`simulate_path_program`, then :func:`measure_motion`.  Returns the figures; raises
+    nothing (see :meth:`ProgramCheck.failures`)."""
     t, q, level = _simulate(traj, ops)
     return measure_motion(traj, t, q, wire_tolerance=wire_tolerance, window=window,
                           level=level)  # fmt: skip

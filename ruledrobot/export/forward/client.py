@@ -49,11 +49,12 @@ def _send_program(host: str, text: str, timeout: float) -> None:
 def forward(s: Session, q_grid: np.ndarray, hot: np.ndarray | None, settings: ForwardSettings,
             heat: object, heartbeat: float, connect_timeout: float,
             levels: np.ndarray | None = None) -> None:  # fmt: skip
-    """Play ``q_grid`` (K, 6) on the controller's clock (module doc); ``hot`` (K,) the heat
-    per sample or None; ``levels`` (K,) the analog set-points as written (a scheduled
-    power, :func:`~..heat.written_levels`) or None.  Returns when the program reports
-    ``DONE``; raises :class:`Stop` otherwise (after the program's controlled stop when it
-    still runs)."""
+    """Play ``q_grid`` (K, 6) on the controller's clock (module doc).
+
+    ``hot`` (K,) the heat per sample or None; ``levels`` (K,) the analog set-points as
+    written (a scheduled power, :func:`~..heat.written_levels`) or None.  Returns when the
+    program reports ``DONE``; raises :class:`Stop` otherwise (after the program's controlled
+    stop when it still runs)."""
     K = q_grid.shape[0]
     me = local_address(s.host)
     server = socket.create_server((me, 0))

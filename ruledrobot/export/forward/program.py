@@ -107,8 +107,9 @@ class ForwardSettings:
 
     @property
     def reserve(self) -> int:
-        """Samples a controlled stop needs ahead of the one playing (it covers about half of
-        ``stop_periods``, and two more for the interpolation)."""
+        """Samples a controlled stop needs ahead of the one playing.
+
+        It covers about half of ``stop_periods``, and two more for the interpolation."""
         return self.stop_periods // 2 + 3
 
     @property
@@ -191,10 +192,12 @@ def _heat_set(heat: Heat | None, levels: bool) -> str:
 
 def forward_program(host: str, port: int, settings: ForwardSettings, heat: Heat | None,
                     connect_timeout: float = 10.0, levels: bool = False) -> str:  # fmt: skip
-    """The URScript program of a forwarded run (module doc): it connects to ``host:port``
-    (the runner), fills its buffer, plays the samples, stops along the path when they run
-    short or on request, and reports in :data:`REG_SAMPLE` / :data:`REG_STATE`; with
-    ``levels`` it sets ``heat``'s analog output to each sample's set-point."""
+    """Return the URScript program of a forwarded run (module doc).
+
+    It connects to ``host:port`` (the runner), fills its buffer, plays the samples, stops
+    along the path when they run short or on request, and reports in :data:`REG_SAMPLE` /
+    :data:`REG_STATE`; with ``levels`` it sets ``heat``'s analog output to each sample's
+    set-point."""
     s = settings
     ring = s.ring
     prefill = s.ahead
