@@ -49,6 +49,7 @@ from ...geometry.checks import FloatArray
 from ...robot.wire.in_stock import across_speeds
 from ...robot.wire.kerf import Material
 from ..job.spec import CutSpec, HeatSpec
+from .kerf_corners import corner_ends, corner_error
 from .wire_geometry import chords
 
 __all__ = ["KerfOffsets", "cut_offsets", "face_rulings", "held_kerf", "kept_surface_error",
@@ -105,20 +106,32 @@ class KerfOffsets:
         return out
 
 
-def _derivative(x: FloatArray, closed: bool) -> FloatArray:
-    """d/di of samples x (M, 3): central differences, periodic when ``closed``."""
+def _derivative(x: FloatArray, closed: bool, side: int = 0) -> FloatArray:
+    """d/di of samples x (M, 3): central differences (``side`` 0), backward (-1) or
+    forward (+1) ones; periodic when ``closed``, else one-sided at the ends (where all
+    three agree)."""
     if closed:
-        return 0.5 * (np.roll(x, -1, axis=0) - np.roll(x, 1, axis=0))
-    return np.gradient(x, axis=0)
+        nxt = np.roll(x, -1, axis=0) if side >= 0 else x
+        prv = np.roll(x, 1, axis=0) if side <= 0 else x
+        return (nxt - prv) / (2.0 if side == 0 else 1.0)
+    d = np.gradient(x, axis=0)
+    if side < 0 and len(x) > 1:
+        d[1:] = x[1:] - x[:-1]
+    elif side > 0 and len(x) > 1:
+        d[:-1] = x[1:] - x[:-1]
+    return d
 
 
-def ruling_normals(frames: FloatArray, t: FloatArray, closed: bool = False) -> FloatArray:
-    """Return unit normals of the surface swept by the frames' z axes at wire parameters ``t``.
-
-    Normals (M, K, 3) at ``t`` (M, K) [m along z from the origin]: ``z x (o' + t z')``.
-    """
+def ruling_normals(
+    frames: FloatArray, t: FloatArray, closed: bool = False, side: int = 0
+) -> FloatArray:
+    """Unit normals (M, K, 3) of the surface swept by the frames' z axes at wire
+    parameters ``t`` (M, K) [m along z from the origin], ``z x (o' + t z')``; ``side``
+    -1 / +1: of the face behind / ahead of each ruling (one-sided differences: at a
+    sharp corner of the path the two differ, :mod:`.kerf_corners`), 0 their mean
+    direction (central differences)."""
     o, z = frames[:, :3, 3], frames[:, :3, 2]
-    do, dz = _derivative(o, closed), _derivative(z, closed)
+    do, dz = _derivative(o, closed, side), _derivative(z, closed, side)
     tangent = do[:, None, :] + t[..., None] * dz[:, None, :]
     n = np.cross(np.broadcast_to(z[:, None, :], tangent.shape), tangent)
     norm = np.linalg.norm(n, axis=-1, keepdims=True)
@@ -169,12 +182,11 @@ def waste_sign(
 def kerf_offsets(
     frames: FloatArray, stock: Box, kerf: float, keep: str | FloatArray | None, closed: bool
 ) -> KerfOffsets:
-    """Return the minimax offsets of every ruling towards the waste by ``kerf / 2``.
-
-    The offsets are the module doc's; zero offsets when ``keep`` is None or ``kerf`` is 0.
-    Rulings that miss the stock get the offset of the nearest ruling that crosses it (the
-    lead-in/out keeps its side).
-    """
+    """The minimax offsets (module doc) of every ruling towards the waste by ``kerf / 2``;
+    zero offsets when ``keep`` is None or ``kerf`` is 0.  At a sharp corner of the path the
+    wire's ends go to the corner points of the offset profile (:mod:`.kerf_corners`; the
+    wire then turns: ``turn``).  Rulings that miss the stock get the offset of the nearest
+    ruling that crosses it (the lead-in/out keeps its side)."""
     M = frames.shape[0]
     if keep is None or kerf <= 0.0:
         return KerfOffsets(np.zeros((M, 3)), np.zeros(M), False)
@@ -191,13 +203,67 @@ def kerf_offsets(
     r = 0.5 * kerf
     length = 2.0 * r / (1.0 + np.cos(half))
     offset = length[:, None] * bis
-    idx = np.flatnonzero(hit)
-    nearest = idx[np.clip(np.searchsorted(idx, np.arange(M)), 0, idx.size - 1)]
-    left = idx[np.clip(np.searchsorted(idx, np.arange(M)) - 1, 0, idx.size - 1)]
-    nearest = np.where(np.abs(left - np.arange(M)) < np.abs(nearest - np.arange(M)), left, nearest)
-    offset = np.where(hit[:, None], offset, offset[nearest])
     err = np.abs(np.einsum("mi,mki->mk", offset, n) - r).max(axis=1)
-    return KerfOffsets(offset, np.where(hit, err, 0.0), True)
+    P = frames[:, None, :3, 3] + t[..., None] * frames[:, None, :3, 2]  # (M, K, 3)
+    ends, turn = _corners(frames, t, P[:, [0, -1]] + offset[:, None, :], np.full((M, 2), r),
+                          sign, closed, hit)  # fmt: skip
+    if turn is not None:  # the rulings at the corners: the line through their moved ends
+        at = ~np.isnan(ends[:, 0, 0])
+        o, z = frames[at, :3, 3], frames[at, :3, 2]
+        wo, _ = _line_through(ends[at], t[at, 0], z)
+        offset[at] = wo - o
+        W = ends[at, :1] + np.linspace(0.0, 1.0, SAMPLES)[None, :, None] * (
+            ends[at, 1:] - ends[at, :1])  # fmt: skip
+        err[at] = _corner_error(frames, t, W, P, np.full(t.shape, r), sign, closed, at)
+    nearest = _nearest_hit(hit)
+    offset = np.where(hit[:, None], offset, offset[nearest])
+    turn = None if turn is None else turn[nearest]
+    return KerfOffsets(offset, np.where(hit, err, 0.0), True, turn)
+
+
+def _line_through(ends: FloatArray, c0: FloatArray, z: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """The wire's origin and direction (K, 3) through moved chord ends ``ends`` (K, 2, 3),
+    its first end at parameter ``c0`` (K,) like the target's (``z`` (K, 3) where the ends
+    coincide)."""
+    d = ends[:, 1] - ends[:, 0]
+    length = np.linalg.norm(d, axis=1, keepdims=True)
+    wz = np.where(length > 0.0, d / np.where(length > 0, length, 1.0), z)
+    return ends[:, 0] - c0[:, None] * wz, wz
+
+
+def _corners(
+    frames: FloatArray, t: FloatArray, moved: FloatArray, half: FloatArray, sign: float,
+    closed: bool, hit: np.ndarray,
+) -> tuple[FloatArray, FloatArray | None]:
+    """The chord ends (M, 2, 3) moved at the path's sharp corners (:func:`.kerf_corners.
+    corner_ends`; NaN at the rulings that did not change) and the wire's turn (M, 3, 3)
+    (identity elsewhere; None: no corner)."""
+    te = t[:, [0, -1]]
+    back = sign * ruling_normals(frames, te, closed, -1)
+    ahead = sign * ruling_normals(frames, te, closed, 1)
+    target = frames[:, None, :3, 3] + te[..., None] * frames[:, None, :3, 2]
+    z = frames[:, :3, 2]
+    ends, changed, _ = corner_ends(target, moved, z, back, ahead, half, sign, closed, hit)
+    if not changed.any():
+        return np.full(moved.shape, np.nan), None
+    turn = np.broadcast_to(np.eye(3), (len(z), 3, 3)).copy()
+    _, wz = _line_through(ends[changed], te[changed, 0], z[changed])
+    turn[changed] = _rotation_between(z[changed], wz)
+    return np.where(changed[:, None, None], ends, np.nan), turn
+
+
+def _corner_error(
+    frames: FloatArray, t: FloatArray, W: FloatArray, P: FloatArray, half: FloatArray,
+    sign: float, closed: bool, at: np.ndarray,
+) -> FloatArray:
+    """:func:`.kerf_corners.corner_error` of rulings ``at`` (M,) whose moved wire has the
+    points ``W`` (K, S, 3) over the target samples ``P`` (M, S, 3) at ``t`` (M, S), half
+    kerfs ``half`` (M, S); the face behind and ahead of each."""
+    back = sign * ruling_normals(frames, t, closed, -1)
+    ahead = sign * ruling_normals(frames, t, closed, 1)
+    full = np.array(P)
+    full[at] = W
+    return corner_error(full, P, back, ahead, half, closed)[at]
 
 
 def kept_surface_error(
@@ -306,20 +372,21 @@ def point_kerf_offsets(
         ref = np.max(v, axis=1, keepdims=True)
         ratio = np.where(ref > 0.0, v / np.where(ref > 0.0, ref, 1.0), 1.0)
         w = held_kerf(ratio, cut, heat, material)  # (M, K)
-        A = P[:, 0] + 0.5 * w[:, :1] * n[:, 0]
-        B = P[:, -1] + 0.5 * w[:, -1:] * n[:, -1]
-        d = B - A
-        length = np.linalg.norm(d, axis=1, keepdims=True)
-        wz = np.where(length > 0.0, d / np.where(length > 0, length, 1.0), z)
-        wo = A - c[:, :1] * wz
+        ends = P[:, [0, -1]] + 0.5 * w[:, [0, -1], None] * n[:, [0, -1]]
+        at_corner, _ = _corners(frames, t, ends, 0.5 * w[:, [0, -1]], sign, closed, hit)
+        ends = np.where(np.isnan(at_corner), ends, at_corner)
+        wo, wz = _line_through(ends, c[:, 0], z)
         # rulings that miss the stock move as the nearest that crosses it (their speeds
         # are differences with their neighbours: an unmoved neighbour would add a jump)
         turn = _rotation_between(z, wz)[near]
         offset = (wo - o)[near]
         wo, wz = o + offset, np.einsum("mij,mj->mi", turn, z)
     # the kept surface: the moved line against each target tangent plane, half a kerf off
-    W = A[:, None, :] + u[None, :, None] * (B - A)[:, None, :]
+    W = ends[:, :1] + u[None, :, None] * (ends[:, 1:] - ends[:, :1])
     err = np.abs(np.einsum("mki,mki->mk", W - P, n) - 0.5 * w).max(axis=1)
+    at = ~np.isnan(at_corner[:, 0, 0])
+    if at.any():
+        err[at] = _corner_error(frames, t, W[at], P, 0.5 * w, sign, closed, at)
     end = np.where(hit[:, None], w[:, [0, -1]], np.nan)
     return KerfOffsets(offset, np.where(hit, err, 0.0), True, turn, end)
 

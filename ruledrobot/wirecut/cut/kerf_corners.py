@@ -1,0 +1,166 @@
+"""Sharp corners of a compensated path: the wire at the corner point of the offset profile.
+
+Where the path turns sharply (a polygon's corner, kept by the refinement, where the wire
+stops: :mod:`..motion.corners`) the surface has two tangent planes at a chord end ``P``
+of the corner ruling: the face behind (rulings ``i - 1, i``), unit normal ``a`` into the
+waste, and the face ahead (``i, i + 1``), ``b`` (one-sided differences,
+:func:`.kerf.ruling_normals` with ``side``).  A wire end moved to ``P + d`` lies ``d . a``
+from the face behind and ``d . b`` from the face ahead; the kerf leaves both where they
+should be when ``d . a = h_a`` and ``d . b = h_b`` (``h`` the half kerfs of the two faces
+there: the neighbouring rulings' at that end).  In the plane of ``a`` and ``b`` (normal
+to the ruling), with ``c = a . b``::
+
+    d = alpha a + beta b,   alpha = (h_a - c h_b) / (1 - c^2),   beta = (h_b - c h_a) / (1 - c^2)
+
+With ``h_a = h_b = h``: ``d = h (a + b) / (1 + c)``, of length ``h / cos(theta / 2)``
+along the bisector (``theta`` the angle between the normals: the path's turn there) --
+the corner point of the offset profile, the intersection of the two offset faces, for a
+convex corner (the waste outside the angle: the point lies past the corner) and a
+concave one (the waste inside: it lies short of it) alike.  The bisector's offset ``h``
+falls short by ``h (1 / cos(theta / 2) - 1)`` (0.17 mm at 90 degrees, 0.8 mm kerf).
+
+**Concave corners.** There the two offset faces meet before the corner: a neighbour whose
+moved end lies past the corner point along the travel on its face (nearer the corner than
+``h tan(theta / 2)``) would carry the wire past it, into the face ahead.  Such ends
+(the run of them next to the corner, with any short of it by less than half a step) are
+spread evenly along the line from the nearest end short of the point to the point, in
+order, so the wire neither overruns nor doubles back nor stands (a convex corner's point
+lies ahead of every end on both faces: nothing moves).  Where the path's end or another
+corner comes first, the run is left as it is (``face_error`` judges).
+
+**Mitre limit.** A turn near 180 degrees (a thin wedge) puts the point far out: ``|d|``
+is held to :data:`MITRE_LIMIT` half kerfs (turns up to 175.4 degrees are exact; a
+sharper wedge's tip is rounded, and ``face_error`` judges it).
+
+A chord end is a corner where its two normals differ by more than
+:data:`~..motion.corners.CORNER_ANGLE` (the turn at which the wire stops); elsewhere the
+normals of a refined surface differ by a fraction of a degree and the offset along the
+central normal stands.  Units: m; the frame of the rulings.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ...geometry.checks import FloatArray
+from ..motion.corners import CORNER_ANGLE
+
+__all__ = ["MITRE_LIMIT", "corner_ends", "corner_error", "mitre"]
+
+#: the largest offset of a corner's wire end from the corner, in half kerfs
+#: (``1 / cos(theta / 2)`` reaches 25 at a turn of 175.4 degrees)
+MITRE_LIMIT = 25.0
+
+
+def mitre(a: FloatArray, b: FloatArray, h_a: FloatArray, h_b: FloatArray) -> FloatArray:
+    """The offsets ``d`` (..., 3) [m] from a corner with ``d . a = h_a`` and ``d . b = h_b``
+    in the plane of the unit normals ``a``, ``b`` (..., 3) (module doc), held to
+    :data:`MITRE_LIMIT` ``max(h_a, h_b)``; half kerfs ``h_a``, ``h_b`` (...,) [m]."""
+    c = np.einsum("...i,...i->...", a, b)
+    s2 = np.maximum(1.0 - c * c, 1e-300)
+    alpha, beta = (h_a - c * h_b) / s2, (h_b - c * h_a) / s2
+    d = alpha[..., None] * a + beta[..., None] * b
+    size = np.linalg.norm(d, axis=-1)
+    top = MITRE_LIMIT * np.maximum(h_a, h_b)
+    return d * np.where(size > top, top / np.maximum(size, 1e-300), 1.0)[..., None]
+
+
+def _neighbours(M: int, closed: bool) -> tuple[np.ndarray, np.ndarray]:
+    """(M,) the index before and after each ruling (periodic when ``closed``, else the
+    ruling itself at the ends)."""
+    i = np.arange(M)
+    if closed:
+        return np.roll(i, 1), np.roll(i, -1)
+    return np.maximum(i - 1, 0), np.minimum(i + 1, M - 1)
+
+
+def _is_corner(back: FloatArray, ahead: FloatArray) -> np.ndarray:
+    """Where the normals behind and ahead (..., 3) differ by more than the corner angle."""
+    ok = (np.linalg.norm(back, axis=-1) > 0.5) & (np.linalg.norm(ahead, axis=-1) > 0.5)
+    return ok & (np.einsum("...i,...i->...", back, ahead) < np.cos(CORNER_ANGLE))
+
+
+def corner_ends(
+    target: FloatArray, moved: FloatArray, z: FloatArray, back: FloatArray,
+    ahead: FloatArray, half: FloatArray, sign: float, closed: bool, hit: np.ndarray,
+) -> tuple[FloatArray, np.ndarray, np.ndarray]:
+    """The moved chord ends with the path's sharp corners taken to the offset profile's
+    corner points (module doc).
+
+    ``target`` (M, 2, 3) [m] the target rulings' chord ends; ``moved`` (M, 2, 3) the ends
+    moved off the corners' way (along the central normals); ``z`` (M, 3) the rulings'
+    directions; ``back``, ``ahead`` (M, 2, 3) the unit normals of the faces behind and
+    ahead at the ends, into the waste (``sign`` times the sweep's ``z x tangent``);
+    ``half`` (M, 2) [m] the half kerfs at the ends; ``hit`` (M,) the rulings crossing the
+    stock.  Returns the ends (M, 2, 3), the rulings whose ends changed (M,) and the
+    corner ends (M, 2)."""
+    M = target.shape[0]
+    out = np.array(moved, dtype=np.float64)
+    before, after = _neighbours(M, closed)
+    corner = _is_corner(back, ahead) & hit[:, None] & hit[before, None] & hit[after, None]
+    changed = corner.any(axis=1)
+    if not changed.any():
+        return out, changed, corner
+    h_a = np.where(np.isfinite(half[before]), half[before], half)
+    h_b = np.where(np.isfinite(half[after]), half[after], half)
+    ii, ee = np.nonzero(corner)
+    X = target[ii, ee] + mitre(back[ii, ee], ahead[ii, ee], h_a[ii, ee], h_b[ii, ee])
+    # the travel on each face, normal to the ruling: (sign n) x z points along the sweep
+    travel_in = sign * np.cross(back[ii, ee], z[ii])
+    travel_out = sign * np.cross(ahead[ii, ee], z[ii])
+    base = out.copy()
+    for k in range(ii.size):  # a few corners: walk the (short) runs of ends past them
+        i, e = int(ii[k]), int(ee[k])
+        out[i, e] = X[k]
+        for step, T in ((-1, travel_in[k]), (1, travel_out[k])):
+            run, j = _run_past(base[:, e], target[:, e], X[k], T, i, step, closed,
+                               corner[:, e] | ~hit)  # fmt: skip
+            if run and j is not None:
+                anchor = base[j, e]
+                f = np.arange(1, len(run) + 1) / (len(run) + 1.0)
+                out[run, e] = X[k] + f[:, None] * (anchor - X[k])
+                changed[run] = True
+    return out, changed, corner
+
+
+def _run_past(
+    ends: FloatArray, target: FloatArray, X: FloatArray, T: FloatArray, i: int, step: int,
+    closed: bool, stop: np.ndarray,
+) -> tuple[list[int], int | None]:
+    """The ends (M, 3) next to corner ``i`` on one side (``step`` -1: behind, travelling
+    along ``T`` into it; +1: ahead, travelling along ``T`` out of it) that lie past the
+    corner point ``X`` along their face, or short of it by less than half their step along
+    the ``target`` ends (M, 3) (spread over less, the wire would nearly stand), nearest
+    first; and the index of the first end short of it (None: the path's end or another
+    corner came first)."""
+    M = ends.shape[0]
+    run: list[int] = []
+    j = i + step
+    while len(run) < M - 1:
+        if closed:
+            j %= M
+        elif not 0 <= j < M:
+            return run, None
+        if stop[j] or j == i:
+            return run, None
+        gap = float(np.linalg.norm(target[j] - target[(j - step) % M]))
+        if -step * float((ends[j] - X) @ T) <= -0.5 * gap:
+            return run, j
+        run.append(j)
+        j += step
+    return run, None
+
+
+def corner_error(
+    wire: FloatArray, target: FloatArray, back: FloatArray, ahead: FloatArray,
+    half: FloatArray, closed: bool,
+) -> FloatArray:
+    """The kept surface's largest error (M,) [m] at corner rulings: the wire's points
+    ``wire`` (M, K, 3) against the two faces' tangent planes at the target points
+    ``target`` (M, K, 3), normals ``back``, ``ahead`` (M, K, 3) into the waste, each
+    half a kerf off: the neighbours' ``half`` (M, K) [m] on its side."""
+    before, after = _neighbours(target.shape[0], closed)
+    d = wire - target
+    e_in = np.abs(np.einsum("mki,mki->mk", d, back) - half[before])
+    e_out = np.abs(np.einsum("mki,mki->mk", d, ahead) - half[after])
+    return np.maximum(e_in, e_out).max(axis=1)
