@@ -53,7 +53,8 @@ from .kerf_corners import corner_ends, corner_error
 from .wire_geometry import chords
 
 __all__ = ["KerfOffsets", "cut_offsets", "face_rulings", "held_kerf", "kept_surface_error",
-           "kerf_offsets", "on_power", "point_kerf_offsets", "ruling_normals", "waste_sign"]
+           "kerf_offsets", "offset_ends", "on_power", "point_kerf_offsets", "ruling_normals",
+           "waste_sign"]
 
 #: points per chord at which the normals are sampled
 SAMPLES = 9
@@ -221,6 +222,24 @@ def kerf_offsets(
     return KerfOffsets(offset, np.where(hit, err, 0.0), True, turn)
 
 
+def offset_ends(
+    frames: FloatArray, chord: FloatArray, half: FloatArray, sign: float, closed: bool = False,
+    hit: np.ndarray | None = None,
+) -> tuple[FloatArray, np.ndarray]:
+    """The chord ends (M, 2, 3) [m] of rulings ``frames`` (M, 4, 4) at ``chord`` (M, 2) [m
+    along z] each moved by its half kerf ``half`` (M, 2) [m] into the waste (``sign`` times
+    the normal ``z x (o' + t z')``): along the normal, or at a sharp corner of the path to
+    the offset profile's corner point (:func:`.kerf_corners.corner_ends`); and the rulings
+    (M,) whose ends the corners moved.  ``hit`` (M,): the rulings in the stock (default
+    all)."""
+    hit = np.ones(len(frames), dtype=bool) if hit is None else hit
+    n = sign * ruling_normals(frames, chord, closed)
+    ends = frames[:, None, :3, 3] + chord[..., None] * frames[:, None, :3, 2]
+    ends = ends + half[..., None] * n
+    at_corner, _ = _corners(frames, chord, ends, half, sign, closed, hit)
+    return np.where(np.isnan(at_corner), ends, at_corner), ~np.isnan(at_corner[:, 0, 0])
+
+
 def _line_through(ends: FloatArray, c0: FloatArray, z: FloatArray) -> tuple[FloatArray, FloatArray]:
     """The wire's origin and direction (K, 3) through moved chord ends ``ends`` (K, 2, 3),
     its first end at parameter ``c0`` (K,) like the target's (``z`` (K, 3) where the ends
@@ -372,9 +391,7 @@ def point_kerf_offsets(
         ref = np.max(v, axis=1, keepdims=True)
         ratio = np.where(ref > 0.0, v / np.where(ref > 0.0, ref, 1.0), 1.0)
         w = held_kerf(ratio, cut, heat, material)  # (M, K)
-        ends = P[:, [0, -1]] + 0.5 * w[:, [0, -1], None] * n[:, [0, -1]]
-        at_corner, _ = _corners(frames, t, ends, 0.5 * w[:, [0, -1]], sign, closed, hit)
-        ends = np.where(np.isnan(at_corner), ends, at_corner)
+        ends, at = offset_ends(frames, t[:, [0, -1]], 0.5 * w[:, [0, -1]], sign, closed, hit)
         wo, wz = _line_through(ends, c[:, 0], z)
         # rulings that miss the stock move as the nearest that crosses it (their speeds
         # are differences with their neighbours: an unmoved neighbour would add a jump)
@@ -384,7 +401,6 @@ def point_kerf_offsets(
     # the kept surface: the moved line against each target tangent plane, half a kerf off
     W = ends[:, :1] + u[None, :, None] * (ends[:, 1:] - ends[:, :1])
     err = np.abs(np.einsum("mki,mki->mk", W - P, n) - 0.5 * w).max(axis=1)
-    at = ~np.isnan(at_corner[:, 0, 0])
     if at.any():
         err[at] = _corner_error(frames, t, W[at], P, 0.5 * w, sign, closed, at)
     end = np.where(hit[:, None], w[:, [0, -1]], np.nan)

@@ -109,46 +109,58 @@ def corner_ends(
     travel_in = sign * np.cross(back[ii, ee], z[ii])
     travel_out = sign * np.cross(ahead[ii, ee], z[ii])
     base = out.copy()
-    for k in range(ii.size):  # a few corners: walk the (short) runs of ends past them
+    reach = np.linalg.norm(X - target[ii, ee], axis=1)
+    for k in range(ii.size):  # a few corners: mend the (short) stretches beside them
         i, e = int(ii[k]), int(ee[k])
         out[i, e] = X[k]
-        for step, T in ((-1, travel_in[k]), (1, travel_out[k])):
-            run, j = _run_past(base[:, e], target[:, e], X[k], T, i, step, closed,
-                               corner[:, e] | ~hit)  # fmt: skip
-            if run and j is not None:
-                anchor = base[j, e]
-                f = np.arange(1, len(run) + 1) / (len(run) + 1.0)
-                out[run, e] = X[k] + f[:, None] * (anchor - X[k])
-                changed[run] = True
+        for step, T in ((-1, -travel_in[k]), (1, travel_out[k])):
+            rows = _beside(target[:, e], i, step, closed, corner[:, e] | ~hit, reach[k])
+            if rows.size:
+                mended = _monotone(base[rows, e], target[rows, e], X[k], T, target[i, e])
+                changed[rows] |= (mended != base[rows, e]).any(axis=1)
+                out[rows, e] = mended
     return out, changed, corner
 
 
-def _run_past(
-    ends: FloatArray, target: FloatArray, X: FloatArray, T: FloatArray, i: int, step: int,
-    closed: bool, stop: np.ndarray,
-) -> tuple[list[int], int | None]:
-    """The ends (M, 3) next to corner ``i`` on one side (``step`` -1: behind, travelling
-    along ``T`` into it; +1: ahead, travelling along ``T`` out of it) that lie past the
-    corner point ``X`` along their face, or short of it by less than half their step along
-    the ``target`` ends (M, 3) (spread over less, the wire would nearly stand), nearest
-    first; and the index of the first end short of it (None: the path's end or another
-    corner came first)."""
-    M = ends.shape[0]
-    run: list[int] = []
-    j = i + step
-    while len(run) < M - 1:
-        if closed:
-            j %= M
-        elif not 0 <= j < M:
-            return run, None
-        if stop[j] or j == i:
-            return run, None
-        gap = float(np.linalg.norm(target[j] - target[(j - step) % M]))
-        if -step * float((ends[j] - X) @ T) <= -0.5 * gap:
-            return run, j
-        run.append(j)
-        j += step
-    return run, None
+def _beside(target: FloatArray, i: int, step: int, closed: bool, stop: np.ndarray,
+            reach: float) -> np.ndarray:  # fmt: skip
+    """The rulings next to corner ``i`` on one side (``step`` -1 behind, +1 ahead), nearest
+    first, up to the first whose target end lies more than twice the corner point's
+    distance ``reach`` [m] from the corner's and three more (or to another corner, a
+    ruling off the stock or the path's end)."""
+    M = target.shape[0]
+    j = i + step * np.arange(1, M)
+    j = np.mod(j, M) if closed else j[(j >= 0) & (j < M)]
+    bad = stop[j] | (j == i)
+    j = j[: int(np.argmax(bad)) if bad.any() else j.size]
+    far = np.linalg.norm(target[j] - target[i], axis=1) > 2.0 * reach
+    return j[: int(np.argmax(far)) + 4 if far.any() else j.size]
+
+
+def _monotone(ends: FloatArray, target: FloatArray, X: FloatArray, T: FloatArray,
+              corner: FloatArray) -> FloatArray:  # fmt: skip
+    """The moved ends ``ends`` (K, 3) of the rulings beside a corner, nearest first, mended
+    so that they go away from the corner point ``X`` (3,) along ``T`` (3,) in order: an end
+    not ahead of every nearer one (and ``X``) by half its target step, or not behind
+    every farther one, is moved onto the line between the kept ends on either side of
+    it, spaced by index (``target`` (K, 3) their target ends, ``corner`` the corner's)."""
+    s = (ends - X) @ T
+    prev = np.vstack([corner[None, :], target[:-1]])
+    half_gap = 0.5 * np.linalg.norm(target - prev, axis=1)
+    before = np.maximum.accumulate(np.r_[0.0, s[:-1]])
+    after = np.minimum.accumulate(np.r_[s[1:], np.inf][::-1])[::-1]
+    good = (s > before + half_gap) & (s < after)
+    if good.all() or not good.any():
+        return ends
+    pos = np.flatnonzero(good) + 1.0  # the kept ends' places, X at place 0
+    anchors = np.vstack([X[None, :], ends[good]])
+    place = np.arange(1, len(ends) + 1, dtype=np.float64)
+    out = np.array(ends)
+    fill = ~good & (place < pos[-1])  # past the last kept end: left as they are
+    knots = np.r_[0.0, pos]
+    for c in range(3):
+        out[fill, c] = np.interp(place[fill], knots, anchors[:, c])
+    return out
 
 
 def corner_error(
