@@ -30,11 +30,15 @@ predicted there along the normal ``n`` into the waste, ``P + w / 2 n``, and the 
 the line through the two moved ends (still a ruling: the frame turns by the smallest
 rotation from the old direction to the new).  The moved wire has other speeds, so the
 ratios are taken again on it, :data:`ROUNDS` times (the offsets change by less than a
-micrometre after two).  Kerf per end (:func:`held_kerf`): ``constant`` and ``on_off``
-``w = material.kerf(feed * ratio, p)`` with ``p`` the power while on
-(:func:`on_power`); ``constant_kerf`` ``w = kerf_base + (kerf - kerf_base) / ratio``
-(the power that holds ``kerf`` at the reference point, ``p0 + (kerf - kerf_base)
-feed / kerf_gain``, melts that at the end moving ``ratio`` as fast).
+micrometre after two).  Kerf per end (:func:`.heat_power.held_kerf`):
+``w = material.kerf(feed * ratio, p)`` with ``p`` the power the heat schedule sets at the
+feed (:func:`.heat_power.set_power`, clipped at the output's ``full_scale``); unclipped
+``constant_kerf`` gives ``w = kerf_base + (kerf - kerf_base) / ratio`` (the power that
+holds ``kerf`` at the reference point melts that at the end moving ``ratio`` as fast).
+
+**Sharp corners** (:mod:`.kerf_corners`): where the path turns by more than the corner
+angle, each end goes to the corner point of the offset profile (the two offset faces'
+intersection) instead of along the bisecting normal, with or without a material.
 """
 
 from __future__ import annotations
@@ -49,12 +53,12 @@ from ...geometry.checks import FloatArray
 from ...robot.wire.in_stock import across_speeds
 from ...robot.wire.kerf import Material
 from ..job.spec import CutSpec, HeatSpec
+from .heat_power import held_kerf
 from .kerf_corners import corner_ends, corner_error
 from .wire_geometry import chords
 
-__all__ = ["KerfOffsets", "cut_offsets", "face_rulings", "held_kerf", "kept_surface_error",
-           "kerf_offsets", "offset_ends", "on_power", "point_kerf_offsets", "ruling_normals",
-           "waste_sign"]
+__all__ = ["KerfOffsets", "cut_offsets", "face_rulings", "kept_surface_error", "kerf_offsets",
+           "offset_ends", "point_kerf_offsets", "ruling_normals", "waste_sign"]
 
 #: points per chord at which the normals are sampled
 SAMPLES = 9
@@ -308,35 +312,6 @@ def kept_surface_error(
     return np.where(hit, np.abs(dist - 0.5 * kerf).max(axis=1), 0.0)
 
 
-def on_power(cut: CutSpec, heat: HeatSpec | None, material: Material) -> float:
-    """Return the wire's power [W/m] while the heat is on (modes ``on_off``, ``constant``).
-
-    In the modes ``on_off`` and ``constant`` (docs/kerf.md): ``[tool] heat power`` when
-    given (clipped to ``full_scale`` on an analog output), else the power that melts the
-    cut's ``kerf`` at its feed (the supply set up for the nominal kerf).
-    """
-    if heat is not None and heat.power is not None:
-        top = heat.full_scale if heat.kind == "analog" and heat.full_scale else np.inf
-        return float(min(heat.power, top))
-    return float(material.power_for_kerf(max(cut.kerf, material.kerf_base), cut.feed_speed))
-
-
-def held_kerf(
-    ratio: ArrayLike, cut: CutSpec, heat: HeatSpec | None, material: Material
-) -> FloatArray:
-    """Return the kerf [m] at chord points moving ``ratio`` times as fast as the reference.
-
-    The kerf has ``ratio``'s shape; ``ratio`` <= 1, relative to the reference point, which
-    the time law holds at the cut's feed (module doc): ``constant_kerf`` ``kerf_base +
-    (kerf - kerf_base) / ratio``, else ``material.kerf(feed * ratio, on_power)``.
-    """
-    r = np.asarray(ratio, dtype=np.float64)
-    if heat is not None and heat.mode == "constant_kerf":
-        with np.errstate(divide="ignore"):
-            return material.kerf_base + (cut.kerf - material.kerf_base) / r
-    return material.kerf(cut.feed_speed * r, on_power(cut, heat, material))
-
-
 def _rotation_between(a: FloatArray, b: FloatArray) -> FloatArray:
     """(M, 3, 3) the smallest rotations taking unit vectors ``a`` (M, 3) to ``b`` (M, 3)
     (Rodrigues: ``I + [v]x + [v]x^2 / (1 + c)``, ``v = a x b``, ``c = a . b``)."""
@@ -364,9 +339,9 @@ def point_kerf_offsets(
     """Return the per-point compensation (module doc) of the target rulings ``frames``.
 
     ``frames`` (M, 4, 4): each chord end is moved by half the kerf predicted there
-    (:func:`held_kerf`) into the waste, ``rounds`` times with the speed ratios of the moved
-    wire.  Rulings that miss the stock, or whose chord is shorter than :data:`SHORT_CHORD`,
-    get the offset and turn of the nearest ruling with a longer chord.
+    (:func:`.heat_power.held_kerf`) into the waste, ``rounds`` times with the speed ratios
+    of the moved wire.  Rulings that miss the stock, or whose chord is shorter than
+    :data:`SHORT_CHORD`, get the offset and turn of the nearest ruling with a longer chord.
     """
     M = frames.shape[0]
     sign = waste_sign(frames, stock, cut.keep, closed)

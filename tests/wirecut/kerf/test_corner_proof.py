@@ -131,3 +131,17 @@ def test_a_prism_loop_is_cut_to_its_offset_profile(tmp_path, shape, material):
     profile = (square if shape == "square" else ell)(tmp_path, heat, material)
     traj = _plan(profile)
     _assert_within(_check(profile, traj, True), traj)
+
+
+def test_on_off_heat_burns_at_a_corner_stop_and_says_what_to_do(tmp_path):
+    """With [material] the wire's power while on stays while it stops at a corner: a burn
+    (face_error inf), whose message names the fix."""
+    from ruledrobot.wirecut.report.outcome import plan_outcome
+
+    profile = corner(tmp_path, 90.0, True, DIGITAL, True)
+    plan = make_plan(load_job(profile.job))
+    _, verdict = plan_outcome(plan, None)
+    check = verdict["face_error"]
+    assert check.gating and not check.ok and check.value == float("inf")
+    assert "at a corner stop" in check.detail
+    assert 'mode = "constant_kerf" on an analog output' in check.detail

@@ -17,6 +17,7 @@ from ruledrobot.wirecut.cut.kerf import offset_ends
 
 TOL = 1e-4  # m, the cuts' default tolerance
 STEP = 0.005  # m between rulings along the directrix
+START = np.array([0.5, 0.0, 0.3])  # m, the first ruling's origin
 
 
 def _strip(n: int, bend: float, corner: float, at: int, twist: float) -> np.ndarray:
@@ -27,7 +28,7 @@ def _strip(n: int, bend: float, corner: float, at: int, twist: float) -> np.ndar
     turn[at] += corner  # heading[j] - heading[j - 1] = turn[j]: the turn at ruling j
     heading = np.concatenate([[0.0], np.cumsum(turn[1:])])
     d = np.stack([np.cos(heading), np.zeros(n - 1), np.sin(heading)], axis=1)
-    o = np.concatenate([np.zeros((1, 3)), np.cumsum(STEP * d, axis=0)]) + [0.5, 0.0, 0.3]
+    o = np.concatenate([np.zeros((1, 3)), np.cumsum(STEP * d, axis=0)]) + START
     travel = np.vstack([d, d[-1:]])
     phi = twist * (np.arange(n) - n / 2)
     z = np.array([0.0, 1.0, 0.0]) * np.cos(phi)[:, None] + np.cross(
