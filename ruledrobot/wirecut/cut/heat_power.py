@@ -19,16 +19,18 @@ __all__ = ["burn_advice", "clipping_note", "full_scale", "held_kerf", "on_power"
 
 
 def full_scale(heat: HeatSpec | None) -> float:
-    """The largest power [W/m] the heat's output sets: its ``full_scale`` on an analog
-    output, else unbounded (a digital output switches a supply whose power it cannot set)."""
+    """The largest power [W/m] the heat's output sets.
+
+    Its ``full_scale`` on an analog output, else unbounded (a digital output switches a supply whose power it cannot set)."""
     if heat is not None and heat.kind == "analog" and heat.full_scale is not None:
         return float(heat.full_scale)
     return float("inf")
 
 
 def on_power(cut: CutSpec, heat: HeatSpec | None, material: Material | None) -> float:
-    """The wire's power [W/m] while the heat is on in the modes ``on_off`` and ``constant``
-    (unclipped): ``[tool] heat power`` when given, else the power that melts the cut's
+    """The wire's power [W/m] while on in the modes ``on_off`` and ``constant`` (unclipped).
+
+    ``[tool] heat power`` when given, else the power that melts the cut's
     ``kerf`` at its feed (the supply set up for the nominal kerf; needs ``material``)."""
     if heat is not None and heat.power is not None:
         return float(heat.power)
@@ -38,8 +40,9 @@ def on_power(cut: CutSpec, heat: HeatSpec | None, material: Material | None) -> 
 def set_power(
     cut: CutSpec, heat: HeatSpec | None, material: Material | None, speed: ArrayLike
 ) -> FloatArray:
-    """The power set-point [W/m] (``speed``'s shape) of ``cut`` with the heat on and its
-    reference point (the chord's fastest point) moving at ``speed`` [m/s], by ``[tool]
+    """The power set-point [W/m] of ``cut`` with the heat on, by mode.
+
+    (``speed``'s shape) with its reference point (the chord's fastest point) moving at ``speed`` [m/s], by ``[tool]
     heat mode``: ``constant_kerf`` ``material.power_for_kerf(kerf, speed)``, ``constant``
     ``power``, ``on_off`` :func:`on_power`; clipped to ``[0, full_scale]``
     (:func:`full_scale`)."""
@@ -55,8 +58,9 @@ def set_power(
 def held_kerf(
     ratio: ArrayLike, cut: CutSpec, heat: HeatSpec | None, material: Material
 ) -> FloatArray:
-    """The kerf [m] (ratio's shape) at chord points moving ``ratio`` (<= 1) times as fast as
-    the reference point, which the time law holds at the cut's feed:
+    """The kerf [m] on the held feed of chord points moving ``ratio`` times the reference.
+
+    (ratio's shape, ``ratio`` <= 1) The reference point, which the time law holds at the cut's feed:
     ``material.kerf(feed * ratio, p)`` with ``p`` the power the schedule sets at the feed
     (:func:`set_power`).  Unclipped ``constant_kerf``: ``kerf_base + (kerf - kerf_base) /
     ratio``."""
@@ -65,8 +69,9 @@ def held_kerf(
 
 
 def clipping_note(cut: CutSpec, heat: HeatSpec | None, material: Material | None) -> str | None:
-    """A warning when the output's ``full_scale`` clips the power the cut asks at its feed
-    (None when it does not): the kerf on the held feed is then narrower than the cut's
+    """A warning when the output's ``full_scale`` clips the power the cut asks at its feed.
+
+    None when it does not: the kerf on the held feed is then narrower than the cut's
     ``kerf`` (the compensation follows it), and where the wire slows the power falls
     below ``full_scale`` again and the kerf comes back to ``kerf``, wider than compensated
     there (``face_error`` judges)."""
@@ -95,8 +100,9 @@ def clipping_note(cut: CutSpec, heat: HeatSpec | None, material: Material | None
 
 
 def burn_advice(heat: HeatSpec | None, material: Material | None) -> str:
-    """What to change when the wire burns where it stands (``face_error``'s burn), in the
-    job's words: a mode that keeps its power while the wire stops (``on_off``,
+    """What to change when the wire burns where it stands (``face_error``'s burn).
+
+    In the job's words: a mode that keeps its power while the wire stops (``on_off``,
     ``constant``) burns at every stop in the block, whatever the power above the
     material's threshold; ``constant_kerf`` on an analog output drops it to the threshold
     there."""

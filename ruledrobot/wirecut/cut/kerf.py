@@ -230,7 +230,9 @@ def offset_ends(
     frames: FloatArray, chord: FloatArray, half: FloatArray, sign: float, closed: bool = False,
     hit: np.ndarray | None = None,
 ) -> tuple[FloatArray, np.ndarray]:
-    """The chord ends (M, 2, 3) [m] of rulings ``frames`` (M, 4, 4) at ``chord`` (M, 2) [m
+    """The chord ends moved by their half kerfs into the waste, corners to corner points.
+
+    The chord ends (M, 2, 3) [m] of rulings ``frames`` (M, 4, 4) at ``chord`` (M, 2) [m
     along z] each moved by its half kerf ``half`` (M, 2) [m] into the waste (``sign`` times
     the normal ``z x (o' + t z')``): along the normal, or at a sharp corner of the path to
     the offset profile's corner point (:func:`.kerf_corners.corner_ends`); and the rulings

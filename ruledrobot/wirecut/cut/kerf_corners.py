@@ -53,8 +53,9 @@ MITRE_LIMIT = 25.0
 
 
 def mitre(a: FloatArray, b: FloatArray, h_a: FloatArray, h_b: FloatArray) -> FloatArray:
-    """The offsets ``d`` (..., 3) [m] from a corner with ``d . a = h_a`` and ``d . b = h_b``
-    in the plane of the unit normals ``a``, ``b`` (..., 3) (module doc), held to
+    """The offsets from a corner to the offset profile's corner point (module doc).
+
+    ``d`` (..., 3) [m] with ``d . a = h_a`` and ``d . b = h_b`` in the plane of the unit normals ``a``, ``b`` (..., 3) (module doc), held to
     :data:`MITRE_LIMIT` ``max(h_a, h_b)``; half kerfs ``h_a``, ``h_b`` (...,) [m]."""
     c = np.einsum("...i,...i->...", a, b)
     s2 = np.maximum(1.0 - c * c, 1e-300)
@@ -84,8 +85,9 @@ def corner_ends(
     target: FloatArray, moved: FloatArray, z: FloatArray, back: FloatArray,
     ahead: FloatArray, half: FloatArray, sign: float, closed: bool, hit: np.ndarray,
 ) -> tuple[FloatArray, np.ndarray, np.ndarray]:
-    """The moved chord ends with the path's sharp corners taken to the offset profile's
-    corner points (module doc).
+    """The moved chord ends with sharp corners at the offset profile's corner points.
+
+    (Module doc.)
 
     ``target`` (M, 2, 3) [m] the target rulings' chord ends; ``moved`` (M, 2, 3) the ends
     moved off the corners' way (along the central normals); ``z`` (M, 3) the rulings'
@@ -167,7 +169,9 @@ def corner_error(
     wire: FloatArray, target: FloatArray, back: FloatArray, ahead: FloatArray,
     half: FloatArray, closed: bool,
 ) -> FloatArray:
-    """The kept surface's largest error (M,) [m] at corner rulings: the wire's points
+    """The kept surface's largest error (M,) [m] at corner rulings.
+
+    The wire's points
     ``wire`` (M, K, 3) against the two faces' tangent planes at the target points
     ``target`` (M, K, 3), normals ``back``, ``ahead`` (M, K, 3) into the waste, each
     half a kerf off: the neighbours' ``half`` (M, K) [m] on its side."""
