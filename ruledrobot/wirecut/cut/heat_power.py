@@ -21,7 +21,8 @@ __all__ = ["burn_advice", "clipping_note", "full_scale", "held_kerf", "on_power"
 def full_scale(heat: HeatSpec | None) -> float:
     """The largest power [W/m] the heat's output sets.
 
-    Its ``full_scale`` on an analog output, else unbounded (a digital output switches a supply whose power it cannot set)."""
+    Its ``full_scale`` on an analog output, else unbounded (a digital output switches a
+    supply whose power it cannot set)."""
     if heat is not None and heat.kind == "analog" and heat.full_scale is not None:
         return float(heat.full_scale)
     return float("inf")
@@ -42,10 +43,10 @@ def set_power(
 ) -> FloatArray:
     """The power set-point [W/m] of ``cut`` with the heat on, by mode.
 
-    (``speed``'s shape) with its reference point (the chord's fastest point) moving at ``speed`` [m/s], by ``[tool]
-    heat mode``: ``constant_kerf`` ``material.power_for_kerf(kerf, speed)``, ``constant``
-    ``power``, ``on_off`` :func:`on_power`; clipped to ``[0, full_scale]``
-    (:func:`full_scale`)."""
+    (``speed``'s shape) with its reference point (the chord's fastest point) moving at
+    ``speed`` [m/s], by ``[tool] heat mode``: ``constant_kerf``
+    ``material.power_for_kerf(kerf, speed)``, ``constant`` ``power``, ``on_off``
+    :func:`on_power`; clipped to ``[0, full_scale]`` (:func:`full_scale`)."""
     v = np.asarray(speed, dtype=np.float64)
     mode = "on_off" if heat is None else heat.mode
     if mode == "constant_kerf":

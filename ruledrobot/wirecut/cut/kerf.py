@@ -130,8 +130,9 @@ def _derivative(x: FloatArray, closed: bool, side: int = 0) -> FloatArray:
 def ruling_normals(
     frames: FloatArray, t: FloatArray, closed: bool = False, side: int = 0
 ) -> FloatArray:
-    """Unit normals (M, K, 3) of the surface swept by the frames' z axes at wire
-    parameters ``t`` (M, K) [m along z from the origin], ``z x (o' + t z')``; ``side``
+    """Return unit normals of the surface swept by the frames' z axes at wire parameters ``t``.
+
+    Normals (M, K, 3) at ``t`` (M, K) [m along z from the origin]: ``z x (o' + t z')``; ``side``
     -1 / +1: of the face behind / ahead of each ruling (one-sided differences: at a
     sharp corner of the path the two differ, :mod:`.kerf_corners`), 0 their mean
     direction (central differences)."""
@@ -187,11 +188,13 @@ def waste_sign(
 def kerf_offsets(
     frames: FloatArray, stock: Box, kerf: float, keep: str | FloatArray | None, closed: bool
 ) -> KerfOffsets:
-    """The minimax offsets (module doc) of every ruling towards the waste by ``kerf / 2``;
-    zero offsets when ``keep`` is None or ``kerf`` is 0.  At a sharp corner of the path the
-    wire's ends go to the corner points of the offset profile (:mod:`.kerf_corners`; the
-    wire then turns: ``turn``).  Rulings that miss the stock get the offset of the nearest
-    ruling that crosses it (the lead-in/out keeps its side)."""
+    """Return the minimax offsets of every ruling towards the waste by ``kerf / 2``.
+
+    The offsets are the module doc's; zero offsets when ``keep`` is None or ``kerf`` is 0.
+    At a sharp corner of the path the wire's ends go to the corner points of the offset
+    profile (:mod:`.kerf_corners`; the wire then turns: ``turn``).  Rulings that miss the
+    stock get the offset of the nearest ruling that crosses it (the lead-in/out keeps its
+    side)."""
     M = frames.shape[0]
     if keep is None or kerf <= 0.0:
         return KerfOffsets(np.zeros((M, 3)), np.zeros(M), False)

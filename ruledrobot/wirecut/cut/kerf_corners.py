@@ -55,8 +55,9 @@ MITRE_LIMIT = 25.0
 def mitre(a: FloatArray, b: FloatArray, h_a: FloatArray, h_b: FloatArray) -> FloatArray:
     """The offsets from a corner to the offset profile's corner point (module doc).
 
-    ``d`` (..., 3) [m] with ``d . a = h_a`` and ``d . b = h_b`` in the plane of the unit normals ``a``, ``b`` (..., 3) (module doc), held to
-    :data:`MITRE_LIMIT` ``max(h_a, h_b)``; half kerfs ``h_a``, ``h_b`` (...,) [m]."""
+    ``d`` (..., 3) [m] with ``d . a = h_a`` and ``d . b = h_b`` in the plane of the unit
+    normals ``a``, ``b`` (..., 3) (module doc), held to :data:`MITRE_LIMIT` ``max(h_a,
+    h_b)``; half kerfs ``h_a``, ``h_b`` (...,) [m]."""
     c = np.einsum("...i,...i->...", a, b)
     s2 = np.maximum(1.0 - c * c, 1e-300)
     alpha, beta = (h_a - c * h_b) / s2, (h_b - c * h_a) / s2
