@@ -54,7 +54,7 @@ from ...robot.wire.in_stock import across_speeds
 from ...robot.wire.kerf import Material
 from ..job.spec import CutSpec, HeatSpec
 from .heat_power import held_kerf
-from .kerf_corners import corner_ends, corner_error
+from .kerf_corners import corner_ends, corner_error, face_rulings_at_corners, neighbours
 from .wire_geometry import chords
 
 __all__ = ["KerfOffsets", "cut_offsets", "face_rulings", "kept_surface_error", "kerf_offsets",
@@ -111,35 +111,62 @@ class KerfOffsets:
         return out
 
 
-def _derivative(x: FloatArray, closed: bool, side: int = 0) -> FloatArray:
-    """d/di of samples x (M, 3): central differences (``side`` 0), backward (-1) or
-    forward (+1) ones; periodic when ``closed``, else one-sided at the ends (where all
-    three agree)."""
+def _derivative(x: FloatArray, closed: bool) -> FloatArray:
+    """d/di of samples x (M, 3) by central differences: periodic when ``closed``, else
+    one-sided at the ends."""
     if closed:
-        nxt = np.roll(x, -1, axis=0) if side >= 0 else x
-        prv = np.roll(x, 1, axis=0) if side <= 0 else x
-        return (nxt - prv) / (2.0 if side == 0 else 1.0)
-    d = np.gradient(x, axis=0)
-    if side < 0 and len(x) > 1:
-        d[1:] = x[1:] - x[:-1]
-    elif side > 0 and len(x) > 1:
-        d[:-1] = x[1:] - x[:-1]
-    return d
+        return 0.5 * (np.roll(x, -1, axis=0) - np.roll(x, 1, axis=0))
+    return np.gradient(x, axis=0)
 
 
-def ruling_normals(
-    frames: FloatArray, t: FloatArray, closed: bool = False, side: int = 0
-) -> FloatArray:
+def ruling_normals(frames: FloatArray, t: FloatArray, closed: bool = False) -> FloatArray:
     """Return unit normals of the surface swept by the frames' z axes at wire parameters ``t``.
 
-    Normals (M, K, 3) at ``t`` (M, K) [m along z from the origin]: ``z x (o' + t z')``; ``side``
-    -1 / +1: of the face behind / ahead of each ruling (one-sided differences: at a
-    sharp corner of the path the two differ, :mod:`.kerf_corners`), 0 their mean
-    direction (central differences)."""
+    Normals (M, K, 3) at ``t`` (M, K) [m along z from the origin]: ``z x (o' + t z')`` by
+    central differences along the rulings (their mean direction at a sharp corner of the
+    path, where the faces behind and ahead differ: :func:`face_normals`)."""
     o, z = frames[:, :3, 3], frames[:, :3, 2]
-    do, dz = _derivative(o, closed, side), _derivative(z, closed, side)
-    tangent = do[:, None, :] + t[..., None] * dz[:, None, :]
-    n = np.cross(np.broadcast_to(z[:, None, :], tangent.shape), tangent)
+    do, dz = _derivative(o, closed), _derivative(z, closed)
+    return _unit(np.cross(z[:, None, :], do[:, None, :] + t[..., None] * dz[:, None, :]))
+
+
+def face_normals(
+    frames: FloatArray, t: FloatArray, before: np.ndarray, after: np.ndarray
+) -> tuple[FloatArray, FloatArray]:
+    """Return unit normals of the faces behind and ahead of each ruling at wire parameters ``t``.
+
+    Normals (M, K, 3), (M, K, 3) at ``t`` (M, K) [m along z], each ``z_i x T`` with ``T``
+    the face's direction of travel at ruling ``i``'s point ``P_i(t) = o_i + t z_i``,
+    sampled by the rulings ``j1, j2 = before[i]`` (behind) and ``after[i]`` (ahead), (M, 2)
+    each: the one-sided difference ``P_j1 - P_i`` when ``j1 == j2`` (the neighbours:
+    ``z x (o' + t z')`` of the face), else the derivative at ``P_i`` of the quadratic
+    through ``P_i``, ``P_j1``, ``P_j2`` at the distances ``s1``, ``s2`` from it,
+    ``(s2^2 (P_j1 - P_i) - s1^2 (P_j2 - P_i)) / (s1 s2 (s2 - s1))`` (the one-sided
+    second-order difference: exact on a face curved in a circle to first order).  A
+    ruling that is its own neighbour (an open path's end) takes the other side's face."""
+    o, z = frames[:, :3, 3], frames[:, :3, 2]
+    P = o[:, None, :] + t[..., None] * z[:, None, :]
+    idx = np.arange(len(o))
+
+    def travel(j: np.ndarray) -> FloatArray:
+        d1 = o[j[:, 0], None, :] + t[..., None] * z[j[:, 0], None, :] - P
+        d2 = o[j[:, 1], None, :] + t[..., None] * z[j[:, 1], None, :] - P
+        s1 = np.linalg.norm(d1, axis=-1, keepdims=True)
+        s2 = np.linalg.norm(d2, axis=-1, keepdims=True)
+        two = (j[:, 0] != j[:, 1])[:, None, None] & (s2 > s1) & (s1 > 0.0)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            q = (s2 * s2 * d1 - s1 * s1 * d2) / (s1 * s2 * (s2 - s1))
+        return np.where(two, q, d1)
+
+    back, ahead = -travel(before), travel(after)
+    back = np.where((before[:, 0] == idx)[:, None, None], ahead, back)
+    ahead = np.where((after[:, 0] == idx)[:, None, None], back, ahead)
+    zz = np.broadcast_to(z[:, None, :], P.shape)
+    return _unit(np.cross(zz, back)), _unit(np.cross(zz, ahead))
+
+
+def _unit(n: FloatArray) -> FloatArray:
+    """Vectors (..., 3) scaled to unit length (zeros stay zero)."""
     norm = np.linalg.norm(n, axis=-1, keepdims=True)
     return n / np.where(norm > 0.0, norm, 1.0)
 
@@ -222,7 +249,7 @@ def kerf_offsets(
         offset[at] = wo - o
         W = ends[at, :1] + np.linspace(0.0, 1.0, SAMPLES)[None, :, None] * (
             ends[at, 1:] - ends[at, :1])  # fmt: skip
-        err[at] = _corner_error(frames, t, W, P, np.full(t.shape, r), sign, closed, at)
+        err[at] = _corner_error(frames, t, W, P, np.full(t.shape, r), sign, closed, at, hit)
     nearest = _nearest_hit(hit)
     offset = np.where(hit[:, None], offset, offset[nearest])
     turn = None if turn is None else turn[nearest]
@@ -267,8 +294,7 @@ def _corners(
     corner_ends`; NaN at the rulings that did not change) and the wire's turn (M, 3, 3)
     (identity elsewhere; None: no corner)."""
     te = t[:, [0, -1]]
-    back = sign * ruling_normals(frames, te, closed, -1)
-    ahead = sign * ruling_normals(frames, te, closed, 1)
+    back, ahead = _faces(frames, te, te, half, sign, closed, hit)
     target = frames[:, None, :3, 3] + te[..., None] * frames[:, None, :3, 2]
     z = frames[:, :3, 2]
     ends, changed, _ = corner_ends(target, moved, z, back, ahead, half, sign, closed, hit)
@@ -280,15 +306,32 @@ def _corners(
     return np.where(changed[:, None, None], ends, np.nan), turn
 
 
+def _faces(
+    frames: FloatArray, te: FloatArray, t: FloatArray, half: FloatArray, sign: float,
+    closed: bool, hit: np.ndarray,
+) -> tuple[FloatArray, FloatArray]:
+    """The unit normals (M, K, 3) into the waste of the faces behind and ahead of each
+    ruling at ``t`` (M, K), sampled by :func:`.kerf_corners.face_rulings_at_corners` from the chord
+    ends ``te`` (M, 2) [m along z] with half kerfs ``half`` (M, 2) [m] (:func:`face_normals`:
+    the neighbours' faces; at a sharp corner the rulings beside it up to the distance
+    of its offset corner point's foot)."""
+    o, z = frames[:, :3, 3], frames[:, :3, 2]
+    before, after = (np.repeat(j[:, None], 2, axis=1) for j in neighbours(len(frames), closed))
+    back, ahead = face_normals(frames, te, before, after)
+    before, after = face_rulings_at_corners(o, z, te, sign * back, sign * ahead, half, closed, hit)
+    back, ahead = face_normals(frames, t, before, after)
+    return sign * back, sign * ahead
+
+
 def _corner_error(
     frames: FloatArray, t: FloatArray, W: FloatArray, P: FloatArray, half: FloatArray,
-    sign: float, closed: bool, at: np.ndarray,
+    sign: float, closed: bool, at: np.ndarray, hit: np.ndarray,
 ) -> FloatArray:
     """:func:`.kerf_corners.corner_error` of rulings ``at`` (M,) whose moved wire has the
     points ``W`` (K, S, 3) over the target samples ``P`` (M, S, 3) at ``t`` (M, S), half
-    kerfs ``half`` (M, S); the face behind and ahead of each."""
-    back = sign * ruling_normals(frames, t, closed, -1)
-    ahead = sign * ruling_normals(frames, t, closed, 1)
+    kerfs ``half`` (M, S); the face behind and ahead of each (:func:`_faces`; ``hit`` (M,)
+    the rulings in the stock)."""
+    back, ahead = _faces(frames, t[:, [0, -1]], t, half[:, [0, -1]], sign, closed, hit)
     full = np.array(P)
     full[at] = W
     return corner_error(full, P, back, ahead, half, closed)[at]
@@ -382,7 +425,7 @@ def point_kerf_offsets(
     W = ends[:, :1] + u[None, :, None] * (ends[:, 1:] - ends[:, :1])
     err = np.abs(np.einsum("mki,mki->mk", W - P, n) - 0.5 * w).max(axis=1)
     if at.any():
-        err[at] = _corner_error(frames, t, W[at], P, 0.5 * w, sign, closed, at)
+        err[at] = _corner_error(frames, t, W[at], P, 0.5 * w, sign, closed, at, hit)
     end = np.where(hit[:, None], w[:, [0, -1]], np.nan)
     return KerfOffsets(offset, np.where(hit, err, 0.0), True, turn, end)
 

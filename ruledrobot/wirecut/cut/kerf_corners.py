@@ -45,7 +45,8 @@ import numpy as np
 from ...geometry.checks import FloatArray
 from ..motion.corners import CORNER_ANGLE
 
-__all__ = ["MITRE_LIMIT", "corner_ends", "corner_error", "mitre"]
+__all__ = ["MITRE_LIMIT", "corner_ends", "corner_error", "face_rulings_at_corners", "mitre",
+           "neighbours"]
 
 #: the largest offset of a corner's wire end from the corner, in half kerfs
 #: (``1 / cos(theta / 2)`` reaches 25 at a turn of 175.4 degrees)
@@ -67,13 +68,59 @@ def mitre(a: FloatArray, b: FloatArray, h_a: FloatArray, h_b: FloatArray) -> Flo
     return d * np.where(size > top, top / np.maximum(size, 1e-300), 1.0)[..., None]
 
 
-def _neighbours(M: int, closed: bool) -> tuple[np.ndarray, np.ndarray]:
+def neighbours(M: int, closed: bool) -> tuple[np.ndarray, np.ndarray]:
     """(M,) the index before and after each ruling (periodic when ``closed``, else the
     ruling itself at the ends)."""
     i = np.arange(M)
     if closed:
         return np.roll(i, 1), np.roll(i, -1)
     return np.maximum(i - 1, 0), np.minimum(i + 1, M - 1)
+
+
+def face_rulings_at_corners(
+    o: FloatArray, z: FloatArray, te: FloatArray, back: FloatArray, ahead: FloatArray,
+    half: FloatArray, closed: bool, hit: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray]:
+    """The rulings (M, 2), (M, 2) that sample the faces behind and ahead of each ruling.
+
+    For :func:`.kerf.face_normals`: the neighbours (twice), except at a sharp corner
+    (``back``, ``ahead`` (M, 2, 3) the neighbours' face normals at the chord ends ``te``
+    (M, 2) [m along ``z``]).  There, on each side, the nearest rulings whose points at the
+    corner's chord parameters lie at least ``L / 2`` and ``L`` from the corner's chord ends,
+    ``L = h tan(theta / 2)`` (the distance along each face from the corner to the foot of
+    the offset corner point; ``h`` the largest half kerf ``half`` (M, 2) [m] there and
+    beside it, ``tan`` held to :data:`MITRE_LIMIT`), stopping at another corner
+    (included: the face ends there), before a ruling off the stock (``hit`` (M,) False) or
+    at the path's end.  Why: a refined path's rulings lie within a fraction of a
+    micrometre of its surface, and next to a corner they are micrometres apart, so their
+    differences turn by degrees where the faces do not, while the corner point moves by
+    ``h sin(theta / 2) / cos^2(theta / 2)`` per radian of ``theta`` (12 mm at 160 degrees,
+    0.4 mm half kerf: a trailing edge's point 0.36 mm off).  Sampled over ``L`` the
+    rulings' error ``e`` tilts the face by about ``8 e / L`` and the corner point's faces
+    by about ``8 e``.  Frames' origins ``o``, directions ``z`` (M, 3)."""
+    M = len(o)
+    before, after = (np.repeat(j[:, None], 2, axis=1) for j in neighbours(M, closed))
+    corner = _is_corner(back, ahead) & hit[:, None]
+    rows = np.flatnonzero(corner.any(axis=1))
+    if not rows.size:
+        return before, after
+    c = np.clip(np.einsum("...i,...i->...", back, ahead), -1.0 + 1e-12, 1.0)
+    i0, i1 = before[:, 0], after[:, 0]
+    h = np.fmax(np.fmax(half[i0], half[i1]), half)
+    reach = h * np.minimum(np.sqrt((1.0 - c) / (1.0 + c)), MITRE_LIMIT)  # (M, 2)
+    wall = corner.any(axis=1)
+    for i in rows:  # a few corners
+        P = o[i] + te[i, :, None] * z[i]  # (2, 3)
+        for step, side in ((-1, before), (1, after)):
+            j = _run(i, step, M, closed, ~hit, wall)  # another corner ends the face
+            if not j.size:
+                continue
+            Q = o[j, None, :] + te[i][None, :, None] * z[j, None, :]  # (J, 2, 3)
+            s = np.linalg.norm(Q - P, axis=-1)
+            for col, share in ((0, 0.5), (1, 1.0)):
+                far = (s >= share * reach[i]).all(axis=1)
+                side[i, col] = j[int(np.argmax(far))] if far.any() else j[-1]
+    return before, after
 
 
 def _is_corner(back: FloatArray, ahead: FloatArray) -> np.ndarray:
@@ -99,7 +146,7 @@ def corner_ends(
     corner ends (M, 2)."""
     M = target.shape[0]
     out = np.array(moved, dtype=np.float64)
-    before, after = _neighbours(M, closed)
+    before, after = neighbours(M, closed)
     corner = _is_corner(back, ahead) & hit[:, None] & hit[before, None] & hit[after, None]
     changed = corner.any(axis=1)
     if not changed.any():
@@ -125,17 +172,26 @@ def corner_ends(
     return out, changed, corner
 
 
+def _run(i: int, step: int, M: int, closed: bool, stop: np.ndarray,
+         wall: np.ndarray | None = None) -> np.ndarray:  # fmt: skip
+    """The rulings next to ``i`` on one side (``step`` -1 behind, +1 ahead), nearest first,
+    up to the first where ``stop`` (M,) holds (or back at ``i``, or the path's end), or to
+    the first where ``wall`` (M,) holds, included."""
+    j = i + step * np.arange(1, M)
+    j = np.mod(j, M) if closed else j[(j >= 0) & (j < M)]
+    bad = stop[j] | (j == i)
+    j = j[: int(np.argmax(bad)) if bad.any() else j.size]
+    at_wall = np.zeros(j.size, dtype=bool) if wall is None else wall[j]
+    return j[: int(np.argmax(at_wall)) + 1] if at_wall.any() else j
+
+
 def _beside(target: FloatArray, i: int, step: int, closed: bool, stop: np.ndarray,
             reach: float) -> np.ndarray:  # fmt: skip
     """The rulings next to corner ``i`` on one side (``step`` -1 behind, +1 ahead), nearest
     first, up to the first whose target end lies more than twice the corner point's
     distance ``reach`` [m] from the corner's and three more (or to another corner, a
     ruling off the stock or the path's end)."""
-    M = target.shape[0]
-    j = i + step * np.arange(1, M)
-    j = np.mod(j, M) if closed else j[(j >= 0) & (j < M)]
-    bad = stop[j] | (j == i)
-    j = j[: int(np.argmax(bad)) if bad.any() else j.size]
+    j = _run(i, step, target.shape[0], closed, stop)
     far = np.linalg.norm(target[j] - target[i], axis=1) > 2.0 * reach
     return j[: int(np.argmax(far)) + 4 if far.any() else j.size]
 
@@ -176,7 +232,7 @@ def corner_error(
     ``wire`` (M, K, 3) against the two faces' tangent planes at the target points
     ``target`` (M, K, 3), normals ``back``, ``ahead`` (M, K, 3) into the waste, each
     half a kerf off: the neighbours' ``half`` (M, K) [m] on its side."""
-    before, after = _neighbours(target.shape[0], closed)
+    before, after = neighbours(target.shape[0], closed)
     d = wire - target
     e_in = np.abs(np.einsum("mki,mki->mk", d, back) - half[before])
     e_out = np.abs(np.einsum("mki,mki->mk", d, ahead) - half[after])
