@@ -22,6 +22,7 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
+from ruledrobot.wirecut.cut.kerf_corners import MITRE_LIMIT
 from ruledrobot.wirecut.job.load import load_job
 from ruledrobot.wirecut.plan import make_plan
 
@@ -145,3 +146,22 @@ def test_on_off_heat_burns_at_a_corner_stop_and_says_what_to_do(tmp_path):
     assert check.gating and not check.ok and check.value == float("inf")
     assert "at a corner stop" in check.detail
     assert 'mode = "constant_kerf" on an analog output' in check.detail
+
+
+@pytest.mark.parametrize("turn", [170.0, 177.0])
+def test_a_wedge_past_the_mitre_limit_is_cut_back_and_face_error_fails_it(tmp_path, turn):
+    """A thin wedge (the part inside a turn of 170 or 177 degrees, no material): up to the
+    mitre limit (a turn of ``2 arccos(1 / 25)``, 175.4 degrees) the wire reaches the corner
+    point; past it the point is held to 25 half kerfs along the bisector, so the kerf cuts
+    the tip back by ``h - 25 h sin(psi / 2)`` (``psi`` the wedge's angle; 0.138 mm at 3
+    degrees, 0.4 mm half kerf), and ``face_error`` (the gating check) says so: not within
+    the tolerance."""
+    profile = corner(tmp_path, turn, True, DIGITAL, False)
+    plan = make_plan(load_job(profile.job))
+    fe = plan.measured.faces["cut"]
+    h, psi = 0.5 * KERF, np.radians(180.0 - turn)
+    if turn > np.degrees(2.0 * np.arccos(1.0 / MITRE_LIMIT)):
+        assert fe.worst == pytest.approx(h - MITRE_LIMIT * h * np.sin(0.5 * psi), abs=2e-6)
+        assert not fe.ok
+    else:
+        assert fe.worst <= 2e-6 and fe.ok
