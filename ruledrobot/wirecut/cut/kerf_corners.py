@@ -4,10 +4,11 @@ Where the path turns sharply (a polygon's corner, kept by the refinement, where 
 stops: :mod:`..motion.corners`) the surface has two tangent planes at a chord end ``P``
 of the corner ruling: the face behind (rulings ``i - 1, i``), unit normal ``a`` into the
 waste, and the face ahead (``i, i + 1``), ``b`` (:func:`.kerf.face_normals`, sampled
-over the corner point's reach: :func:`face_rulings_at_corners`).  A wire end moved to ``P + d`` lies ``d . a``
-from the face behind and ``d . b`` from the face ahead; the kerf leaves both where they
-should be when ``d . a = h_a`` and ``d . b = h_b`` (``h`` the half kerfs of the two faces
-there: the neighbouring rulings' at that end).  In the plane of ``a`` and ``b`` (normal
+over the corner point's reach: :func:`face_rulings_at_corners`).  A wire end moved to
+``P + d`` lies ``d . a`` from the face behind and ``d . b`` from the face ahead; the
+kerf leaves both where they should be when ``d . a = h_a`` and ``d . b = h_b`` (``h``
+the half kerfs of the two faces there: the neighbouring rulings' at that end).  In the
+plane of ``a`` and ``b`` (normal
 to the ruling), with ``c = a . b``::
 
     d = alpha a + beta b,   alpha = (h_a - c h_b) / (1 - c^2),   beta = (h_b - c h_a) / (1 - c^2)

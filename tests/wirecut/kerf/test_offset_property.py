@@ -1,11 +1,12 @@
 """A property of the per-point compensation's geometry (``offset_ends``, docs/kerf.md):
 on random planar and twisted ruled strips, smooth or with a sharp corner (convex or
 concave, 40-150 degrees, turning at most the mitre limit's 175.4 degrees at either end),
-with random half kerfs at each end, each moved chord end lies its half kerf from the surface's tangent planes beside it -- the faces behind and ahead
-of its ruling, computed here from the strip's own bilinear patches -- and the moved ends
-never double back along the path.  Independent of the planner's normals: a patch between
-rulings ``i`` and ``i + 1`` has, at ruling ``i``'s point ``P_i(t)``, the tangent plane
-spanned by ``z_i`` and ``P_{i+1}(t) - P_i(t)``."""
+with random half kerfs at each end, each moved chord end lies its half kerf from the
+surface's tangent planes beside it -- the faces behind and ahead of its ruling, computed
+here from the strip's own bilinear patches -- and the moved ends never double back along
+the path.  Independent of the planner's normals: a patch between rulings ``i`` and
+``i + 1`` has, at ruling ``i``'s point ``P_i(t)``, the tangent plane spanned by ``z_i``
+and ``P_{i+1}(t) - P_i(t)``."""
 
 from __future__ import annotations
 
