@@ -70,8 +70,9 @@ def mitre(a: FloatArray, b: FloatArray, h_a: FloatArray, h_b: FloatArray) -> Flo
 
 
 def neighbours(M: int, closed: bool) -> tuple[np.ndarray, np.ndarray]:
-    """(M,) the index before and after each ruling (periodic when ``closed``, else the
-    ruling itself at the ends)."""
+    """Return the index before and after each ruling.
+
+    (M,), (M,): periodic when ``closed``, else the ruling itself at the ends."""
     i = np.arange(M)
     if closed:
         return np.roll(i, 1), np.roll(i, -1)
