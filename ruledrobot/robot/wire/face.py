@@ -52,6 +52,11 @@ SAMPLES = 5
 #: the nearest sampled points whose rulings are a chord end's candidates: the plane
 #: nearest the face decides (module doc)
 NEAREST = 12
+#: m: the largest spacing of the sampled points along the pass between rulings (at least
+#: half the kerf): finer than the distance between two faces the wire could mistake
+SPACING = 2e-4
+#: at most this many parts per gap between two rulings (a gap across a non-face stretch)
+MAX_BETWEEN = 1000
 #: m/s: a hot wire slower than this stands still and burns: the melt then grows with the
 #: time it stays, which the energy balance does not describe (a sampled stop never reaches
 #: exactly 0)
@@ -111,17 +116,33 @@ class FaceTarget:
         """(n,) bool: sample k is on the face."""
         return ranges_mask(self.ranges, n)
 
-    def samples(self) -> FloatArray:
-        """(K, SAMPLES, 3) m: where the wire belongs along each chord, its ends included.
+    def samples(self) -> tuple[FloatArray, np.ndarray]:
+        """Where the wire belongs: points (P, 3) m and each one's two rulings (P, 2).
 
-        Points evenly along the chord moved half the cut's ``kerf`` into the waste: a wire
-        is nearer its own ruling's than another face's where two faces run close (both
-        sides of a thin trailing edge lie a kerf apart there)."""
+        Per ruling :data:`SAMPLES` points evenly along the chord, its ends included, moved
+        half the cut's ``kerf`` into the waste: a wire is nearer its own ruling's than
+        another face's where two faces run close (both sides of a thin trailing edge lie
+        a kerf apart there).  Between consecutive rulings more such rows, linearly, at
+        most :data:`SPACING` (or half a kerf, the larger) apart, owned by both rulings: a
+        face whose rulings lie far apart (a straight move between two refined corners)
+        has points near its wire wherever it is, so the nearest points never all belong
+        to a denser face beside it (the way out of a slit past its refined corner was
+        judged against the way in, a kerf off)."""
         u = np.linspace(0.0, 1.0, SAMPLES)
         t = self.chord[:, :1] + u * (self.chord[:, 1:] - self.chord[:, :1])
         k = np.broadcast_to(np.arange(len(t))[:, None], t.shape)
         on = self.origins[:, None, :] + t[..., None] * self.directions[:, None, :]
-        return on + 0.5 * self.kerf * self.normals(k, t)
+        rows = on + 0.5 * self.kerf * self.normals(k, t)  # (K, SAMPLES, 3)
+        K = len(rows)
+        gap = np.linalg.norm(np.diff(rows, axis=0), axis=2).max(axis=1) if K > 1 else []
+        n = np.maximum(np.ceil(np.asarray(gap) / max(SPACING, 0.5 * self.kerf)), 1).astype(int)
+        n = np.minimum(n, MAX_BETWEEN)  # (K-1,) parts per gap
+        i = np.repeat(np.arange(K - 1), n - 1)  # the gap of each added row
+        f = (np.arange(i.size) - np.repeat(np.cumsum(n - 1) - (n - 1), n - 1) + 1) / n[i]
+        between = rows[i] + f[:, None, None] * (rows[i + 1] - rows[i])
+        pts = np.concatenate([rows, between]).reshape(-1, 3)
+        owner = np.concatenate([np.stack([np.arange(K)] * 2, axis=1), np.stack([i, i + 1], 1)])
+        return pts, np.repeat(owner, SAMPLES, axis=0)
 
     def normals(self, k: np.ndarray, t: FloatArray) -> FloatArray:
         """Unit normals (..., 3) into the waste on rulings ``k`` (...) at ``t`` (...) m."""
@@ -235,12 +256,12 @@ def face_error(
         p = np.asarray(power, dtype=np.float64)[rows]
         v = across_speeds(wis.t, wis.ends, wis.fractions())[rows]  # (R, 2)
         w = _kerf(v, p, material, face.tolerance)
-    pts = face.samples().reshape(-1, 3)
+    pts, owner = face.samples()
     near = min(NEAREST, len(pts))
     _, idx = cKDTree(pts).query(np.array(x.reshape(-1, 3)), k=near)  # writable copy
     # the candidates of both chord ends serve both: the wire lies on one ruling
-    k = (np.asarray(idx).reshape(len(x), 2 * near) // SAMPLES)[:, None, :]  # (R, 1, 2 near)
-    k = np.broadcast_to(k, (len(x), 2, 2 * near))
+    k = owner[np.asarray(idx).reshape(len(x), 2 * near)].reshape(len(x), 1, 4 * near)
+    k = np.broadcast_to(k, (len(x), 2, 4 * near))
     rel = x[:, :, None, :] - face.origins[k]
     t = np.einsum("rjni,rjni->rjn", rel, face.directions[k])
     with np.errstate(invalid="ignore"):

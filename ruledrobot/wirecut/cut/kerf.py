@@ -30,11 +30,15 @@ predicted there along the normal ``n`` into the waste, ``P + w / 2 n``, and the 
 the line through the two moved ends (still a ruling: the frame turns by the smallest
 rotation from the old direction to the new).  The moved wire has other speeds, so the
 ratios are taken again on it, :data:`ROUNDS` times (the offsets change by less than a
-micrometre after two).  Kerf per end (:func:`held_kerf`): ``constant`` and ``on_off``
-``w = material.kerf(feed * ratio, p)`` with ``p`` the power while on
-(:func:`on_power`); ``constant_kerf`` ``w = kerf_base + (kerf - kerf_base) / ratio``
-(the power that holds ``kerf`` at the reference point, ``p0 + (kerf - kerf_base)
-feed / kerf_gain``, melts that at the end moving ``ratio`` as fast).
+micrometre after two).  Kerf per end (:func:`.heat_power.held_kerf`):
+``w = material.kerf(feed * ratio, p)`` with ``p`` the power the heat schedule sets at the
+feed (:func:`.heat_power.set_power`, clipped at the output's ``full_scale``); unclipped
+``constant_kerf`` gives ``w = kerf_base + (kerf - kerf_base) / ratio`` (the power that
+holds ``kerf`` at the reference point melts that at the end moving ``ratio`` as fast).
+
+**Sharp corners** (:mod:`.kerf_corners`): where the path turns by more than the corner
+angle, each end goes to the corner point of the offset profile (the two offset faces'
+intersection) instead of along the bisecting normal, with or without a material.
 """
 
 from __future__ import annotations
@@ -49,10 +53,12 @@ from ...geometry.checks import FloatArray
 from ...robot.wire.in_stock import across_speeds
 from ...robot.wire.kerf import Material
 from ..job.spec import CutSpec, HeatSpec
+from .heat_power import held_kerf
+from .kerf_corners import corner_ends, corner_error, face_rulings_at_corners, neighbours
 from .wire_geometry import chords
 
-__all__ = ["KerfOffsets", "cut_offsets", "face_rulings", "held_kerf", "kept_surface_error",
-           "kerf_offsets", "on_power", "point_kerf_offsets", "ruling_normals", "waste_sign"]
+__all__ = ["KerfOffsets", "cut_offsets", "face_rulings", "kept_surface_error", "kerf_offsets",
+           "offset_ends", "point_kerf_offsets", "ruling_normals", "waste_sign"]
 
 #: points per chord at which the normals are sampled
 SAMPLES = 9
@@ -106,7 +112,8 @@ class KerfOffsets:
 
 
 def _derivative(x: FloatArray, closed: bool) -> FloatArray:
-    """d/di of samples x (M, 3): central differences, periodic when ``closed``."""
+    """d/di of samples x (M, 3) by central differences: periodic when ``closed``, else
+    one-sided at the ends."""
     if closed:
         return 0.5 * (np.roll(x, -1, axis=0) - np.roll(x, 1, axis=0))
     return np.gradient(x, axis=0)
@@ -115,12 +122,51 @@ def _derivative(x: FloatArray, closed: bool) -> FloatArray:
 def ruling_normals(frames: FloatArray, t: FloatArray, closed: bool = False) -> FloatArray:
     """Return unit normals of the surface swept by the frames' z axes at wire parameters ``t``.
 
-    Normals (M, K, 3) at ``t`` (M, K) [m along z from the origin]: ``z x (o' + t z')``.
-    """
+    Normals (M, K, 3) at ``t`` (M, K) [m along z from the origin]: ``z x (o' + t z')`` by
+    central differences along the rulings (their mean direction at a sharp corner of the
+    path, where the faces behind and ahead differ: :func:`face_normals`)."""
     o, z = frames[:, :3, 3], frames[:, :3, 2]
     do, dz = _derivative(o, closed), _derivative(z, closed)
-    tangent = do[:, None, :] + t[..., None] * dz[:, None, :]
-    n = np.cross(np.broadcast_to(z[:, None, :], tangent.shape), tangent)
+    return _unit(np.cross(z[:, None, :], do[:, None, :] + t[..., None] * dz[:, None, :]))
+
+
+def face_normals(
+    frames: FloatArray, t: FloatArray, before: np.ndarray, after: np.ndarray
+) -> tuple[FloatArray, FloatArray]:
+    """Return unit normals of the faces behind and ahead of each ruling at wire parameters ``t``.
+
+    Normals (M, K, 3), (M, K, 3) at ``t`` (M, K) [m along z], each ``z_i x T`` with ``T``
+    the face's direction of travel at ruling ``i``'s point ``P_i(t) = o_i + t z_i``,
+    sampled by the rulings ``j1, j2 = before[i]`` (behind) and ``after[i]`` (ahead), (M, 2)
+    each: the one-sided difference ``P_j1 - P_i`` when ``j1 == j2`` (the neighbours:
+    ``z x (o' + t z')`` of the face), else the derivative at ``P_i`` of the quadratic
+    through ``P_i``, ``P_j1``, ``P_j2`` at the distances ``s1``, ``s2`` from it,
+    ``(s2^2 (P_j1 - P_i) - s1^2 (P_j2 - P_i)) / (s1 s2 (s2 - s1))`` (the one-sided
+    second-order difference: exact on a face curved in a circle to first order).  A
+    ruling that is its own neighbour (an open path's end) takes the other side's face."""
+    o, z = frames[:, :3, 3], frames[:, :3, 2]
+    P = o[:, None, :] + t[..., None] * z[:, None, :]
+    idx = np.arange(len(o))
+
+    def travel(j: np.ndarray) -> FloatArray:
+        d1 = o[j[:, 0], None, :] + t[..., None] * z[j[:, 0], None, :] - P
+        d2 = o[j[:, 1], None, :] + t[..., None] * z[j[:, 1], None, :] - P
+        s1 = np.linalg.norm(d1, axis=-1, keepdims=True)
+        s2 = np.linalg.norm(d2, axis=-1, keepdims=True)
+        two = (j[:, 0] != j[:, 1])[:, None, None] & (s2 > s1) & (s1 > 0.0)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            q = (s2 * s2 * d1 - s1 * s1 * d2) / (s1 * s2 * (s2 - s1))
+        return np.where(two, q, d1)
+
+    back, ahead = -travel(before), travel(after)
+    back = np.where((before[:, 0] == idx)[:, None, None], ahead, back)
+    ahead = np.where((after[:, 0] == idx)[:, None, None], back, ahead)
+    zz = np.broadcast_to(z[:, None, :], P.shape)
+    return _unit(np.cross(zz, back)), _unit(np.cross(zz, ahead))
+
+
+def _unit(n: FloatArray) -> FloatArray:
+    """Vectors (..., 3) scaled to unit length (zeros stay zero)."""
     norm = np.linalg.norm(n, axis=-1, keepdims=True)
     return n / np.where(norm > 0.0, norm, 1.0)
 
@@ -172,9 +218,10 @@ def kerf_offsets(
     """Return the minimax offsets of every ruling towards the waste by ``kerf / 2``.
 
     The offsets are the module doc's; zero offsets when ``keep`` is None or ``kerf`` is 0.
-    Rulings that miss the stock get the offset of the nearest ruling that crosses it (the
-    lead-in/out keeps its side).
-    """
+    At a sharp corner of the path the wire's ends go to the corner points of the offset
+    profile (:mod:`.kerf_corners`; the wire then turns: ``turn``).  Rulings that miss the
+    stock get the offset of the nearest ruling that crosses it (the lead-in/out keeps its
+    side)."""
     M = frames.shape[0]
     if keep is None or kerf <= 0.0:
         return KerfOffsets(np.zeros((M, 3)), np.zeros(M), False)
@@ -191,13 +238,103 @@ def kerf_offsets(
     r = 0.5 * kerf
     length = 2.0 * r / (1.0 + np.cos(half))
     offset = length[:, None] * bis
-    idx = np.flatnonzero(hit)
-    nearest = idx[np.clip(np.searchsorted(idx, np.arange(M)), 0, idx.size - 1)]
-    left = idx[np.clip(np.searchsorted(idx, np.arange(M)) - 1, 0, idx.size - 1)]
-    nearest = np.where(np.abs(left - np.arange(M)) < np.abs(nearest - np.arange(M)), left, nearest)
-    offset = np.where(hit[:, None], offset, offset[nearest])
     err = np.abs(np.einsum("mi,mki->mk", offset, n) - r).max(axis=1)
-    return KerfOffsets(offset, np.where(hit, err, 0.0), True)
+    P = frames[:, None, :3, 3] + t[..., None] * frames[:, None, :3, 2]  # (M, K, 3)
+    ends, turn = _corners(frames, t, P[:, [0, -1]] + offset[:, None, :], np.full((M, 2), r),
+                          sign, closed, hit)  # fmt: skip
+    if turn is not None:  # the rulings at the corners: the line through their moved ends
+        at = ~np.isnan(ends[:, 0, 0])
+        o, z = frames[at, :3, 3], frames[at, :3, 2]
+        wo, _ = _line_through(ends[at], t[at, 0], z)
+        offset[at] = wo - o
+        W = ends[at, :1] + np.linspace(0.0, 1.0, SAMPLES)[None, :, None] * (
+            ends[at, 1:] - ends[at, :1])  # fmt: skip
+        err[at] = _corner_error(frames, t, W, P, np.full(t.shape, r), sign, closed, at, hit)
+    nearest = _nearest_hit(hit)
+    offset = np.where(hit[:, None], offset, offset[nearest])
+    turn = None if turn is None else turn[nearest]
+    return KerfOffsets(offset, np.where(hit, err, 0.0), True, turn)
+
+
+def offset_ends(
+    frames: FloatArray, chord: FloatArray, half: FloatArray, sign: float, closed: bool = False,
+    hit: np.ndarray | None = None,
+) -> tuple[FloatArray, np.ndarray]:
+    """The chord ends moved by their half kerfs into the waste, corners to corner points.
+
+    The chord ends (M, 2, 3) [m] of rulings ``frames`` (M, 4, 4) at ``chord`` (M, 2) [m
+    along z] each moved by its half kerf ``half`` (M, 2) [m] into the waste (``sign`` times
+    the normal ``z x (o' + t z')``): along the normal, or at a sharp corner of the path to
+    the offset profile's corner point (:func:`.kerf_corners.corner_ends`); and the rulings
+    (M,) whose ends the corners moved.  ``hit`` (M,): the rulings in the stock (default
+    all)."""
+    hit = np.ones(len(frames), dtype=bool) if hit is None else hit
+    n = sign * ruling_normals(frames, chord, closed)
+    ends = frames[:, None, :3, 3] + chord[..., None] * frames[:, None, :3, 2]
+    ends = ends + half[..., None] * n
+    at_corner, _ = _corners(frames, chord, ends, half, sign, closed, hit)
+    return np.where(np.isnan(at_corner), ends, at_corner), ~np.isnan(at_corner[:, 0, 0])
+
+
+def _line_through(ends: FloatArray, c0: FloatArray, z: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """The wire's origin and direction (K, 3) through moved chord ends ``ends`` (K, 2, 3),
+    its first end at parameter ``c0`` (K,) like the target's (``z`` (K, 3) where the ends
+    coincide)."""
+    d = ends[:, 1] - ends[:, 0]
+    length = np.linalg.norm(d, axis=1, keepdims=True)
+    wz = np.where(length > 0.0, d / np.where(length > 0, length, 1.0), z)
+    return ends[:, 0] - c0[:, None] * wz, wz
+
+
+def _corners(
+    frames: FloatArray, t: FloatArray, moved: FloatArray, half: FloatArray, sign: float,
+    closed: bool, hit: np.ndarray,
+) -> tuple[FloatArray, FloatArray | None]:
+    """The chord ends (M, 2, 3) moved at the path's sharp corners (:func:`.kerf_corners.
+    corner_ends`; NaN at the rulings that did not change) and the wire's turn (M, 3, 3)
+    (identity elsewhere; None: no corner)."""
+    te = t[:, [0, -1]]
+    back, ahead = _faces(frames, te, te, half, sign, closed, hit)
+    target = frames[:, None, :3, 3] + te[..., None] * frames[:, None, :3, 2]
+    z = frames[:, :3, 2]
+    ends, changed, _ = corner_ends(target, moved, z, back, ahead, half, sign, closed, hit)
+    if not changed.any():
+        return np.full(moved.shape, np.nan), None
+    turn = np.broadcast_to(np.eye(3), (len(z), 3, 3)).copy()
+    _, wz = _line_through(ends[changed], te[changed, 0], z[changed])
+    turn[changed] = _rotation_between(z[changed], wz)
+    return np.where(changed[:, None, None], ends, np.nan), turn
+
+
+def _faces(
+    frames: FloatArray, te: FloatArray, t: FloatArray, half: FloatArray, sign: float,
+    closed: bool, hit: np.ndarray,
+) -> tuple[FloatArray, FloatArray]:
+    """The unit normals (M, K, 3) into the waste of the faces behind and ahead of each
+    ruling at ``t`` (M, K), sampled by :func:`.kerf_corners.face_rulings_at_corners` from the chord
+    ends ``te`` (M, 2) [m along z] with half kerfs ``half`` (M, 2) [m] (:func:`face_normals`:
+    the neighbours' faces; at a sharp corner the rulings beside it up to the distance
+    of its offset corner point's foot)."""
+    o, z = frames[:, :3, 3], frames[:, :3, 2]
+    before, after = (np.repeat(j[:, None], 2, axis=1) for j in neighbours(len(frames), closed))
+    back, ahead = face_normals(frames, te, before, after)
+    before, after = face_rulings_at_corners(o, z, te, sign * back, sign * ahead, half, closed, hit)
+    back, ahead = face_normals(frames, t, before, after)
+    return sign * back, sign * ahead
+
+
+def _corner_error(
+    frames: FloatArray, t: FloatArray, W: FloatArray, P: FloatArray, half: FloatArray,
+    sign: float, closed: bool, at: np.ndarray, hit: np.ndarray,
+) -> FloatArray:
+    """:func:`.kerf_corners.corner_error` of rulings ``at`` (M,) whose moved wire has the
+    points ``W`` (K, S, 3) over the target samples ``P`` (M, S, 3) at ``t`` (M, S), half
+    kerfs ``half`` (M, S); the face behind and ahead of each (:func:`_faces`; ``hit`` (M,)
+    the rulings in the stock)."""
+    back, ahead = _faces(frames, t[:, [0, -1]], t, half[:, [0, -1]], sign, closed, hit)
+    full = np.array(P)
+    full[at] = W
+    return corner_error(full, P, back, ahead, half, closed)[at]
 
 
 def kept_surface_error(
@@ -221,35 +358,6 @@ def kept_surface_error(
     d = wire_frames[:, :3, 3] - surface_frames[:, :3, 3]
     dist = np.einsum("mi,mki->mk", d, n)
     return np.where(hit, np.abs(dist - 0.5 * kerf).max(axis=1), 0.0)
-
-
-def on_power(cut: CutSpec, heat: HeatSpec | None, material: Material) -> float:
-    """Return the wire's power [W/m] while the heat is on (modes ``on_off``, ``constant``).
-
-    In the modes ``on_off`` and ``constant`` (docs/kerf.md): ``[tool] heat power`` when
-    given (clipped to ``full_scale`` on an analog output), else the power that melts the
-    cut's ``kerf`` at its feed (the supply set up for the nominal kerf).
-    """
-    if heat is not None and heat.power is not None:
-        top = heat.full_scale if heat.kind == "analog" and heat.full_scale else np.inf
-        return float(min(heat.power, top))
-    return float(material.power_for_kerf(max(cut.kerf, material.kerf_base), cut.feed_speed))
-
-
-def held_kerf(
-    ratio: ArrayLike, cut: CutSpec, heat: HeatSpec | None, material: Material
-) -> FloatArray:
-    """Return the kerf [m] at chord points moving ``ratio`` times as fast as the reference.
-
-    The kerf has ``ratio``'s shape; ``ratio`` <= 1, relative to the reference point, which
-    the time law holds at the cut's feed (module doc): ``constant_kerf`` ``kerf_base +
-    (kerf - kerf_base) / ratio``, else ``material.kerf(feed * ratio, on_power)``.
-    """
-    r = np.asarray(ratio, dtype=np.float64)
-    if heat is not None and heat.mode == "constant_kerf":
-        with np.errstate(divide="ignore"):
-            return material.kerf_base + (cut.kerf - material.kerf_base) / r
-    return material.kerf(cut.feed_speed * r, on_power(cut, heat, material))
 
 
 def _rotation_between(a: FloatArray, b: FloatArray) -> FloatArray:
@@ -279,9 +387,9 @@ def point_kerf_offsets(
     """Return the per-point compensation (module doc) of the target rulings ``frames``.
 
     ``frames`` (M, 4, 4): each chord end is moved by half the kerf predicted there
-    (:func:`held_kerf`) into the waste, ``rounds`` times with the speed ratios of the moved
-    wire.  Rulings that miss the stock, or whose chord is shorter than :data:`SHORT_CHORD`,
-    get the offset and turn of the nearest ruling with a longer chord.
+    (:func:`.heat_power.held_kerf`) into the waste, ``rounds`` times with the speed ratios
+    of the moved wire.  Rulings that miss the stock, or whose chord is shorter than
+    :data:`SHORT_CHORD`, get the offset and turn of the nearest ruling with a longer chord.
     """
     M = frames.shape[0]
     sign = waste_sign(frames, stock, cut.keep, closed)
@@ -306,20 +414,18 @@ def point_kerf_offsets(
         ref = np.max(v, axis=1, keepdims=True)
         ratio = np.where(ref > 0.0, v / np.where(ref > 0.0, ref, 1.0), 1.0)
         w = held_kerf(ratio, cut, heat, material)  # (M, K)
-        A = P[:, 0] + 0.5 * w[:, :1] * n[:, 0]
-        B = P[:, -1] + 0.5 * w[:, -1:] * n[:, -1]
-        d = B - A
-        length = np.linalg.norm(d, axis=1, keepdims=True)
-        wz = np.where(length > 0.0, d / np.where(length > 0, length, 1.0), z)
-        wo = A - c[:, :1] * wz
+        ends, at = offset_ends(frames, t[:, [0, -1]], 0.5 * w[:, [0, -1]], sign, closed, hit)
+        wo, wz = _line_through(ends, c[:, 0], z)
         # rulings that miss the stock move as the nearest that crosses it (their speeds
         # are differences with their neighbours: an unmoved neighbour would add a jump)
         turn = _rotation_between(z, wz)[near]
         offset = (wo - o)[near]
         wo, wz = o + offset, np.einsum("mij,mj->mi", turn, z)
     # the kept surface: the moved line against each target tangent plane, half a kerf off
-    W = A[:, None, :] + u[None, :, None] * (B - A)[:, None, :]
+    W = ends[:, :1] + u[None, :, None] * (ends[:, 1:] - ends[:, :1])
     err = np.abs(np.einsum("mki,mki->mk", W - P, n) - 0.5 * w).max(axis=1)
+    if at.any():
+        err[at] = _corner_error(frames, t, W[at], P, 0.5 * w, sign, closed, at, hit)
     end = np.where(hit[:, None], w[:, [0, -1]], np.nan)
     return KerfOffsets(offset, np.where(hit, err, 0.0), True, turn, end)
 

@@ -50,6 +50,7 @@ from .clearance import Cell
 from .closed import loop_paths
 from .cutpath import CutPath, RefinedCut
 from .entry import PROFILE_KINDS, profile_entry
+from .heat_power import clipping_note
 from .kerf import cut_offsets
 from .wire_geometry import anchored_frames, chords, world_referenced
 from .wire_pose import SearchOptions, search_wire_pose
@@ -452,8 +453,12 @@ def cut_paths(
     except ValueError as exc:  # name the job file and the cut's section
         raise ValueError(f"{job.source or 'job'}: {where} {exc}") from None
     wire = kerf.moved(rc.frames)
+    clipped = clipping_note(cut, job.tool.heat, job.material)  # a warning: face_error judges
     if rc.closed:
-        return loop_paths(job, cut, rc, wire, kerf, cell, options)
+        paths = loop_paths(job, cut, rc, wire, kerf, cell, options)
+        if clipped:
+            paths[0] = dataclasses.replace(paths[0], notes=(clipped, *paths[0].notes))
+        return paths
     lead = max(cut.lead_in, cut.lead_out)
     grown = job.stock.grown(lead)
     _, _, near = chords(wire, grown)
@@ -498,7 +503,7 @@ def cut_paths(
         F = world_referenced(F)
     rows = np.r_[np.repeat(rows[:1], before), rows, np.repeat(rows[-1:], after)]
     S = kerf.moved(F, rows, back=True)  # the target rulings (lead-in/out ones: outside the stock)
-    notes = (_extended_note(where, runs),) if runs else ()
+    notes = ((_extended_note(where, runs),) if runs else ()) + ((clipped,) if clipped else ())
     err = np.r_[np.zeros(before), kerf.error[keep], np.zeros(after)]
     motion = search_wire_pose(F, job.tool, cell, options)
     return [CutPath(F, motion, rc.steps, (before, after), rc.input_rulings, cut.name,

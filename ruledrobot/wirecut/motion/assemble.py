@@ -35,7 +35,7 @@ from ..cut.clearance import Cell
 from ..cut.passes import CutPath
 from ..cut.wire_geometry import speed_factor
 from ..job.spec import Job
-from .corners import corner_nodes, corner_stop_mask, time_between_corners
+from .corners import CORNER_JOIN, corner_nodes, corner_stop_mask, time_between_corners
 from .densify import densified, pass_deviation, pass_feed_error, uneven_intervals
 from .timing import TimedPath, TimingFailure, concatenate, dwell, joint_move
 from .transit import TransitPlanner
@@ -284,7 +284,7 @@ def _pass_timing(
         if not bad.size:
             break
         cp = densified(cp, bad, model, bow, job.stock)
-    return cp, timed, corner_stop_mask(timed, s[corners])
+    return cp, timed, corner_stop_mask(timed, s[corners], int(CORNER_JOIN / dt))
 
 
 def assemble_motion(

@@ -41,6 +41,7 @@ from .timing import TimedPath, concatenate, dwell, time_path
 __all__ = [
     "CORNER_ANGLE",
     "CORNER_DWELL",
+    "CORNER_JOIN",
     "corner_dwell",
     "corner_nodes",
     "corner_stop_mask",
@@ -55,6 +56,15 @@ CORNER_ANGLE = np.radians(30.0)
 #: settles rounds the corner (a 40 degree corner at 20 mm/s without the wait: 0.5 mm,
 #: face_error 0.32 mm on the emulator); the default servo's settle time, 0.5 s
 CORNER_DWELL = servo_settle_time()
+#: s: two slow runs of the joints less than this apart are one approach to a corner stop
+#: (:func:`corner_stop_mask`).  Before a concave corner the chord ends are re-spaced
+#: towards the offset profile's corner point by different factors (docs/kerf.md, "Sharp
+#: corners"), a kink of the wire's rigid motion a few samples before the stop: the time
+#: law slows there (tapered profile: 6.9 mm/s against 8), is let back to the feed for a
+#: sample, then stops.  That slow-down is the corner's own (its offset makes it) and the
+#: wire never holds the feed in between, so it is counted with the stop (the kerf's
+#: compensation at the stop is the heat schedule's, as for the stop itself).
+CORNER_JOIN = 0.02
 
 
 def corner_nodes(frames: FloatArray, half_length: float, angle: float = CORNER_ANGLE) -> np.ndarray:
@@ -145,15 +155,21 @@ def corner_dwell(before: TimedPath, vel_limits: FloatArray, acc_limits: FloatArr
                                feed_limited=np.ones(d.t.size, dtype=bool))  # fmt: skip
 
 
-def corner_stop_mask(timed: TimedPath, s_corners: FloatArray) -> np.ndarray:
+def corner_stop_mask(timed: TimedPath, s_corners: FloatArray, join: int = 0) -> np.ndarray:
     """Return the samples (M,) of the feed-limited runs of ``timed`` that reach a corner.
 
     The runs of feed-limited samples (slowed by the joints, inside the stock) that reach a
-    corner at path parameters ``s_corners``.
+    corner at path parameters ``s_corners``; runs apart by at most ``join`` samples (and
+    those between) are one run: the approach to a stop (:data:`CORNER_JOIN`).
     """
     fl = np.asarray(timed.feed_limited, dtype=bool)
     if not fl.any() or len(s_corners) == 0:
         return np.zeros(fl.shape, dtype=bool)
+    if join > 0:  # close the gaps of at most join samples between two slow runs
+        i = np.arange(fl.size)
+        prev = np.maximum.accumulate(np.where(fl, i, -1))
+        nxt = np.minimum.accumulate(np.where(fl, i, fl.size)[::-1])[::-1]
+        fl = fl | ((prev >= 0) & (nxt < fl.size) & (nxt - prev - 1 <= join))
     starts = fl & ~np.r_[False, fl[:-1]]
     run = np.cumsum(starts) * fl  # 1.. per run, 0 outside
     at = np.clip(np.searchsorted(timed.s_of_t, s_corners), 0, fl.size - 1)

@@ -4,8 +4,8 @@
 Inside the heat windows (pre-heat, lead-in, cut, lead-out: the samples the wire is hot
 in) the desired power of the sample's cut is, by ``[tool] heat mode``:
 
-* ``on_off``: the power while on (:func:`~..cut.kerf.on_power`: ``power``, else the
-  power that melts the cut's kerf at its feed);
+* ``on_off``: the power while on (:func:`~..cut.heat_power.on_power`: ``power``, else
+  the power that melts the cut's kerf at its feed);
 * ``constant``: ``power``;
 * ``constant_kerf``: ``power_threshold + (kerf - kerf_base) v / kerf_gain``
   (:meth:`~ruledrobot.robot.wire.kerf.Material.power_for_kerf`) with ``v`` the measured
@@ -13,7 +13,8 @@ in) the desired power of the sample's cut is, by ``[tool] heat mode``:
   point); outside the block (pre-heat, the lead-in's way to it) the cut's feed, so the
   wire enters hot enough; at a stop ``v = 0`` and the power falls to the threshold;
 
-zero outside the windows, clipped to ``[0, full_scale]`` when the output has one.  The
+zero outside the windows, clipped to ``[0, full_scale]`` on an analog output: one function,
+:func:`~..cut.heat_power.set_power`, which the compensation's kerf uses too.  The
 set-points lead the motion by the wire's ``lag``: ``setpoint(t) = desired(t + lag)``
 (the last value held), so that :func:`~ruledrobot.robot.wire.kerf.wire_power`, the wire's
 power as the model delays it, is the desired power.  Units: W/m, s.
@@ -25,7 +26,7 @@ import numpy as np
 
 from ...geometry.checks import FloatArray
 from ...robot.motion.trajectory import HEATED_PHASES
-from ..cut.kerf import on_power
+from ..cut.heat_power import set_power
 from ..job.spec import Job
 from .assemble import Motion
 
@@ -50,7 +51,6 @@ def heat_schedule(job: Job, motion: Motion) -> FloatArray | None:
     if not has_heat_model(job):
         return None
     h = job.tool.heat
-    mode = "on_off" if h is None else h.mode
     t = motion.timed.t
     on = motion.heat if h is not None else np.isin(motion.labels.astype(str), HEATED_PHASES)
     desired = np.zeros(t.size)
@@ -58,15 +58,8 @@ def heat_schedule(job: Job, motion: Motion) -> FloatArray | None:
         rows = np.flatnonzero(on & (motion.pass_of == k))
         if not rows.size:
             continue
-        cut = cp.cut
-        if mode == "constant_kerf":
-            v = np.where(motion.wire.inside[rows], motion.wire.feed[rows], cut.feed_speed)
-            desired[rows] = job.material.power_for_kerf(cut.kerf, np.nan_to_num(v))
-        elif mode == "constant":
-            desired[rows] = h.power
-        else:
-            desired[rows] = on_power(cut, h, job.material)
-    top = h.full_scale if h is not None and h.full_scale is not None else np.inf
-    desired = np.clip(desired, 0.0, top)
+        # the reference point's speed: measured in the block, the cut's feed outside it
+        v = np.where(motion.wire.inside[rows], motion.wire.feed[rows], cp.cut.feed_speed)
+        desired[rows] = set_power(cp.cut, h, job.material, np.nan_to_num(v))
     lag = 0.0 if h is None else h.lag
     return np.interp(t + lag, t, desired) if lag > 0.0 else desired

@@ -14,6 +14,7 @@ from ...robot.verdict import Check, Verdict
 from ...robot.wire.cut import feed_measures
 from ...robot.wire.face import FaceError
 from ...robot.wire.lag import corner_dwell, wire_bow
+from ..cut.heat_power import burn_advice
 from ..motion.feed_limit import feed_limit_reason
 from ..plan import SINGULARITY_MARGIN, Plan, job_reference
 from ..reach.explain import reach_reasons
@@ -83,7 +84,7 @@ def _cut_sections(plan: Plan, ver: Verification | None) -> tuple[list[dict], lis
             kept_surface_error_mm=err * 1e3 if compensated else None,
             wire_tolerance_mm=cut.wire_tolerance * 1e3, feed_tolerance=cut.feed_tolerance,
             face_error_mm=None if fe is None else _face_mm(fe), tolerance_mm=cut.tolerance * 1e3,
-            face_detail="" if fe is None else _face_detail(fe, mo),
+            face_detail="" if fe is None else _face_detail(fe, mo, plan.job),
             predicted_kerf=None if fe is None else _kerf_words(fe),
             wire_lag=None if lag["bow_mm"] is None else
             f"{lag['bow_mm']:.3g} mm / {lag['corner_dwell_s']:.3g} s",
@@ -148,13 +149,16 @@ def _face_mm(fe: FaceError) -> float | None:
     return None if np.isnan(fe.worst) else float(fe.worst) * 1e3
 
 
-def _face_detail(fe: FaceError, mo) -> str:
-    """Where the face is worst, in words: a burn's time, or the error's time and phase."""
+def _face_detail(fe: FaceError, mo, job) -> str:
+    """Where the face is worst, in words: a burn's time, where the wire stands and what to
+    change (:func:`~..cut.heat_power.burn_advice`), or the error's time and phase."""
     if np.isnan(fe.worst):
         return "the wire never cut the part's face"
     if fe.burn:
-        return (f"burn at t = {fe.t:.3f} s: the wire stops in the foam with the heat above "
-                "its threshold")  # fmt: skip
+        at_corner = mo.corner_stop is not None and bool(mo.corner_stop[fe.at])
+        where = "at a corner stop in the foam" if at_corner else "in the foam"
+        return (f"burn at t = {fe.t:.3f} s: the wire stops {where} with the heat above its "
+                f"threshold; {burn_advice(job.tool.heat, job.material)}")  # fmt: skip
     return (f"worst at t = {fe.t:.3f} s ({mo.labels[fe.at]}), the predicted kerf there "
             f"{fe.kerf[fe.at, 0] * 1e3:.3f} / {fe.kerf[fe.at, 1] * 1e3:.3f} mm at the wire's "
             "start / end side")  # fmt: skip

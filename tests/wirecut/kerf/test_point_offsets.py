@@ -12,7 +12,8 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from ruledrobot.robot.wire.kerf import Material
-from ruledrobot.wirecut.cut.kerf import cut_offsets, held_kerf, kerf_offsets
+from ruledrobot.wirecut.cut.heat_power import held_kerf
+from ruledrobot.wirecut.cut.kerf import cut_offsets, kerf_offsets
 from ruledrobot.wirecut.cut.passes import refine_cut
 from ruledrobot.wirecut.cut.wire_geometry import chords
 from ruledrobot.wirecut.job.load import load_job
@@ -26,7 +27,7 @@ def test_constant_kerf_ends_agree_with_the_model(ratio, kerf, feed):
     the reference point's speed, evaluated at the end's speed."""
     m = Material(**MATERIAL)
     job_cut = type("C", (), {"kerf": kerf, "feed_speed": feed})
-    heat = type("H", (), {"mode": "constant_kerf"})
+    heat = type("H", (), {"mode": "constant_kerf", "kind": "analog", "full_scale": None})
     p = m.power_for_kerf(kerf, feed)
     assert held_kerf(ratio, job_cut, heat, m) == pytest.approx(m.kerf(feed * ratio, p), rel=1e-12)
 
@@ -78,3 +79,24 @@ def test_without_material_the_constant_kerf_is_unchanged(panel):
     np.testing.assert_array_equal(k.offset, ref.offset)
     assert k.turn is None
     np.testing.assert_allclose(_end_offsets(job, rc, k)[10:-10], KERF / 2, atol=1e-12)
+
+
+def test_clipped_power_the_compensation_uses_what_the_schedule_sets(tmp_path):
+    """constant_kerf with full_scale below the power the kerf asks at the feed (50 W/m):
+    the schedule sets 45 W/m on the held stretch and the compensation moves the reference
+    end by half the kerf 45 W/m melts there, not half the cut's kerf; the plan says so."""
+    from ruledrobot.wirecut.cut.passes import cut_paths
+
+    heat = ('heat = { output = "analog:0", mode = "constant_kerf", full_scale = 45.0, '
+            "preheat = 0.5 }")
+    job = load_job(write_panel(tmp_path, heat))
+    rc = refine_cut(job.cut, job.stock, "panel", job.tool.wire_length)
+    k = cut_offsets(rc.frames, job.stock, job.cut, job.tool.heat, job.material, False)
+    c0, c1, hit = chords(rc.frames, job.stock)
+    full = hit & (np.abs(c1 - c0) > 0.99 * 0.2)
+    m = Material(**MATERIAL)
+    clipped = m.kerf(job.cut.feed_speed, 45.0)  # 0.7375 mm
+    assert clipped < KERF
+    np.testing.assert_allclose(_end_offsets(job, rc, k)[full][:, 0], clipped / 2, atol=2e-7)
+    notes = " ".join(n for cp in cut_paths(job) for n in cp.notes)
+    assert "full_scale 45 W/m clips" in notes and "face_error judges" in notes

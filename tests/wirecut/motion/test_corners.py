@@ -81,3 +81,8 @@ def test_the_stop_mask_takes_the_slow_runs_that_reach_a_corner():
     mask = corner_stop_mask(Timed, np.array([0.6]))  # inside the second slow run
     assert mask.tolist() == [0, 0, 0, 0, 0, 1, 1, 1, 0, 0, 0]
     assert not corner_stop_mask(Timed, np.array([])).any()
+    # a slow run a sample before the stop's, joined: one approach (CORNER_JOIN)
+    joined = corner_stop_mask(Timed, np.array([0.6]), join=1)
+    assert joined.tolist() == [0, 0, 0, 0, 0, 1, 1, 1, 1, 1, 1]
+    assert corner_stop_mask(Timed, np.array([0.1]), join=1).tolist()[:5] == [0, 1, 1, 0, 0]
+    assert corner_stop_mask(Timed, np.array([0.1]), join=2).tolist() == [0] + [1] * 10

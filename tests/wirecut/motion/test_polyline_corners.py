@@ -132,7 +132,7 @@ def gcode_plans(jobs) -> dict:
 @pytest.mark.parametrize("kind", ["dxf", "lines"])
 def test_a_polyline_of_any_format_plans_like_the_gcode(jobs, gcode_plans, name, kind):
     """The wire stops at the G-code's corners (onto the leading edge, round the trailing
-    edge in two or three turns after the kerf offset, off the leading edge), within two
+    edge at the offset profile's corner point, off the leading edge), within two
     rulings of them; it stays on its ruling within its tolerance, and the feed is held
     within its tolerance between them, as the G-code's to 1 %.  (The count of stops, runs
     of slowed samples, differs where a corner is doubled: the tapered G-code's 3, its
@@ -141,7 +141,7 @@ def test_a_polyline_of_any_format_plans_like_the_gcode(jobs, gcode_plans, name, 
     cut = jobs[name, kind].cut
     got = _measures(make_plan(jobs[name, kind]))
     if name == "profile":
-        assert ref["corner_stops"] == 4 and got["corner_stops"] == 4
+        assert ref["corner_stops"] == 3 and got["corner_stops"] == 3
     assert got["corner_stops"] >= 3 and ref["corner_stops"] >= 3
     gap = np.abs(got["corners"][:, None] - ref["corners"][None, :])
     assert gap.min(axis=0).max() <= 2 and gap.min(axis=1).max() <= 2, got["corners"]
