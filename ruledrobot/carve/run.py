@@ -12,6 +12,7 @@ closed mesh that holds the part.
 from __future__ import annotations
 
 import dataclasses
+import math
 import os
 import time
 from dataclasses import dataclass, field
@@ -50,6 +51,11 @@ class CarveResult:
     def ok(self) -> bool:
         """Whether every check holds (the report's ``ok``)."""
         return bool(self.report["ok"])
+
+
+def _ratio(volume: float, part: float) -> float | None:
+    """``volume / part - 1`` to 5 decimals, None when ``volume`` is not estimated (NaN)."""
+    return None if not math.isfinite(volume) else round(volume / part - 1.0, 5)
 
 
 def check_fits(part: PartMesh, cell: Cell) -> None:
@@ -205,8 +211,9 @@ def _report(cell: Cell, part: PartMesh, plan: CutPlan, carved, base, query: Mesh
                     "cutter's parallel wire with a turntable), chosen the same way",
             "directions": [[round(float(x), 4) for x in lp.axis] for lp in plan.baseline],
             "carved_volume_l": round(vb * 1e3, 5), "excess": round(vb / vp - 1.0, 5),
-            "rough_excess_voxel": round(plan.kept_voxel / vp - 1.0, 5),
-            "baseline_excess_voxel": round(plan.baseline_kept_voxel / vp - 1.0, 5)},
+            # voxel estimates: null when not made (no roughing loop was chosen)
+            "rough_excess_voxel": _ratio(plan.kept_voxel, vp),
+            "baseline_excess_voxel": _ratio(plan.baseline_kept_voxel, vp)},
         "carved": None if made is None else made.as_dict(),
         "notes": [f"repaired: {r}" for r in part.repairs] + list(plan.notes)
                  + ([made.note()] if made is not None and made.note() else []),

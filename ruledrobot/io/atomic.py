@@ -7,6 +7,7 @@ behind (DESIGN: "Nothing is written half").
 from __future__ import annotations
 
 import contextlib
+import math
 import os
 import tempfile
 from collections.abc import Iterator
@@ -74,6 +75,20 @@ def atomic_write_bytes(path: str | os.PathLike[str], data: bytes) -> Path:
     return Path(path)
 
 
+def _nonfinite(doc: object, where: str = "") -> str | None:
+    """Return the path (``cuts[2].depth_mm``) of the first NaN or infinity in ``doc``."""
+    if isinstance(doc, float):
+        return None if math.isfinite(doc) else (where or "the document")
+    items = (doc.items() if isinstance(doc, dict)
+             else enumerate(doc) if isinstance(doc, list | tuple) else ())  # fmt: skip
+    for k, v in items:
+        found = _nonfinite(v, f"{where}[{k}]" if isinstance(k, int) else
+                           (f"{where}.{k}" if where else str(k)))  # fmt: skip
+        if found:
+            return found
+    return None
+
+
 def atomic_write_json(path: str | os.PathLike[str], doc: object, *, compact: bool = False) -> Path:
     """Write ``doc`` as JSON to ``path`` atomically; return the path.
 
@@ -87,6 +102,6 @@ def atomic_write_json(path: str | os.PathLike[str], doc: object, *, compact: boo
         text = (json.dumps(doc, separators=(",", ":"), allow_nan=False) if compact
                 else json.dumps(doc, indent=JSON_INDENT, allow_nan=False))  # fmt: skip
     except ValueError as exc:
-        raise ValueError(f"{path}: {exc} (write null, or a word, for a value that is not a "
-                         "finite number)") from None
+        raise ValueError(f"{path}: {exc} at {_nonfinite(doc) or '?'} (write null, or a word, "
+                         "for a value that is not a finite number)") from None
     return atomic_write_text(path, text + "\n")
