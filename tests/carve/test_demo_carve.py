@@ -1,7 +1,12 @@
-"""``ruledrobot demo --carve``: the column made from its closed form, carved, planned: PASS."""
+"""``ruledrobot demo --carve``: the column made from its closed form, carved, planned: PASS.
+
+The demo is ``ruledrobot make`` on the column's cell file (written into the make folder's
+``part/``): its one run is also the test of make's whole chain that passes, for real (the
+chain that fails, tests/make/test_make_column.py; make's own logic, tests/make with fakes)."""
 
 from __future__ import annotations
 
+import hashlib
 import json
 
 import numpy as np
@@ -10,6 +15,7 @@ from typer.testing import CliRunner
 from ruledrobot.carve.demo import column_mesh
 from ruledrobot.cli import app
 from ruledrobot.io.lines import read_lines_document
+from ruledrobot.io.outdir import read_manifest
 
 
 def test_the_demo_column_is_closed_and_on_its_closed_form():
@@ -41,6 +47,28 @@ def test_demo_carve_carves_the_column_in_one_exact_loop_and_plans_it(tmp_path):
     # make's demo (docs/make.md): the setup planned, its program and viewer file
     plan = json.loads((out / "setup1" / "report.json").read_text())
     assert plan["verdict"]["ok"]
-    assert (out / "setup1" / "cut.script").is_file() and (out / "view" / "setup1.html").is_file()
     assert (out / "part" / "column.stl").is_file()
-    assert "make: PASS — 1 setup" in " ".join(res.output.split())
+    text = " ".join(res.output.split())
+    assert "make: PASS — 1 setup" in text
+    setup = out / "setup1"
+    for name in ("cut.script", "trajectory.csv", "trajectory.json", "report.json", "job.toml",
+                 "face0.json"):  # fmt: skip
+        assert (setup / name).is_file(), name
+    assert (out / "view" / "setup1.html").stat().st_size > 500_000
+    assert (out / "setups.txt").is_file()
+    doc = json.loads((out / "make.json").read_text())
+    assert doc["ok"] and doc["carve"]["cuts"] == 1 and len(doc["setups"]) == 1
+    assert doc["setups"][0]["cuts"] == ["face0"] and doc["setups"][0]["program"]["mode"]
+    assert abs(doc["carve"]["excess"]) < 0.03
+    # the sidecar and the program name the setup's own job file, which holds those bytes
+    meta = json.loads((setup / "trajectory.json").read_text())
+    assert meta["job"]["path"] == str(setup / "job.toml")
+    assert hashlib.sha256((setup / "job.toml").read_bytes()).hexdigest() == meta["job"]["sha256"]
+    script = (setup / "cut.script").read_text()
+    assert f"# job: {setup / 'job.toml'}" in script and "# verified" in script
+    # the summary names setups, cuts, the verdict, the excess, the time, the steps by hand
+    for words in ("1 cut in 1 setup", "face0", "PASS", "excess material", "robot time",
+                  "Setup 1: clamp the 200 x 200 x 150 mm block"):  # fmt: skip
+        assert words in text, words
+    assert set(read_manifest(out)["files"]) >= {"setup1/cut.script", "view/setup1.html",
+                                                "setup1/trajectory.csv", "make.json"}

@@ -88,15 +88,25 @@ def test_feed_chord_meets_the_chord_without_a_jump():
 
 
 def _independent(t: np.ndarray, ends: np.ndarray, box: Box, n: int = 2001):
-    """Points of the wire tested inside the box; speeds across the wire of every point."""
-    lam = np.linspace(0.0, 1.0, n)
+    """Points of the wire tested inside the box; speeds across the wire of every point.
+
+    The wire's ``n`` points at fractions ``lam`` of it, ``a + lam (b - a)``, are linear in
+    ``lam``, and so are their box coordinates and their velocities (np.gradient over ``t``
+    is linear): both are interpolated between the ends' ((T, 3) -> (T, n)), the squared
+    speed across the wire as the quadratic in ``lam`` it is."""
+    lam = np.linspace(0.0, 1.0, n)[None, :]
     a, b = ends[:, 0], ends[:, 1]
-    pts = a[:, None] + lam[None, :, None] * (b - a)[:, None]
-    inbox = np.all(np.abs(box.to_box(pts)) <= 0.5 * box.size, axis=-1)
-    v = np.gradient(pts, t, axis=0)
+    pa, pb = box.to_box(a), box.to_box(b)
+    inbox = np.ones((len(t), n), dtype=bool)
+    for i in range(3):  # each box axis: (T, n)
+        inbox &= np.abs(pa[:, i, None] + lam * (pb - pa)[:, i, None]) <= 0.5 * box.size[i]
     d = (b - a) / np.linalg.norm(b - a, axis=1, keepdims=True)
-    across = v - (v * d[:, None]).sum(-1, keepdims=True) * d[:, None]
-    speed = np.where(inbox, np.linalg.norm(across, axis=-1), -np.inf).max(axis=1)
+    va, vb = np.gradient(a, t, axis=0), np.gradient(b, t, axis=0)
+    ca = va - (va * d).sum(-1, keepdims=True) * d  # across the wire, at its ends
+    dc = vb - (vb * d).sum(-1, keepdims=True) * d - ca
+    sq = (ca * ca).sum(-1)[:, None] + lam * (2 * (ca * dc).sum(-1)[:, None]
+                                             + lam * (dc * dc).sum(-1)[:, None])
+    speed = np.where(inbox, np.sqrt(np.maximum(sq, 0.0)), -np.inf).max(axis=1)
     length = inbox.sum(axis=1) / (n - 1) * np.linalg.norm(b - a, axis=1)
     return inbox.sum(axis=1) >= 3, speed, length
 

@@ -21,7 +21,13 @@ from ruledrobot.io.outdir import read_manifest
 from ruledrobot.io.trajectory import read_trajectory
 from ruledrobot.wirecut.job.demo import DEMO_JOB
 
-TRIALS = 10
+#: where the kills fall (fractions): one while the command starts (before its staging
+#: folder exists), one while it plans (the staging folder empty), and four in quarters of
+#: the time it writes its files (from the staging folder's first file to the command's
+#: exit, the last quarter past it), each at a random moment in its stratum
+STRATA = ((None, 0.0, 1.0), ("planning", 0.0, 1.0),
+          ("writing", 0.0, 0.25), ("writing", 0.25, 0.5), ("writing", 0.5, 0.75),
+          ("writing", 0.75, 1.05))  # fmt: skip
 
 
 def _complete(folder: Path) -> dict:
@@ -40,31 +46,66 @@ def _plan(job: Path, out: Path) -> subprocess.Popen:
                             env=env)  # fmt: skip
 
 
+def _phases(proc: subprocess.Popen, out: Path, seen: set[Path]) -> dict[str, float]:
+    """Poll a running plan's staging folder: the moments (s after now) its folder appears
+    (``planning``) and receives its first file (``writing``), and its exit (``end``)."""
+    t0, marks = time.monotonic(), {}
+    while proc.poll() is None:
+        for phase in ("planning", "writing"):
+            if phase not in marks and _entered(out, seen, phase):
+                marks[phase] = time.monotonic() - t0
+        time.sleep(0.01)
+    marks["end"] = time.monotonic() - t0
+    return marks
+
+
+def _staging(out: Path) -> set[Path]:
+    return set(out.parent.glob(f".{out.name}.staging-*"))
+
+
 def test_a_killed_plan_leaves_the_old_or_the_new_complete_set(tmp_path):
-    old_job, new_job = tmp_path / "old.toml", tmp_path / "new.toml"
-    old_job.write_text(DEMO_JOB)
-    new_job.write_text(DEMO_JOB.replace("feed_speed = 0.01", "feed_speed = 0.012"))
+    """SIGKILL at a random moment in each stratum of :data:`STRATA`; after each kill the
+    folder is the previous complete set or the incoming one (then the next trial plans the
+    other job over it)."""
+    jobs = {0.01: tmp_path / "old.toml", 0.012: tmp_path / "new.toml"}
+    jobs[0.01].write_text(DEMO_JOB)
+    jobs[0.012].write_text(DEMO_JOB.replace("feed_speed = 0.01", "feed_speed = 0.012"))
     out = tmp_path / "cut"
-    t0 = time.monotonic()
-    assert _plan(old_job, out).wait(120) == 0
-    full = time.monotonic() - t0
-    old = _complete(out)
+    proc = _plan(jobs[0.01], out)
+    marks = _phases(proc, out, _staging(out))
+    assert proc.wait() == 0 and "writing" in marks, marks
+    window = marks["end"] - marks["writing"]
+    feed, current = 0.01, _complete(out)
     rng = np.random.default_rng(1)
     outcomes = []
-    for _ in range(TRIALS):
-        proc = _plan(new_job, out)
-        time.sleep(float(rng.uniform(0.2, 1.2 * full)))
+    for phase, lo, hi in STRATA:
+        incoming = 0.012 if feed == 0.01 else 0.01
+        seen = _staging(out)
+        proc = _plan(jobs[incoming], out)
+        if phase is None:  # before the staging folder: the command starting
+            time.sleep(float(rng.uniform(0.2, marks["planning"])))
+        else:  # wait for the phase in this run, then a random moment in the stratum
+            length = window if phase == "writing" else marks["writing"] - marks["planning"]
+            while proc.poll() is None and not _entered(out, seen, phase):
+                time.sleep(0.01)
+            time.sleep(float(rng.uniform(lo, hi)) * length)
         proc.send_signal(signal.SIGKILL)
         proc.wait(30)
         man = _complete(out)  # never a mixed or half-written folder
-        outcomes.append("old" if man["files"] == old["files"] else "new")
+        outcomes.append("old" if man["files"] == current["files"] else "new")
         traj = read_trajectory(out / "trajectory.csv")  # and the pair reads back
-        feed = 0.01 if outcomes[-1] == "old" else 0.012
+        if outcomes[-1] == "new":  # the incoming set, whole: the next trial replaces it
+            feed, current = incoming, man
         assert json.loads((out / "report.json").read_text())["feed_speed_mm_s"] == feed * 1e3
         assert traj.n > 0
-        if outcomes[-1] == "new":  # start the next trial from the old set again
-            assert _plan(old_job, out).wait(120) == 0
-            old = _complete(out)
     leftovers = [p.name for p in tmp_path.iterdir() if p.name.startswith(".cut.")]
     assert all(".staging-" in n for n in leftovers)  # a killed run's staging, swept later
     assert "old" in outcomes
+
+
+def _entered(out: Path, seen: set[Path], phase: str) -> bool:
+    """Whether a plan started after ``seen`` was taken has entered ``phase``: its staging
+    folder exists (``planning``) or holds a file (``writing``)."""
+    new = _staging(out) - seen
+    return bool(new) and (phase == "planning" or any(
+        q.is_file() for p in new for q in p.rglob("*")))

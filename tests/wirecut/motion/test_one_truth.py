@@ -26,18 +26,31 @@ def _job(text: str):
 
 
 def _measure(traj, stock: Box, wire_length: float, n: int = 601):
-    """Independent: (inside (M,), depth (M,), cutting speed (M,)) from the TCP column."""
+    """Independent: (inside (M,), depth (M,), cutting speed (M,)) from the TCP column.
+
+    The wire's ``n`` points ``o + s z`` (``s`` along the wire, ``o``, ``z`` the TCP's origin
+    and z axis) are linear in ``s``, and so are their box coordinates and their velocities
+    (np.gradient over time is linear) and the velocities' parts across the wire (``z`` a
+    unit vector): each is interpolated from two (M, 3) columns into (M, n) scalars, the
+    speed across as the root of its quadratic in ``s``."""
     T = traj.tcp_poses()
-    lam = np.linspace(-0.5, 0.5, n)
-    pts = T[:, None, :3, 3] + lam[None, :, None] * wire_length * T[:, None, :3, 2]
-    loc = stock.to_box(pts)
-    inbox = np.all(np.abs(loc) <= 0.5 * stock.size, axis=-1)
+    o, z = T[:, :3, 3], T[:, :3, 2]
+    s = np.linspace(-0.5, 0.5, n)[None, :] * wire_length
+    lo, lz = stock.to_box(o), z @ stock.rotation  # box coordinates: lo + s lz
+    inbox = np.ones((len(o), n), dtype=bool)
+    depth_all = np.full((len(o), n), np.inf)
+    for i in range(3):  # each box axis: (M, n)
+        room = 0.5 * stock.size[i] - np.abs(lo[:, i, None] + s * lz[:, i, None])
+        inbox &= room >= 0.0
+        np.minimum(depth_all, room, out=depth_all)
     inside = inbox.any(axis=1)
-    depth = np.where(inbox, (0.5 * stock.size - np.abs(loc)).min(-1), 0.0).max(axis=1)
-    v = np.gradient(pts, traj.t, axis=0)
-    z = T[:, None, :3, 2]
-    across = v - (v * z).sum(-1, keepdims=True) * z
-    sp = np.linalg.norm(across, axis=-1)
+    depth = np.where(inbox, depth_all, 0.0).max(axis=1)
+    vo, vz = np.gradient(o, traj.t, axis=0), np.gradient(z, traj.t, axis=0)
+    A = vo - (vo * z).sum(-1, keepdims=True) * z  # across the wire: A + s B
+    B = vz - (vz * z).sum(-1, keepdims=True) * z
+    aa, ab, bb = ((A * A).sum(-1)[:, None], (A * B).sum(-1)[:, None], (B * B).sum(-1)[:, None])
+    sq = aa + s * (2.0 * ab + s * bb)
+    sp = np.sqrt(np.maximum(sq, 0.0))
     speed = np.where(inbox, sp, -np.inf).max(axis=1)
     # how fast the speed changes along the wire (per m) among the points in the box: the
     # dense points lie up to one spacing inside the chord's true ends
