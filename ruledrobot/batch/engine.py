@@ -100,7 +100,9 @@ def local_cluster(workers: int, quiet: bool = True):
         return distributed.LocalCluster(
             n_workers=workers, threads_per_worker=1, processes=True, host="127.0.0.1",
             dashboard_address=None, scheduler_kwargs={"allowed_failures": 0},
-            silence_logs=logging.ERROR if quiet else logging.WARNING,
+            # quiet: the batch reports its jobs itself; a worker that loses the scheduler
+            # while the batch stops (Ctrl-C on a busy machine) would print its traceback
+            silence_logs=logging.CRITICAL if quiet else logging.WARNING,
         )  # fmt: skip
 
 
