@@ -385,14 +385,20 @@ def _ladder_roll(
     cost = np.where(node_ok[0], 0.0, np.inf)
     back = np.zeros((n, k * 8), dtype=np.intp)
     for i in range(1, n):
-        dq = wrap_angle(qn[i - 1][:, None, :] - qn[i][None, :, :])  # (N, N, 6)
+        # only the reached nodes of the last ruling and the valid ones of this (the rest
+        # cost inf either way; in index order, so ties break as over all nodes)
+        a, b = np.flatnonzero(np.isfinite(cost)), np.flatnonzero(node_ok[i])
+        if not (a.size and b.size):
+            return None
+        dq = wrap_angle(qn[i - 1][a][:, None, :] - qn[i][b][None, :, :])  # (A, B, 6)
         step = np.abs(dq).max(axis=-1)
-        c = (dq * dq).sum(-1) + roll_weight * droll
+        c = (dq * dq).sum(-1) + roll_weight * droll[np.ix_(a, b)]
         c = np.where(step <= jump, c, np.inf)
-        total = cost[:, None] + c
-        back[i] = np.argmin(total, axis=0)
-        cost = total[back[i], np.arange(k * 8)]
-        cost = np.where(node_ok[i], cost, np.inf)
+        total = cost[a][:, None] + c
+        arg = np.argmin(total, axis=0)
+        back[i, b] = a[arg]
+        cost = np.full(k * 8, np.inf)
+        cost[b] = total[arg, np.arange(b.size)]
         if not np.isfinite(cost).any():
             return None
     j = int(np.argmin(cost))
