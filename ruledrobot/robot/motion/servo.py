@@ -3,8 +3,8 @@ by the emulator's arm, the runs that set the wire's heat along a servo motion, a
 planner's corner dwell (docs/kerf.md, "The heat on the robot").
 
 servoj smooths the stream it is given: UR's controller follows with a lag of about
-``lookahead_time`` (a shorter one at a higher ``gain``; /work/shared/research/ur_rtde.md,
-"servoJ lag and jitter").  The project models it as a first-order tracker of time
+``lookahead_time`` (a shorter one at a higher ``gain``; the project's research notes,
+ur_rtde.md, "servoJ lag and jitter").  The project models it as a first-order tracker of time
 constant :func:`servo_time_constant`, stepped once per control period::
 
     ref_k = ref_{k-1} + a (goal_k - ref_{k-1}),    a = min(1, dt / tau)

@@ -1,6 +1,6 @@
 """The kerf a hot wire melts: the one model of its width from speed and heat.
 
-An energy balance per metre of wire (docs/kerf.md; /work/shared/research/hotwire-physics.md):
+An energy balance per metre of wire (docs/kerf.md; the research notes, hotwire-physics.md):
 the heat put into the wire above what it loses without cutting, ``p - p0`` [W/m], melts
 a channel of width ``w`` while the wire moves across itself at ``v`` [m/s]::
 

@@ -6,7 +6,7 @@ at mid-span by the bending moment of the equivalent simply supported beam over `
 
     bow = q * c * (2 L - c) / (8 T)        (= q L^2 / (8 T) when the chord is the wire)
 
-(/work/shared/research/hotwire-physics.md, "Wire lag and corners").  The drag grows
+(the research notes, hotwire-physics.md, "Wire lag and corners").  The drag grows
 with speed; the model takes it linear, ``q = drag * v`` (``drag`` [N/m per m/s], a
 material constant measured like the kerf: a cut stopped mid-way shows the bow).
 
