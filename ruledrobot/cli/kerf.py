@@ -78,6 +78,7 @@ def fit(
 
     from ..io.atomic import atomic_write_text
     from ..kerf import fit_kerf, material_text, read_measured
+    from ..kerf.fit import FIT_HEADER
 
     try:
         res = fit_kerf(read_measured(measured))
@@ -97,7 +98,12 @@ def fit(
                       highlight=False, markup=False)  # fmt: skip
         console.print(text, highlight=False, markup=False)
         raise typer.Exit(code=1)
-    path = atomic_write_text(out or measured.with_name("material.toml"), text)
+    target = out or measured.with_name("material.toml")
+    if target.exists() and not target.read_text(errors="replace").startswith(FIT_HEADER):
+        # a file of the user's own (a table pasted and edited by hand) is never written over
+        raise fail(f"{target}: exists and was not written by kerf fit; give another --out "
+                   "or move it")  # fmt: skip
+    path = atomic_write_text(target, text)
     console.print(text, highlight=False, markup=False)
     console.print(f"wrote {path}", highlight=False, markup=False)
 

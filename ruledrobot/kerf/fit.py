@@ -38,6 +38,9 @@ from .measured import Measured
 __all__ = ["HELD_OUT_LIMIT", "RELATIVE_LIMIT", "RMS_LIMIT", "Constant", "KerfFit",
            "fit_kerf"]  # fmt: skip
 
+#: the first words of every table kerf fit writes (it writes over no other file)
+FIT_HEADER = "# ruledrobot kerf fit"
+
 #: largest RMS residual [m] of a good fit: twice a caliper's reading scatter on foam
 RMS_LIMIT = 0.05e-3
 #: largest leave-one-out prediction error [m]: the default face tolerance (docs/kerf.md)
@@ -279,7 +282,7 @@ def material_text(fit: KerfFit) -> str:
     if mat is None:
         raise ValueError(f"{fit.measured.source}: no material: {fit.verdict.summary()}")
     word = "PASS" if fit.verdict.ok else "FAIL"
-    out = [f"# ruledrobot kerf fit {fit.measured.source}: {int(fit.used.sum())} of "
+    out = [f"{FIT_HEADER} {fit.measured.source}: {int(fit.used.sum())} of "
            f"{fit.used.size} rows fitted, RMS {fit.rms * 1e3:.3f} mm; {word}: "
            f"{fit.verdict.summary()}", "# paste into a job file (docs/kerf.md)", "[material]"]
     for c in fit.constants:

@@ -97,3 +97,16 @@ def test_ladder_bad_input_exits_2(job_file, tmp_path):
                                    "--powers", "15,30"], env={"COLUMNS": "200"})  # fmt: skip
     assert res.exit_code == 2 and "--speeds: expected comma-separated numbers" in res.output
     assert not (tmp_path / "lad").exists()
+
+
+def test_fit_writes_over_its_own_table_but_never_over_a_users_file(tmp_path):
+    path = _csv(tmp_path / "measured.csv")
+    mine = tmp_path / "material.toml"
+    mine.write_text("[material]\nkerf_base = 0.0004  # my own, edited\n")
+    res = CliRunner().invoke(app, ["kerf", "fit", str(path)])
+    assert res.exit_code == 2 and "was not written by kerf fit" in res.output
+    assert mine.read_text() == "[material]\nkerf_base = 0.0004  # my own, edited\n"
+    mine.unlink()
+    for _ in range(2):  # the fit's own table is replaced by the next fit
+        assert CliRunner().invoke(app, ["kerf", "fit", str(path)]).exit_code == 0
+    assert mine.read_text().startswith("# ruledrobot kerf fit")
