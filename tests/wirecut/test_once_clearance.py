@@ -17,7 +17,8 @@ from ruledrobot.wirecut.motion.transit import TransitPlanner
 
 
 def _one_at_a_time(cell: Cell, q, P) -> dict[str, np.ndarray]:
-    """The rules as they were written before (a segment test per capsule)."""
+    """The rules as they were written before (a segment test per capsule), the bow's
+    table rule with the rods' and the hub's radii (a capsule lowest at an end less its radius)."""
     stock, margin = cell.stock, cell.margin
     qf = np.nan_to_num(q.reshape(-1, 6))
     Pf = P.reshape(-1, 4, 4)
@@ -37,7 +38,12 @@ def _one_at_a_time(cell: Cell, q, P) -> dict[str, np.ndarray]:
             dist = segment_distance(a[:, None], b[:, None], w[:, :, 0], w[:, :, 1])
             out["bow or wire hits the arm"] |= (dist < radius[k] + BowTool.arm_radius
                                                 + margin).any(axis=1)  # fmt: skip
-    out["bow below the table"] = (w[:, :3, :, 2] < cell.table_z + margin).any(axis=(1, 2))
+    # the rods' and the hub's solids, each capsule alone (the rods' radius, the hub's)
+    below = np.zeros(n, bool)
+    for k in range(3):
+        below |= (w[:, k, :, 2] - BowTool.arm_radius < cell.table_z + margin).any(axis=1)
+    below |= (h[:, :, 2] - cell.hub_radius < cell.table_z + margin).any(axis=1)
+    out["bow below the table"] = below
     up = body >= 1
     low = ends[:, up][..., 2].min(axis=2) - radius[up]
     out["arm below the table"] = (low < cell.table_z + margin).any(axis=1)

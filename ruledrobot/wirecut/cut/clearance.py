@@ -285,7 +285,12 @@ def clearance(cell: Cell, q: FloatArray, P: FloatArray) -> dict[str, np.ndarray]
             reach = radius[near] + BowTool.arm_radius + margin
             out[BOW_ARM] = (dist < reach[None, :, None]).any(axis=(1, 2))
     if cell.table_z is not None:
-        out[BOW_TABLE] = (w[:, :3, :, 2] < cell.table_z + margin).any(axis=(1, 2))
+        # the rods are capsules of the bow's arm radius and the hub a cylinder (as a
+        # capsule) in MuJoCo: a segment's solid is lowest at an end point less its radius
+        low = w[:, :3, :, 2].min(axis=(1, 2)) - BowTool.arm_radius
+        if cell.hub is not None:
+            low = np.minimum(low, h[:, :, 2].min(axis=1) - cell.hub_radius)
+        out[BOW_TABLE] = low < cell.table_z + margin
         # every link from the shoulder on (the column stands on the base, on the table);
         # a capsule is lowest at an end point
         up = body >= 1
