@@ -18,7 +18,8 @@ from ruledrobot.wirecut.motion.transit import TransitPlanner
 
 def _one_at_a_time(cell: Cell, q, P) -> dict[str, np.ndarray]:
     """The rules as they were written before (a segment test per capsule), the bow's
-    table rule with the rods' and the hub's radii (a capsule lowest at an end less its radius)."""
+    table rule with the rods' radius (a capsule lowest at an end less its radius) and the
+    hub's rim sampled at 4,096 points."""
     stock, margin = cell.stock, cell.margin
     qf = np.nan_to_num(q.reshape(-1, 6))
     Pf = P.reshape(-1, 4, 4)
@@ -42,7 +43,14 @@ def _one_at_a_time(cell: Cell, q, P) -> dict[str, np.ndarray]:
     below = np.zeros(n, bool)
     for k in range(3):
         below |= (w[:, k, :, 2] - BowTool.arm_radius < cell.table_z + margin).any(axis=1)
-    below |= (h[:, :, 2] - cell.hub_radius < cell.table_z + margin).any(axis=1)
+    # the hub a cylinder: its lowest point on a rim, over 64 points of each end's rim
+    axis = (h[:, 1] - h[:, 0]) / np.linalg.norm(h[:, 1] - h[:, 0], axis=1)[:, None]
+    e1 = np.cross(axis, [0.3, 0.5, 0.8])
+    e1 /= np.linalg.norm(e1, axis=1)[:, None]
+    e2 = np.cross(axis, e1)
+    ang = np.linspace(0.0, 2 * np.pi, 4096, endpoint=False)
+    rim_z = cell.hub_radius * (np.cos(ang)[None] * e1[:, 2:] + np.sin(ang)[None] * e2[:, 2:])
+    below |= (h[:, :, 2].min(axis=1) + rim_z.min(axis=1) < cell.table_z + margin - 1e-6)
     out["bow below the table"] = below
     up = body >= 1
     low = ends[:, up][..., 2].min(axis=2) - radius[up]

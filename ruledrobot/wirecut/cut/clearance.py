@@ -285,11 +285,14 @@ def clearance(cell: Cell, q: FloatArray, P: FloatArray) -> dict[str, np.ndarray]
             reach = radius[near] + BowTool.arm_radius + margin
             out[BOW_ARM] = (dist < reach[None, :, None]).any(axis=(1, 2))
     if cell.table_z is not None:
-        # the rods are capsules of the bow's arm radius and the hub a cylinder (as a
-        # capsule) in MuJoCo: a segment's solid is lowest at an end point less its radius
+        # the rods are capsules of the bow's arm radius in MuJoCo: lowest at an end point
+        # less the radius; the hub is a cylinder: lowest on an end's rim, r sqrt(1 - a_z^2)
+        # below the end's centre (a: its unit axis)
         low = w[:, :3, :, 2].min(axis=(1, 2)) - BowTool.arm_radius
         if cell.hub is not None:
-            low = np.minimum(low, h[:, :, 2].min(axis=1) - cell.hub_radius)
+            a_z = (h[:, 1, 2] - h[:, 0, 2]) / np.linalg.norm(h[:, 1] - h[:, 0], axis=1)
+            rim = cell.hub_radius * np.sqrt(np.clip(1.0 - a_z**2, 0.0, None))
+            low = np.minimum(low, h[:, :, 2].min(axis=1) - rim)
         out[BOW_TABLE] = low < cell.table_z + margin
         # every link from the shoulder on (the column stands on the base, on the table);
         # a capsule is lowest at an end point
