@@ -24,12 +24,13 @@ demo: $(STAMP)
 	$(BIN)/ruledrobot demo --out out/demo
 
 ## Run the whole test suite (what CI runs): the tests that are not real-time on both
-## cores (pytest-xdist), then the real-time ones (emulator streams) apart from them, in
-## two groups of whole modules (their tolerances are sized for a loaded 2-core machine;
-## README, "Development").
+## cores (pytest-xdist; a module's tests on one worker, so its module fixtures are built
+## once), then the real-time ones (emulator streams) apart from them, in two groups of
+## whole modules (their tolerances are sized for a loaded 2-core machine; README,
+## "Development").
 test: $(STAMP)
 	$(BIN)/ruff check ruledrobot tests scripts
-	$(PYTEST) -q -n 2 -m "not realtime"
+	$(PYTEST) -q -n 2 --dist loadscope -m "not realtime"
 	$(PYTEST) -q -n 2 --dist loadfile -m realtime
 
 ## The edit loop: ruff and the fast tests on both cores (no real-time streams, no slow
