@@ -3,8 +3,9 @@
 A minimal writer (no third-party dependency: tomli-w is an extra of the batch planner)
 for the flat tables of a job file — numbers, strings, booleans, lists and inline
 tables.  Floats always carry a ``.`` or an exponent (so that TOML reads them back as
-floats), rounded to 12 decimals; numpy scalars and arrays are written as numbers and
-lists.  Used by carve's jobs and the kerf ladder's.
+floats), rounded to 12 decimals (``-0.0`` as ``0.0``); numpy scalars and arrays are
+written as numbers and lists.  Used by carve's jobs, the kerf ladder's and the placement's
+job files (a whole parsed document, :func:`toml_document`).
 """
 
 from __future__ import annotations
@@ -13,7 +14,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["toml_table", "toml_value"]
+__all__ = ["toml_document", "toml_table", "toml_value"]
 
 
 def toml_value(v: Any) -> str:
@@ -42,3 +43,24 @@ def toml_table(name: str, table: dict[str, Any], header: str = "[{}]") -> list[s
     The lines of the table ``name`` (``header`` ``"[[{}]]"`` for an array entry), one
     ``key = value`` each, and a blank line."""
     return [header.format(name), *(f"{k} = {toml_value(v)}" for k, v in table.items()), ""]
+
+
+def toml_document(doc: dict[str, Any], prefix: str = "") -> str:
+    """Write a whole TOML document (a parsed job file: values, tables, arrays of tables).
+
+    The inverse of ``tomllib.loads`` for such documents: a key's plain values first, then
+    its tables (``[prefix.name]``) and arrays of tables (``[[prefix.name]]``), recursively.
+    """
+    def is_array_of_tables(v: Any) -> bool:
+        return isinstance(v, list) and bool(v) and all(isinstance(x, dict) for x in v)
+
+    out = [f"{k} = {toml_value(v)}" for k, v in doc.items()
+           if not isinstance(v, dict) and not is_array_of_tables(v)]  # fmt: skip
+    for k, v in doc.items():
+        name = f"{prefix}{k}"
+        if isinstance(v, dict):
+            out += [f"\n[{name}]", toml_document(v, name + ".").rstrip("\n")]
+        elif is_array_of_tables(v):
+            for entry in v:
+                out += [f"\n[[{name}]]", toml_document(entry, name + ".").rstrip("\n")]
+    return "\n".join(out) + "\n"

@@ -23,6 +23,7 @@ import numpy as np
 from ..geometry import se3
 from ..io.atomic import atomic_write_text
 from ..io.text import user_text
+from ..io.toml_text import toml_document, toml_value
 from ..wirecut.job.spec import Job
 
 if sys.version_info >= (3, 11):
@@ -37,14 +38,9 @@ _PATH_KEYS = ("file", "calibration", "root", "tip", "gcode", "airfoil", "dxf", "
 _PATH = re.compile(r'(\b(?:' + "|".join(_PATH_KEYS) + r')\s*=\s*)"([^"]*)"')
 
 
-def _num(v: float) -> str:
-    v = float(v) + 0.0
-    r = repr(round(v, 9))
-    return "0.0" if r == "-0.0" else r
-
-
 def _vec(v) -> str:
-    return "[" + ", ".join(_num(x) for x in np.asarray(v, dtype=float).ravel()) + "]"
+    """A vector as a TOML list of floats."""
+    return toml_value(np.asarray(v, dtype=float).ravel())
 
 
 def _table_spans(lines: list[str]) -> list[tuple[str, int, int, int]]:
@@ -195,7 +191,7 @@ def write_job_file(
         pass
     doc = tomllib.loads(text)
     out = head + "# (written whole from the parsed job: the original's comments are not kept)\n"
-    out += _dump(_moved_doc(doc, job, keep_cuts))
+    out += toml_document(_moved_doc(doc, job, keep_cuts))
     out = _rebase_paths(out, src, final)
     atomic_write_text(path, out)
     back = parse_job(tomllib.loads(out), str(path), base_dir=path.parent)
@@ -229,37 +225,3 @@ def _moved_doc(doc: dict, job: Job, keep_cuts: list[int] | None) -> dict:
         if cut.keep is not None and not isinstance(cut.keep, str):
             doc["cut"] = {**doc.get("cut", {}), "keep": list(map(float, cut.keep))}
     return doc
-
-
-def _value(v) -> str:
-    if isinstance(v, bool):
-        return "true" if v else "false"
-    if isinstance(v, (int, float)):
-        return _num(v) if isinstance(v, float) else str(v)
-    if isinstance(v, str):
-        return '"' + v.replace("\\", "\\\\").replace('"', '\\"') + '"'
-    if isinstance(v, list):
-        return "[" + ", ".join(_value(x) for x in v) + "]"
-    if isinstance(v, dict):
-        return "{ " + ", ".join(f"{k} = {_value(x)}" for k, x in v.items()) + " }"
-    raise ValueError(f"cannot write {v!r} to TOML")
-
-
-def _dump(doc: dict, prefix: str = "") -> str:
-    """A minimal TOML writer for job documents (tables, arrays of tables, values)."""
-    out = []
-    plain = {k: v for k, v in doc.items()
-             if not isinstance(v, dict) and not (isinstance(v, list) and v and
-                                                 all(isinstance(x, dict) for x in v))}
-    for k, v in plain.items():
-        out.append(f"{k} = {_value(v)}")
-    for k, v in doc.items():
-        name = f"{prefix}{k}"
-        if isinstance(v, dict):
-            out.append(f"\n[{name}]")
-            out.append(_dump(v, name + ".").rstrip("\n"))
-        elif isinstance(v, list) and v and all(isinstance(x, dict) for x in v):
-            for entry in v:
-                out.append(f"\n[[{name}]]")
-                out.append(_dump(entry, name + ".").rstrip("\n"))
-    return "\n".join(x for x in out if x is not None) + "\n"

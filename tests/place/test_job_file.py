@@ -14,7 +14,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from ruledrobot.geometry import se3
-from ruledrobot.place.job_file import _dump, _rebase_paths, write_job_file
+from ruledrobot.io.toml_text import toml_document
+from ruledrobot.place.job_file import _rebase_paths, write_job_file
 from ruledrobot.place.regions import moved_job
 from ruledrobot.wirecut.job.demo import DEMO_JOB
 from ruledrobot.wirecut.job.load import load_job
@@ -151,4 +152,4 @@ _docs = st.dictionaries(
 @settings(max_examples=150, deadline=None)
 @given(_docs)
 def test_the_toml_writer_reads_back(doc):
-    assert tomllib.loads(_dump(doc)) == doc
+    assert tomllib.loads(toml_document(doc)) == doc
