@@ -12,12 +12,13 @@ from __future__ import annotations
 
 import importlib
 
-from ._common import app
+from ._common import app, reflow_help
 
 # importing a command module registers its commands; this order is the order of --help
 for _module in ("surfaces", "formats", "plan", "reach", "carve", "make", "kerf", "batch",
                 "view", "robot"):
     importlib.import_module(f".{_module}", __name__)
+reflow_help(app)
 
 __all__ = ["app", "main"]
 

@@ -42,6 +42,27 @@ def literal(text: str) -> str:
     return escape(text)
 
 
+def reflow_help(typer_app: typer.Typer) -> None:
+    """Give every command of ``typer_app`` (and of its groups) its docstring as help, reflowed.
+
+    Typer (0.29) prints the lines after a command's first paragraph as written, so a
+    docstring wrapped at 95 columns broke mid-sentence in an 80-column terminal ("...
+    setup's program" / "(cut.script), ..."). The lines of each paragraph are joined
+    unless a line starts a list item (``-``, ``*``) or is indented (an example); rich
+    wraps the rest to the terminal.
+    """
+    import inspect
+    import re
+
+    for info in typer_app.registered_commands:
+        if info.help is None and info.callback is not None and info.callback.__doc__:
+            doc = inspect.cleandoc(info.callback.__doc__)
+            info.help = re.sub(r"(?<=\S)\n(?![-*\s])", " ", doc)
+    for group in typer_app.registered_groups:
+        if group.typer_instance is not None:
+            reflow_help(group.typer_instance)
+
+
 def numbers(text: str | None, option: str, n: int | None = None) -> list[float] | None:
     """Parse a comma-separated list of numbers.
 

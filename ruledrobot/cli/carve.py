@@ -9,13 +9,16 @@ import typer
 
 from ._common import app, console, err, fail, literal
 
+#: the cell file argument of ``carve`` and ``make`` (one text for both commands' help)
+CELL_ARGUMENT = typer.Argument(..., help=literal(
+    "Cell file (.toml): [part] file, units, pose, tolerance, rough_cuts, repair, and the "
+    "[stock], [robot], [tool], [cut] of a job (docs/carve.md)."))  # fmt: skip
+
 
 @app.command(epilog="Example:  ruledrobot carve cell.toml --out out/carve   then  ruledrobot "
              "plan out/carve/job.toml --out out/carve-plan   (docs/carve.md)")  # fmt: skip
 def carve(
-    cell: Path = typer.Argument(..., help=literal(
-        "Cell file (.toml): [part] file, units, pose, tolerance, rough_cuts, repair, and the "
-        "[stock], [robot], [tool], [cut] of a job.")),
+    cell: Path = CELL_ARGUMENT,
     out: Path = typer.Option(Path("out/carve"), "--out", "-o", help="Output folder."),
 ) -> None:
     """Turn a part (a closed STL, OBJ, PLY mesh or 3DM model) into the ruled cuts that make it.

@@ -9,15 +9,14 @@ from typing import Any
 
 import typer
 
-from ._common import app, console, err, fail, literal, print_verdict
+from ._common import app, console, err, fail, print_verdict
+from .carve import CELL_ARGUMENT
 
 
 @app.command(epilog="Example:  ruledrobot make cell.toml --out out/part   (the cell file: "
              "docs/carve.md; what make writes: docs/make.md)")  # fmt: skip
 def make(
-    cell: Path = typer.Argument(..., help=literal(
-        "Cell file (.toml), as ruledrobot carve reads it: [part] file, units, pose, tolerance, "
-        "and the [stock], [robot], [tool], [cut] of a job.")),
+    cell: Path = CELL_ARGUMENT,
     out: Path = typer.Option(Path("out/make"), "--out", "-o", help="Output folder."),
 ) -> None:
     """Make a part.

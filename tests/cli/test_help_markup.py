@@ -33,3 +33,19 @@ def test_every_bracket_of_every_help_text_is_shown():
         if lost:
             eaten[" ".join(["ruledrobot", *path])] = sorted(lost)
     assert not eaten, eaten
+
+
+def test_every_help_text_wraps_at_the_terminal_not_at_the_docstrings_lines():
+    """At 80 columns no paragraph line of a command's description breaks short of the
+    width before the paragraph ends (typer 0.29 printed a docstring's own line breaks:
+    "... write each setup's program" / "(cut.script), ..." in an 80-column terminal)."""
+    runner = CliRunner()
+    short = {}
+    for path, _ in _commands(typer.main.get_command(app), []):
+        out = runner.invoke(app, [*path, "--help"], env={"COLUMNS": "80"}).output
+        head = out.split("╭")[0].splitlines()[3:]  # the description, after the usage line
+        for line, nxt in zip(head, head[1:], strict=False):
+            text, follow = line.strip(), nxt.strip()
+            if text and follow and not follow.startswith(("-", "*")) and len(text) < 55:
+                short[" ".join(["ruledrobot", *path])] = text
+    assert not short, short
