@@ -28,6 +28,7 @@ from typing import Any
 import numpy as np
 
 from ..robot.motion.trajectory import CUTTING_PHASES
+from ..robot.motion.trajectory import PHASE_COLOURS as PHASE_HEX
 from .kerf import (
     BURN_COLOUR,
     BURN_RADIUS,
@@ -42,12 +43,9 @@ from .scene import PlanScene
 
 __all__ = ["PHASE_COLOURS", "Painter", "caption", "figures_markdown"]
 
-#: RGB of the phases (trail, labels).
-PHASE_COLOURS = {
-    "approach": (120, 130, 145), "lead_in": (60, 140, 220), "cut": (230, 90, 20),
-    "lead_out": (60, 140, 220), "retract": (120, 130, 145), "transit": (120, 130, 145),
-    "move": (120, 130, 145),
-}  # fmt: skip
+#: RGB of the phases (trail, labels): the plots' colours (one home, the trajectory's phases)
+PHASE_COLOURS = {p: tuple(int(c[k:k + 2], 16) for k in (1, 3, 5))
+                 for p, c in PHASE_HEX.items()}  # fmt: skip
 _CUT_COLOUR = (235, 110, 30)
 _SURFACE_COLOUR = (70, 150, 230)
 _WIRE_COLOUR = (230, 20, 20)

@@ -46,6 +46,7 @@ __all__ = [
     "CUTTING_PHASES",
     "HEATED_PHASES",
     "HEAT_MODES",
+    "PHASE_COLOURS",
     "PHASE_NAMES",
     "Heat",
     "KinematicsRef",
@@ -68,6 +69,12 @@ CUTTING_PHASES = ("lead_in", "cut", "lead_out")
 #: the phases with the wire hot: the cutting phases and the preheat before them (the
 #: planner's heat windows; a path program keeps the TCP speed tight in them)
 HEATED_PHASES = ("preheat", *CUTTING_PHASES)
+#: the colour of each phase (hex RGB) in every picture of a plan: plots.png's 3-D path and
+#: time bands, the viewer's trail; the moves with the wire cold share one
+PHASE_COLOURS = {
+    "approach": "#9467bd", "transit": "#9467bd", "retract": "#9467bd", "move": "#9467bd",
+    "preheat": "#d62728", "lead_in": "#1f77b4", "cut": "#2ca02c", "lead_out": "#17becf",
+}  # fmt: skip
 
 
 def kinematics_checksum(dh: ArrayLike) -> str:

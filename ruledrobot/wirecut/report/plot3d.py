@@ -27,7 +27,7 @@ from ...geometry.box import Box
 from ...geometry.mesh import Mesh
 from ...geometry.ranges import runs_of
 from ...io.axes3d import cube_axes, draw_box, draw_mesh
-from ...robot.motion.trajectory import HEATED_PHASES
+from ...robot.motion.trajectory import HEATED_PHASES, PHASE_COLOURS
 from ...robot.tool import BowTool
 from ...robot.wire.in_stock import flange_wire_ends
 from ..plan import Plan
@@ -35,13 +35,6 @@ from ..plan import Plan
 __all__ = ["PART_COLOUR", "PHASE_COLOURS", "PHASE_WORDS", "SURFACE_COLOUR", "phase_runs",
            "scene_panel"]
 
-#: colours of the phases in every picture of a plan (the 3-D path, the time axes' bands):
-#: the moves with the wire cold share one
-PHASE_COLOURS = {
-    "approach": "tab:purple", "transit": "tab:purple", "retract": "tab:purple",
-    "move": "tab:purple", "preheat": "tab:red", "lead_in": "tab:blue", "cut": "tab:green",
-    "lead_out": "tab:cyan",
-}  # fmt: skip
 #: the phases in words, for legends
 PHASE_WORDS = {
     "approach": "approach", "transit": "transit", "retract": "retract", "move": "move",
