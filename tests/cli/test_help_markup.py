@@ -4,6 +4,7 @@ as rich markup, where ``[part]`` or ``[m]`` is a style tag and vanished ("... an
 
 from __future__ import annotations
 
+import itertools
 import re
 
 import typer
@@ -44,7 +45,7 @@ def test_every_help_text_wraps_at_the_terminal_not_at_the_docstrings_lines():
     for path, _ in _commands(typer.main.get_command(app), []):
         out = runner.invoke(app, [*path, "--help"], env={"COLUMNS": "80"}).output
         head = out.split("╭")[0].splitlines()[3:]  # the description, after the usage line
-        for line, nxt in zip(head, head[1:], strict=False):
+        for line, nxt in itertools.pairwise(head):
             text, follow = line.strip(), nxt.strip()
             if text and follow and not follow.startswith(("-", "*")) and len(text) < 55:
                 short[" ".join(["ruledrobot", *path])] = text
