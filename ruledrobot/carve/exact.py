@@ -116,7 +116,9 @@ def _open(fit: Fit, region: Region, stock: Box, d0: FloatArray, p0: FloatArray,
             if r is None or abs(r) > half:
                 return None  # the surface ends before the block does
             p = o + r * n0
-            dirs = fit.line_directions(p, n0)
+            # a plane's rulings are all parallel to the first, d0 (its tangent basis would
+            # turn them towards the nearest basis vector: a fan about the first ruling)
+            dirs = np.stack([d0, d0]) if fit.kind == "plane" else fit.line_directions(p, n0)
             if not np.all(np.isfinite(dirs)):
                 return None
             d = _pick(dirs, d)

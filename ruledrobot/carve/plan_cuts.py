@@ -27,7 +27,7 @@ from .model import CarveCut, CutMeasure
 from .quadric import Fit, fit_region
 from .readers import PartMesh
 from .rough import SEAMS, Loop, choose_loops, loop_lines
-from .segment import Region, segment
+from .segment import CREASES, MAX_PIECES, Region, segment
 
 __all__ = ["MAX_REFUSED", "CutPlan", "find_cuts", "prefer_direction"]
 
@@ -109,6 +109,37 @@ def _robot_accepts(check: Callable[[CarveCut], str] | None, centre: FloatArray,
     return accept
 
 
+def _fitted(part: PartMesh, regions: list[Region], tolerance: float,
+            notes: list[str]) -> list[tuple[Region, Fit]]:  # fmt: skip
+    """Fit every region; one no ruled surface fits is split at the finer creases of
+    :data:`~.segment.CREASES` and replaced by its pieces when each piece fits (a plane or
+    a ruled quadric; :data:`~.segment.MAX_PIECES` at most), said in ``notes``.
+    ``regions`` holds the pieces (new indices) in place of the region split."""
+    out: list[tuple[Region, Fit]] = []
+    for r in list(regions):
+        fit = fit_region(r, tolerance)
+        if fit.kind not in ("plane", "ruled") and len(r.faces) > 1:
+            for sharp in CREASES:
+                pieces = segment(part, sharp, r.faces,
+                                 first=max(x.index for x in regions) + 1)
+                if not 2 <= len(pieces) <= MAX_PIECES:
+                    continue
+                fits = [fit_region(p, tolerance) for p in pieces]
+                if all(f.kind in ("plane", "ruled") for f in fits):
+                    regions[:] = [x for x in regions if x is not r] + pieces
+                    notes.append(f"region {r.index} (no one surface fits it) is "
+                                 f"{len(pieces)} faces meeting at creases of "
+                                 f"{np.degrees(sharp):.3g} degrees or more: regions "
+                                 f"{pieces[0].index}-{pieces[-1].index}")  # fmt: skip
+                    out += list(zip(pieces, fits, strict=True))
+                    break
+            else:
+                out.append((r, fit))
+            continue
+        out.append((r, fit))
+    return out
+
+
 def find_cuts(part: PartMesh, stock: Box, query: MeshQuery, tolerance: float,
               rough_cuts: int, lead: float = 0.02, progress=lambda msg: None,
               check: Callable[[CarveCut], str] | None = None) -> CutPlan:  # fmt: skip
@@ -123,8 +154,7 @@ def find_cuts(part: PartMesh, stock: Box, query: MeshQuery, tolerance: float,
     exact: list[tuple[CarveCut, CutMeasure]] = []
     notes: list[str] = []
     progress(f"fitting {len(regions)} regions")
-    for r in regions:
-        fit = fit_region(r, tolerance)
+    for r, fit in _fitted(part, regions, tolerance, notes):
         if fit.kind == "plane" and block_face(fit, stock, tolerance):
             faces[r.index] = "block face"
             continue

@@ -54,7 +54,13 @@ from ...robot.wire.in_stock import across_speeds
 from ...robot.wire.kerf import Material
 from ..job.spec import CutSpec, HeatSpec
 from .heat_power import held_kerf
-from .kerf_corners import corner_ends, corner_error, face_rulings_at_corners, neighbours
+from .kerf_corners import (
+    MITRE_LIMIT,
+    corner_ends,
+    corner_error,
+    face_rulings_at_corners,
+    neighbours,
+)
 from .wire_geometry import chords
 
 __all__ = ["KerfOffsets", "cut_offsets", "face_rulings", "kept_surface_error", "kerf_offsets",
@@ -236,7 +242,10 @@ def kerf_offsets(
     mid, half = 0.5 * (lo + hi), 0.5 * (hi - lo)
     bis = np.cos(mid)[:, None] * ref + np.sin(mid)[:, None] * side
     r = 0.5 * kerf
-    length = 2.0 * r / (1.0 + np.cos(half))
+    # the bisector's length, held to the corners' mitre cap (MITRE_LIMIT half kerfs): where
+    # the normals along a ruling turn by nearly 180 degrees (rulings pivoting about a point
+    # in the block) no offset holds the face, and ``err`` names the shortfall
+    length = 2.0 * r / np.maximum(1.0 + np.cos(half), 2.0 / MITRE_LIMIT)
     offset = length[:, None] * bis
     err = np.abs(np.einsum("mi,mki->mk", offset, n) - r).max(axis=1)
     P = frames[:, None, :3, 3] + t[..., None] * frames[:, None, :3, 2]  # (M, K, 3)
