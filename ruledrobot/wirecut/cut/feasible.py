@@ -4,7 +4,9 @@
 the refinement, the kerf offset and the wire-pose search (:mod:`.wire_pose`: reach,
 IK branch continuity with the joint steps between rulings, singularity, the clearance
 of arm, bow and wire against the stock, the table and the arm itself) — and says, per
-cut, why no pass was found ("" when every pass of the cut has a motion).  One model:
+cut, why no pass was found ("" when every pass of the cut has a motion), or why the
+kerf offset cannot hold the kept surface (the verdict's ``kept_surface`` check, on the
+offset's own error and the cut's ``wire_tolerance``).  One model:
 carve chooses its cuts with it (docs/carve.md, "Cuts chosen with the robot"), the plan
 judges them with it.  It does not time the motion (the feed is the time law's, in the
 plan).
@@ -42,6 +44,14 @@ def cut_reasons(job: Job, model: RobotModel | None = None,
             out[cut.name] = str(exc).splitlines()[0]
             continue
         bad = [p for p in passes if not p.feasible]
-        out[cut.name] = "; ".join(r for p in bad for r in p.motion.reasons) or (
-            "no motion found" if bad else "")  # fmt: skip
+        why = [r for p in bad for r in p.motion.reasons] or (["no motion found"] if bad else [])
+        # the verdict's kept_surface check, on the same error (the kerf offset's) and limit
+        err = max((float(p.kerf_error.max()) for p in passes
+                   if p.compensated and p.kerf_error is not None and p.kerf_error.size),
+                  default=0.0)  # fmt: skip
+        if err > cut.wire_tolerance:
+            why.append(f"the kept surface would lie {err * 1e3:.3g} mm from the target "
+                       f"(limit {cut.wire_tolerance * 1e3:.3g} mm): a straight wire's kerf "
+                       "offset cannot follow the surface there")  # fmt: skip
+        out[cut.name] = "; ".join(why)
     return out
