@@ -54,6 +54,9 @@ class CutPlan:
     notes: tuple[str, ...] = ()
     kept_voxel: float = float("nan")
     baseline_kept_voxel: float = float("nan")
+    #: the exact cuts the robot check refused, largest face first (the first is probed for
+    #: a turn of the block, :func:`.robotcheck.next_best`)
+    refused: tuple[CarveCut, ...] = field(default=(), repr=False)
 
 
 def prefer_direction(stock: Box) -> FloatArray:
@@ -152,6 +155,7 @@ def find_cuts(part: PartMesh, stock: Box, query: MeshQuery, tolerance: float,
     prefer = prefer_direction(stock)
     faces: dict[int, str] = {}
     exact: list[tuple[CarveCut, CutMeasure]] = []
+    refused: list[CarveCut] = []
     notes: list[str] = []
     progress(f"fitting {len(regions)} regions")
     for r, fit in _fitted(part, regions, tolerance, notes):
@@ -180,6 +184,7 @@ def find_cuts(part: PartMesh, stock: Box, query: MeshQuery, tolerance: float,
                    "or turn of the block where it can")  # fmt: skip
             faces[r.index] = why
             notes.append(why)
+            refused.append(got)
             continue
         faces[r.index] = "exact"
         exact.append((got, m))
@@ -221,4 +226,4 @@ def find_cuts(part: PartMesh, stock: Box, query: MeshQuery, tolerance: float,
                + rough)  # fmt: skip
     return CutPlan(tuple(c for c, _ in ordered), tuple(m for _, m in ordered), tuple(loops),
                    tuple(base), tuple(regions), faces, tuple(notes), kept,
-                   base_kept)  # fmt: skip
+                   base_kept, tuple(refused))  # fmt: skip

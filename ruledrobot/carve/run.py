@@ -30,6 +30,7 @@ from .jobs import setups_of, write_jobs
 from .meshquery import MeshQuery
 from .plan_cuts import CutPlan, find_cuts
 from .readers import PartMesh, edge_counts, read_part
+from .robotcheck import RobotCheck, next_best
 
 __all__ = ["CarveResult", "carve", "check_fits"]
 
@@ -100,6 +101,19 @@ def _checks(plan: CutPlan, carved, part_volume: float, closed_ok: bool, tol: flo
     return out
 
 
+def _offer_turn(plan: CutPlan, check: RobotCheck, cell: Cell) -> CutPlan:
+    """``plan`` with the next best for its largest refused face (:func:`.robotcheck.next_best`)
+    added to that face's words and the notes."""
+    cut = plan.refused[0]
+    words = next_best(check, cut, cell.stock, cell.part.pose, cell.tables)
+    if not words:
+        return plan
+    faces = dict(plan.faces)
+    if cut.region is not None and cut.region in faces:
+        faces[cut.region] = f"{faces[cut.region]}; {words}"
+    return dataclasses.replace(plan, faces=faces, notes=(*plan.notes, f"{cut.what}: {words}"))
+
+
 def carve(cell_path: str | os.PathLike[str], out: str | os.PathLike[str],
           progress=lambda msg: None) -> CarveResult:  # fmt: skip
     """Carve the part of a cell file into ``out`` (module doc); ValueError on bad input."""
@@ -116,12 +130,13 @@ def carve(cell_path: str | os.PathLike[str], out: str | os.PathLike[str],
         from ..wirecut import CutSpec  # its defaults: the lead the planner uses
 
         lead = float(cell.tables.get("cut", {}).get("lead_in", CutSpec.lead_in))
-        from .robotcheck import RobotCheck
-
         check = RobotCheck(cell.tables)
         try:
             plan = find_cuts(part, cell.stock, query, cell.part.tolerance, cell.part.rough_cuts,
                              lead, progress, check)  # fmt: skip
+            if plan.refused and plan.cuts:  # a face's trouble, not a block out of reach
+                progress("trying the block turned for the largest face the arm cannot make")
+                plan = _offer_turn(plan, check, cell)
         finally:
             check.close()
         times["robot_check"] = check.seconds
