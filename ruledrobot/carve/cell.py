@@ -12,6 +12,9 @@ A cell file is a job file (docs/wirecut.md) with a ``[part]`` table instead of c
     rough_cuts = 4               # roughing loops where the surface is not ruled (0: none)
     repair = false               # true: merge vertices within tolerance / 100 and turn
                                  # facets to agree with their neighbours (noted)
+    turns = true                 # a face the arm cannot make: try the block turned a
+                                 # quarter turn and offer the turn that lets it (up to a
+                                 # minute more; false: only name the face)
 
     [stock]   ...                # as in a job: the block
     [robot]   ...
@@ -51,7 +54,7 @@ __all__ = ["MESH_SUFFIXES", "Cell", "PartSpec", "load_cell", "parse_cell"]
 
 #: the part files read (:mod:`.readers`)
 MESH_SUFFIXES = (".stl", ".obj", ".ply", ".3dm")
-_PART_FIELDS = ("file", "units", "pose", "tolerance", "rough_cuts", "repair")
+_PART_FIELDS = ("file", "units", "pose", "tolerance", "rough_cuts", "repair", "turns")
 _SECTIONS = ("part", "stock", "robot", "tool", "cut")
 
 
@@ -61,7 +64,8 @@ class PartSpec:
 
     ``file`` (resolved), ``units`` (m, cm, mm, in), ``pose`` (4, 4) the part frame in the robot
     base frame, ``tolerance`` [m], ``rough_cuts``, ``repair`` (mend the mesh as CAD exported
-    it: :mod:`.repair`)."""
+    it: :mod:`.repair`), ``turns`` (offer a turn of the block for a face the arm cannot
+    make: :func:`.robotcheck.next_best`)."""
 
     file: Path
     units: str
@@ -69,6 +73,7 @@ class PartSpec:
     tolerance: float = 0.0005
     rough_cuts: int = 4
     repair: bool = False
+    turns: bool = True
 
     @property
     def scale(self) -> float:
@@ -142,12 +147,13 @@ def _part(raw: object, where: str, base_dir: Path | None) -> PartSpec:
     if isinstance(rough, bool) or not isinstance(rough, int) or not 0 <= rough <= 12:
         raise _fail(where, "rough_cuts",
                     f"expected an integer 0 <= rough_cuts <= 12, got {rough!r}")  # fmt: skip
-    repair = raw.get("repair", False)
-    if not isinstance(repair, bool):
-        raise _fail(where, "repair", f"expected true or false, got {repair!r}")
+    flags = {key: raw.get(key, default) for key, default in (("repair", False), ("turns", True))}
+    for key, v in flags.items():
+        if not isinstance(v, bool):
+            raise _fail(where, key, f"expected true or false, got {v!r}")
     return PartSpec(file=path, units=units, pose=se3.pose_from_ur_vector(pose_raw),
                     tolerance=_number(raw, "tolerance", where, 0.0005, 0.0),
-                    rough_cuts=int(rough), repair=repair)  # fmt: skip
+                    rough_cuts=int(rough), **flags)  # fmt: skip
 
 
 def absolute_paths(tables: dict[str, Any], base_dir: Path | None) -> dict[str, Any]:

@@ -104,7 +104,7 @@ class RobotCheck:
 TURNS = ((0, 90.0), (0, -90.0), (1, 90.0), (1, -90.0))
 #: time [s] past which no further turn is tried (a refused cut's search takes up to a
 #: minute on a busy 2-core machine; a passing one seconds)
-TURN_SECONDS = 90.0
+TURN_SECONDS = 30.0
 
 
 @dataclass(frozen=True)

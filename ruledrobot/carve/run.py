@@ -134,7 +134,8 @@ def carve(cell_path: str | os.PathLike[str], out: str | os.PathLike[str],
         try:
             plan = find_cuts(part, cell.stock, query, cell.part.tolerance, cell.part.rough_cuts,
                              lead, progress, check)  # fmt: skip
-            if plan.refused and plan.cuts:  # a face's trouble, not a block out of reach
+            # a face's trouble, not a block out of reach; ``turns = false``: name it only
+            if plan.refused and plan.cuts and cell.part.turns:
                 progress("trying the block turned for the largest face the arm cannot make")
                 plan = _offer_turn(plan, check, cell)
         finally:

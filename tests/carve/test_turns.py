@@ -10,12 +10,15 @@ from __future__ import annotations
 import re
 
 import numpy as np
+import tomllib
 
+from ruledrobot.carve.cell import parse_cell
 from ruledrobot.carve.model import CarveCut
 from ruledrobot.carve.robotcheck import TURNS, next_best, quarter_turns
 from ruledrobot.geometry import se3
 from ruledrobot.geometry.box import Box
 from ruledrobot.geometry.lines import Lines
+from ruledrobot.io.demo_cell import DEMO_CELL
 
 STOCK = Box(np.array([0.5, 0.1, 0.3]), np.array([0.2, 0.15, 0.1]))
 PART = se3.pose_from_ur_vector([0.5, 0.1, 0.3, 0.0, 0.0, 0.3])
@@ -77,3 +80,17 @@ def test_no_turn_tried_in_a_cell_with_a_robot_base_and_every_turn_named_when_non
     words = next_best(refuse, lying, STOCK, PART, {})
     assert words == ("the block turned +90° about x, -90° about x, +90° about y, -90° about y "
                      "does not let the arm make it either")  # fmt: skip
+
+
+def test_turns_is_a_boolean_of_the_part_table(tmp_path):
+    (tmp_path / "p.stl").write_text("solid p\nendsolid p\n")
+    text = f'[part]\nfile = "p.stl"\nunits = "mm"\nturns = "no"\n{DEMO_CELL}'
+    doc = tomllib.loads(text)
+    try:
+        parse_cell(doc, "cell.toml", base_dir=tmp_path)
+    except ValueError as exc:
+        assert str(exc) == "cell.toml: [part] turns: expected true or false, got 'no'"
+    else:
+        raise AssertionError("turns = 'no' accepted")
+    doc["part"]["turns"] = False
+    assert parse_cell(doc, "cell.toml", base_dir=tmp_path).part.turns is False
