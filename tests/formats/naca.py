@@ -44,10 +44,20 @@ def lednicer_text(name: str, pts: np.ndarray) -> str:
     return f"{name}\n{len(upper)}. {len(lower)}.\n\n{body}"
 
 
-def distance_to_polyline(q: np.ndarray, poly: np.ndarray) -> np.ndarray:
-    """Distance of points q (K, d) to the polyline poly (N, d)."""
+def distance_to_polyline(q: np.ndarray, poly: np.ndarray, chunk: int = 1 << 18) -> np.ndarray:
+    """Distance of points q (K, d) to the polyline poly (N, d), segments of zero length
+    included (their first point).
+
+    Exact (each point against every segment), in blocks of points of at most ``chunk``
+    point-segment pairs: thousands of points against thousands of segments at once made
+    arrays of hundreds of MB (seconds of page faults per call)."""
     a, b = poly[:-1], poly[1:]
     ab = b - a
-    t = np.clip(np.einsum("kni,ni->kn", q[:, None] - a[None], ab) / (ab * ab).sum(1), 0, 1)
-    closest = a[None] + t[..., None] * ab[None]
-    return np.linalg.norm(q[:, None] - closest, axis=2).min(axis=1)
+    ab2 = (ab * ab).sum(1).clip(1e-30)
+    rows = max(1, chunk // max(1, len(a)))
+    out = np.empty(len(q))
+    for s in range(0, len(q), rows):
+        w = q[s : s + rows, None] - a[None]  # (k, N - 1, d)
+        t = np.clip(np.einsum("kni,ni->kn", w, ab) / ab2, 0, 1)
+        out[s : s + rows] = np.linalg.norm(w - t[..., None] * ab[None], axis=2).min(axis=1)
+    return out

@@ -23,7 +23,7 @@ from typer.testing import CliRunner
 
 from ruledrobot.cli import app
 
-from .naca import naca4, selig_text
+from .naca import distance_to_polyline, naca4, selig_text
 
 runner = CliRunner()
 
@@ -137,14 +137,6 @@ def _face_points(frames: np.ndarray, y: float, profile: bool) -> np.ndarray:
     return p[keep]
 
 
-def _to_polyline(p: np.ndarray, poly: np.ndarray) -> np.ndarray:
-    """Distances (P,) of points (P, 3) from the polyline through ``poly`` (K, 3)."""
-    a, b = poly[:-1], poly[1:]
-    d = b - a
-    t = np.clip(((p[:, None] - a[None]) * d[None]).sum(-1) / (d * d).sum(-1).clip(1e-30), 0, 1)
-    return np.linalg.norm(p[:, None] - (a[None] + t[..., None] * d[None]), axis=-1).min(axis=1)
-
-
 def _truth() -> dict[float, np.ndarray]:
     """The closed-form root and tip paths (entry, profile, exit) in the base frame."""
     R = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]])  # POSE's rotation
@@ -167,7 +159,7 @@ def test_the_rulings_of_every_format_agree(plans, a, b):
     for y in (ROOT_Y, TIP_Y):
         pa, pb = _face_points(plans[a][3], y, True), _face_points(plans[b][3], y, True)
         assert len(pa) > 100 and len(pb) > 100
-        assert _to_polyline(pa, pb).max() < 1e-4, (a, b, y)
+        assert distance_to_polyline(pa, pb).max() < 1e-4, (a, b, y)
 
 
 @pytest.mark.parametrize("kind", list(SURFACES))
@@ -178,7 +170,7 @@ def test_the_rulings_follow_the_closed_form(plans, kind):
     straight lines (0.27-0.32 mm in the slits, the waste; docs/formats.md)."""
     for y, truth in _truth().items():
         pts = _face_points(plans[kind][3], y, kind != "airfoil")
-        assert _to_polyline(pts, truth).max() < 1e-4, (kind, y)
+        assert distance_to_polyline(pts, truth).max() < 1e-4, (kind, y)
 
 
 def test_the_default_panel_in_a_block_past_its_trailing_edge_plans(tmp_path):
