@@ -36,6 +36,7 @@ from collections.abc import Callable
 from typing import Any
 
 __all__ = [
+    "TIMEOUT_S",
     "WORKER_MALLOC",
     "WORKER_MEMORY",
     "Engine",
@@ -47,6 +48,10 @@ __all__ = [
 #: memory [bytes] each local worker should have (sizes the cluster; the nanny's limit is
 #: the machine's memory shared out): a plan of the demo job peaks near 200 MB
 WORKER_MEMORY = 1 << 30
+
+#: seconds to reach a scheduler, or the local cluster's own, by default: an address where
+#: nothing listens is retried until then (the tests make it shorter)
+TIMEOUT_S = 10.0
 
 
 class EngineUnavailable(RuntimeError):
@@ -111,10 +116,11 @@ class Engine:
 
     Use as a context manager (closes the client, and the local cluster it started).
     ``workers``: processes of the local cluster (default :func:`default_workers`);
-    ``scheduler``: address of a running scheduler instead; ``timeout``: seconds to reach it."""
+    ``scheduler``: address of a running scheduler instead; ``timeout``: seconds to reach it
+    (default :data:`TIMEOUT_S`)."""
 
     def __init__(self, workers: int | None = None, scheduler: str | None = None,
-                 timeout: float = 10.0, quiet: bool = True) -> None:  # fmt: skip
+                 timeout: float | None = None, quiet: bool = True) -> None:  # fmt: skip
         if workers is not None and scheduler is not None:
             raise ValueError("--workers sizes the local cluster; with --scheduler the "
                              "cluster's own workers plan (start more of them there)")  # fmt: skip
@@ -122,7 +128,7 @@ class Engine:
             raise ValueError(f"--workers: expected at least 1, got {workers}")
         self.scheduler = scheduler
         self.workers = workers if workers is not None or scheduler else default_workers()
-        self.timeout = timeout
+        self.timeout = TIMEOUT_S if timeout is None else timeout
         self.quiet = quiet
         self.cluster: Any = None
         self.client: Any = None

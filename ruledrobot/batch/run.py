@@ -321,7 +321,7 @@ def run_batch(
     scheduler: str | None = None,
     force: bool = False,
     progress: Callable[[BatchProgress], None] | None = None,
-    timeout: float = 10.0,
+    timeout: float | None = None,
     quiet: bool = True,
 ) -> BatchResult:
     """Plan every job of ``jobs`` into ``out/<name>/`` and write the batch's summaries.
@@ -333,9 +333,9 @@ def run_batch(
     ``scheduler``: the address of a Dask scheduler to use instead; ``force``: replan
     jobs whose results a rerun would keep; ``progress``: called with a
     :class:`BatchProgress` whenever a job starts or ends; ``timeout``: seconds to
-    reach the scheduler; ``quiet``: silence Dask's log.  BatchInputError (and
-    EngineUnavailable) for bad input to the batch itself; everything about a job goes
-    into its record.
+    reach the scheduler (default :data:`~.engine.TIMEOUT_S`); ``quiet``: silence Dask's
+    log.  BatchInputError (and EngineUnavailable) for bad input to the batch itself;
+    everything about a job goes into its record.
     """
     out = Path(out)
     entries = tuple(jobs) if jobs and all(isinstance(j, JobEntry) for j in jobs) else \

@@ -85,7 +85,12 @@ def test_workers_and_scheduler_together_are_bad_input(setting, tmp_path):
     assert not (tmp_path / "x").exists()
 
 
-def test_an_unreachable_scheduler_is_bad_input(setting, tmp_path):
+def test_an_unreachable_scheduler_is_bad_input(setting, tmp_path, monkeypatch):
+    """Nothing listens there: refused within the engine's timeout, made 2 s here (the
+    default's 10 s were the test's whole time)."""
+    from ruledrobot.batch import engine
+
+    monkeypatch.setattr(engine, "TIMEOUT_S", 2.0)
     with deadline(120):
         res = runner.invoke(app, ["place", str(setting[0]), "--scheduler",
                                   "tcp://127.0.0.1:9", "--out", str(tmp_path / "x")])  # fmt: skip
