@@ -28,6 +28,15 @@ from ruledrobot.wirecut.job.demo import DEMO_JOB
 STRATA = ((None, 0.0, 1.0), ("planning", 0.0, 1.0),
           ("writing", 0.0, 0.25), ("writing", 0.25, 0.5), ("writing", 0.5, 0.75),
           ("writing", 0.75, 1.05))  # fmt: skip
+#: the two jobs planned over each other: the demo job made cheap (two refinement steps, a
+#: feed of 40 and 45 mm/s: a 10 s cut, each plan about a third of the demo's), what is
+#: tested being the folder's swap, not the cut
+OLD, NEW = 0.04, 0.045
+
+
+def _job(feed: float) -> str:
+    return DEMO_JOB.replace("steps = 4", "steps = 2").replace("feed_speed = 0.01 ",
+                                                              f"feed_speed = {feed} ")
 
 
 def _complete(folder: Path) -> dict:
@@ -67,19 +76,20 @@ def test_a_killed_plan_leaves_the_old_or_the_new_complete_set(tmp_path):
     """SIGKILL at a random moment in each stratum of :data:`STRATA`; after each kill the
     folder is the previous complete set or the incoming one (then the next trial plans the
     other job over it)."""
-    jobs = {0.01: tmp_path / "old.toml", 0.012: tmp_path / "new.toml"}
-    jobs[0.01].write_text(DEMO_JOB)
-    jobs[0.012].write_text(DEMO_JOB.replace("feed_speed = 0.01", "feed_speed = 0.012"))
+    jobs = {OLD: tmp_path / "old.toml", NEW: tmp_path / "new.toml"}
+    for feed, path in jobs.items():
+        path.write_text(_job(feed))
+        assert f"feed_speed = {feed} " in path.read_text()
     out = tmp_path / "cut"
-    proc = _plan(jobs[0.01], out)
+    proc = _plan(jobs[OLD], out)
     marks = _phases(proc, out, _staging(out))
     assert proc.wait() == 0 and "writing" in marks, marks
     window = marks["end"] - marks["writing"]
-    feed, current = 0.01, _complete(out)
+    feed, current = OLD, _complete(out)
     rng = np.random.default_rng(1)
     outcomes = []
     for phase, lo, hi in STRATA:
-        incoming = 0.012 if feed == 0.01 else 0.01
+        incoming = NEW if feed == OLD else OLD
         seen = _staging(out)
         proc = _plan(jobs[incoming], out)
         if phase is None:  # before the staging folder: the command starting
