@@ -44,20 +44,32 @@ def lednicer_text(name: str, pts: np.ndarray) -> str:
     return f"{name}\n{len(upper)}. {len(lower)}.\n\n{body}"
 
 
-def distance_to_polyline(q: np.ndarray, poly: np.ndarray, chunk: int = 1 << 18) -> np.ndarray:
+def distance_to_polyline(q: np.ndarray, poly: np.ndarray) -> np.ndarray:
     """Distance of points q (K, d) to the polyline poly (N, d), segments of zero length
     included (their first point).
 
-    Exact (each point against every segment), in blocks of points of at most ``chunk``
-    point-segment pairs: thousands of points against thousands of segments at once made
-    arrays of hundreds of MB (seconds of page faults per call)."""
+    Exact, each point against the segments that can hold its nearest point only: the
+    nearest vertex is ``dv`` away, and a point of a segment within ``dv`` of q lies within
+    half the segment's length of one of its ends, so the segments next to the vertices
+    within ``dv + L / 2`` (``L`` the longest segment) are all that count (a k-d tree finds
+    them).  Every point against every segment made arrays of hundreds of MB for the
+    thousands of rulings of the formats matrix (seconds per call)."""
+    from scipy.spatial import cKDTree
+
     a, b = poly[:-1], poly[1:]
     ab = b - a
-    ab2 = (ab * ab).sum(1).clip(1e-30)
-    rows = max(1, chunk // max(1, len(a)))
-    out = np.empty(len(q))
-    for s in range(0, len(q), rows):
-        w = q[s : s + rows, None] - a[None]  # (k, N - 1, d)
-        t = np.clip(np.einsum("kni,ni->kn", w, ab) / ab2, 0, 1)
-        out[s : s + rows] = np.linalg.norm(w - t[..., None] * ab[None], axis=2).min(axis=1)
+    ab2 = (ab * ab).sum(1)
+    tree = cKDTree(poly)
+    dv, _ = tree.query(q)
+    reach = dv + 0.5 * float(np.sqrt(ab2.max(initial=0.0)))
+    pairs = cKDTree(q).sparse_distance_matrix(tree, float(reach.max(initial=0.0)),
+                                              output_type="ndarray")  # fmt: skip
+    pairs = pairs[pairs["v"] <= reach[pairs["i"]]]
+    i = np.concatenate([pairs["i"], pairs["i"]])
+    s = np.concatenate([pairs["j"] - 1, pairs["j"]])  # the segments either side of a vertex
+    i, s = i[(s >= 0) & (s < len(a))], s[(s >= 0) & (s < len(a))]
+    w = q[i] - a[s]
+    t = np.clip((w * ab[s]).sum(1) / ab2[s].clip(1e-30), 0, 1)
+    out = dv.copy()
+    np.minimum.at(out, i, np.linalg.norm(w - t[:, None] * ab[s], axis=1))
     return out

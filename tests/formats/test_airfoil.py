@@ -180,3 +180,19 @@ def test_the_grid_finds_the_same_crossings_as_all_pairs(seed, n, step):
     except ValueError:
         found = True
     assert found == expected
+
+
+@given(seed=st.integers(0, 2**32 - 1), n=st.integers(2, 120), dim=st.sampled_from([2, 3]),
+       scale=st.floats(0.001, 1.0))  # fmt: skip
+def test_the_polyline_distance_is_the_least_over_every_segment(seed, n, dim, scale):
+    """The test helper's k-d tree shortcut (tests/formats/naca.py) against every point
+    with every segment, a segment of zero length among them."""
+    rng = np.random.default_rng(seed)
+    poly = np.cumsum(rng.normal(size=(n, dim)) * scale, axis=0)
+    poly[n // 2] = poly[n // 2 - 1]
+    q = rng.normal(size=(50, dim)) * scale * np.sqrt(n)
+    a, ab = poly[:-1], np.diff(poly, axis=0)
+    t = np.clip(np.einsum("kni,ni->kn", q[:, None] - a[None], ab)
+                / (ab * ab).sum(1).clip(1e-30), 0, 1)  # fmt: skip
+    every = np.linalg.norm(q[:, None] - (a[None] + t[..., None] * ab[None]), axis=2).min(axis=1)
+    np.testing.assert_allclose(distance_to_polyline(q, poly), every, rtol=0.0, atol=1e-12)
