@@ -25,6 +25,11 @@ def _job(text: str):
     return parse_job(job_document(text, "test_job.toml"), "test_job.toml")
 
 
+#: rows (samples) of the dense measure at a time: (M, n) arrays of a whole trajectory were
+#: hundreds of MB (seconds of page faults per plan)
+ROWS = 2048
+
+
 def _measure(traj, stock: Box, wire_length: float, n: int = 601):
     """Independent: (inside (M,), depth (M,), cutting speed (M,)) from the TCP column.
 
@@ -32,30 +37,41 @@ def _measure(traj, stock: Box, wire_length: float, n: int = 601):
     and z axis) are linear in ``s``, and so are their box coordinates and their velocities
     (np.gradient over time is linear) and the velocities' parts across the wire (``z`` a
     unit vector): each is interpolated from two (M, 3) columns into (M, n) scalars, the
-    speed across as the root of its quadratic in ``s``."""
+    speed across as the root of its quadratic in ``s`` (:data:`ROWS` rows at a time)."""
     T = traj.tcp_poses()
     o, z = T[:, :3, 3], T[:, :3, 2]
     s = np.linspace(-0.5, 0.5, n)[None, :] * wire_length
     lo, lz = stock.to_box(o), z @ stock.rotation  # box coordinates: lo + s lz
-    inbox = np.ones((len(o), n), dtype=bool)
-    depth_all = np.full((len(o), n), np.inf)
-    for i in range(3):  # each box axis: (M, n)
-        room = 0.5 * stock.size[i] - np.abs(lo[:, i, None] + s * lz[:, i, None])
+    vo, vz = np.gradient(o, traj.t, axis=0), np.gradient(z, traj.t, axis=0)
+    A = vo - (vo * z).sum(-1, keepdims=True) * z  # across the wire: A + s B
+    B = vz - (vz * z).sum(-1, keepdims=True) * z
+    quad = np.stack([(A * A).sum(-1), (A * B).sum(-1), (B * B).sum(-1)], axis=1)  # (M, 3)
+    parts = [_dense(lo[r : r + ROWS], lz[r : r + ROWS], quad[r : r + ROWS], stock.size, s,
+                    wire_length / (n - 1)) for r in range(0, len(o), ROWS)]  # fmt: skip
+    inside, depth, speed, slope = (np.concatenate(x) for x in zip(*parts, strict=True))
+    return inside, depth, speed, slope
+
+
+def _dense(lo, lz, quad, size, s, spacing):
+    """:func:`_measure` for rows of samples: box coordinates ``lo + s lz`` (k, 3) each,
+    the speed across the wire squared ``aa + 2 ab s + bb s^2`` (``quad`` (k, 3)), the wire's
+    points at ``s`` (1, n) ``spacing`` apart."""
+    inbox = np.ones((len(lo), s.shape[1]), dtype=bool)
+    depth_all = np.full(inbox.shape, np.inf)
+    for i in range(3):  # each box axis: (k, n)
+        room = 0.5 * size[i] - np.abs(lo[:, i, None] + s * lz[:, i, None])
         inbox &= room >= 0.0
         np.minimum(depth_all, room, out=depth_all)
     inside = inbox.any(axis=1)
     depth = np.where(inbox, depth_all, 0.0).max(axis=1)
-    vo, vz = np.gradient(o, traj.t, axis=0), np.gradient(z, traj.t, axis=0)
-    A = vo - (vo * z).sum(-1, keepdims=True) * z  # across the wire: A + s B
-    B = vz - (vz * z).sum(-1, keepdims=True) * z
-    aa, ab, bb = ((A * A).sum(-1)[:, None], (A * B).sum(-1)[:, None], (B * B).sum(-1)[:, None])
+    aa, ab, bb = quad[:, 0, None], quad[:, 1, None], quad[:, 2, None]
     sq = aa + s * (2.0 * ab + s * bb)
     sp = np.sqrt(np.maximum(sq, 0.0))
     speed = np.where(inbox, sp, -np.inf).max(axis=1)
     # how fast the speed changes along the wire (per m) among the points in the box: the
     # dense points lie up to one spacing inside the chord's true ends
     both = inbox[:, 1:] & inbox[:, :-1]
-    slope = np.where(both, np.abs(np.diff(sp, axis=1)), 0.0).max(axis=1) / (wire_length / (n - 1))
+    slope = np.where(both, np.abs(np.diff(sp, axis=1)), 0.0).max(axis=1) / spacing
     return inside, depth, speed, slope
 
 
