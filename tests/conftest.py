@@ -79,8 +79,6 @@ SLOW_TESTS: frozenset[str] = frozenset({
     "test_part_stl_is_one_closed_two_manifold_of_the_right_volume",
     "tests/wirecut/report/test_user_files.py::test_replanning_keeps_recordings_and_every_users_file",
     "tests/wirecut/report/test_verdict.py::test_a_colliding_cut_fails_with_collisions_in_words",
-    "tests/wirecut/report/test_verdict.py::"
-    "test_a_failed_plan_leaves_no_runnable_trajectory_of_an_earlier_plan",
     "tests/wirecut/test_once_clearance.py::test_moves_checked_in_a_batch_are_each_move_checked_alone",
     "tests/wirecut/test_search_options.py::test_the_options_reach_the_passes_of_an_open_and_a_closed_cut",
 })  # fmt: skip
