@@ -22,6 +22,7 @@ import numpy as np
 
 from ..io.atomic import atomic_write_json, atomic_write_text
 from ..io.outdir import StagedFolder
+from ..wirecut.cut.cutpath import CutPath
 from ..wirecut.job.spec import Job
 from ..wirecut.plan import job_reference
 from ..wirecut.reach.evaluate import Evaluator, details
@@ -90,6 +91,7 @@ def run_place(
     progress: Callable[[str], None] | None = None,
     program: Callable[[object, Path], Path] | None = None,
     scorer: Callable[[Evaluator], Evaluator] | None = None,
+    passes: list[CutPath] | None = None,
 ) -> PlaceOutcome:
     """Search ``region`` for ``job``'s block, verify the best, split into setups if need be.
 
@@ -100,12 +102,15 @@ def run_place(
     its folder (``cut.script`` from the command line).  ``scorer(evaluator)`` returns what
     scores the candidates: the evaluator itself by default, one that scores them on Dask
     workers from the command line (:class:`ruledrobot.batch.place.DistributedEvaluator`).
+    ``passes``: the planner's passes of the job at its placement when the caller has them
+    (a plan's, :attr:`~ruledrobot.wirecut.plan.Plan.passes`); by default
+    :func:`~.search.job_passes`.
     """
     say = progress or (lambda msg: None)
     out = Path(out)
     model = job.robot_model()
     with StagedFolder(out) as stage:
-        passes = job_passes(job, model, say)
+        passes = job_passes(job, model, say) if passes is None else list(passes)
         ev = Evaluator(job, passes, model, rulings=rulings, rolls=rolls, rules=Rules())
         if scorer is not None:
             ev = scorer(ev)
