@@ -113,7 +113,9 @@ def test_ctrl_c_stops_cleanly_and_the_same_command_resumes(tmp_path):
     pytest.importorskip("distributed")
     jobs = tmp_path / "jobs"
     jobs.mkdir()
-    for k in range(4):  # four jobs on two workers: the first result comes with two to go
+    n = 3  # three jobs on two workers: the first result comes with two to go (one running,
+    # one sent in its place); a fourth cost the resume a second round of plans
+    for k in range(n):
         (jobs / f"p{k}.toml").write_text(FAST_JOB.replace("feed_speed = 0.04 ",
                                                           f"feed_speed = 0.04{k} "))
     out = tmp_path / "out"
@@ -152,7 +154,7 @@ def test_ctrl_c_stops_cleanly_and_the_same_command_resumes(tmp_path):
         again = subprocess.run(cmd, capture_output=True, text=True, env=env, timeout=150)
     assert again.returncode == 0, again.stdout + again.stderr
     doc = json.loads((out / "batch.json").read_text())
-    assert [j["status"] for j in doc["jobs"]] == ["feasible"] * 4
-    assert doc["run"]["kept"] == len(done) and doc["run"]["planned"] == 4 - len(done)
+    assert [j["status"] for j in doc["jobs"]] == ["feasible"] * n
+    assert doc["run"]["kept"] == len(done) and doc["run"]["planned"] == n - len(done)
     assert f"kept {len(done)}" in " ".join(again.stdout.split())
-    assert Path(out / "batch.csv").read_text().count("feasible") == 4
+    assert Path(out / "batch.csv").read_text().count("feasible") == n
