@@ -131,10 +131,10 @@ def read_input(cell_path: str | os.PathLike[str]) -> tuple[Cell, PartMesh]:
 def cell_cuts(cell: Cell, part: PartMesh, query: MeshQuery,
               check: Callable[[CarveCut], str] | None = None,
               progress: Callable[[str], None] = lambda msg: None) -> CutPlan:  # fmt: skip
-    """The cuts of a cell's part (:func:`.plan_cuts.find_cuts`) with the cell's tolerance,
-    roughing loops and lead (the planner's default lead when ``[cut]`` names none).
+    """Return the cuts of a cell's part, as :func:`carve` finds them.
 
-    ``check``: the robot (:class:`.robotcheck.RobotCheck`, as :func:`carve` asks it);
+    :func:`.plan_cuts.find_cuts` with the cell's tolerance, roughing loops and lead (the
+    planner's default lead when ``[cut]`` names none).  ``check``: the robot (:class:`.robotcheck.RobotCheck`, as :func:`carve` asks it);
     None: the geometry alone."""
     from ..wirecut import CutSpec  # its defaults: the lead the planner uses
 
