@@ -134,8 +134,9 @@ def cell_cuts(cell: Cell, part: PartMesh, query: MeshQuery,
     """Return the cuts of a cell's part, as :func:`carve` finds them.
 
     :func:`.plan_cuts.find_cuts` with the cell's tolerance, roughing loops and lead (the
-    planner's default lead when ``[cut]`` names none).  ``check``: the robot (:class:`.robotcheck.RobotCheck`, as :func:`carve` asks it);
-    None: the geometry alone."""
+    planner's default lead when ``[cut]`` names none).  ``check``: the robot
+    (:class:`.robotcheck.RobotCheck`, as :func:`carve` asks it); None: the geometry alone
+    (the block-turn search of a refused face, carve's, is not made)."""
     from ..wirecut import CutSpec  # its defaults: the lead the planner uses
 
     lead = float(cell.tables.get("cut", {}).get("lead_in", CutSpec.lead_in))
