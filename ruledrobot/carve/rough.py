@@ -233,6 +233,21 @@ def _voxels(stock: Box, count: int) -> tuple[FloatArray, float, tuple[int, int, 
     return local @ stock.rotation.T + stock.centre, h, X.shape
 
 
+def _all_below(points: np.ndarray, normals_t: np.ndarray, offsets: np.ndarray,
+               cells: int = 2**16) -> np.ndarray:
+    """Whether each point (N, 3) satisfies every ``p . n_j <= offset_j`` (normals (3, K)).
+
+    In the dtype given, in chunks of about ``cells`` products (in cache and below
+    OpenBLAS's threading: the fastest measured on the 2-core machine); the (N, K) matrix
+    of a convex hull's thousands of facets at once took a gigabyte and seconds of page
+    faults (the ellipsoid's hull, 30,000 voxels against 3,840 facets: 4 s, now 0.1 s)."""
+    out = np.empty(len(points), dtype=bool)
+    step = max(1, cells // max(1, normals_t.shape[1]))
+    for s in range(0, len(points), step):
+        out[s:s + step] = np.all(points[s:s + step] @ normals_t <= offsets, axis=1)
+    return out
+
+
 def choose_loops(hull: FloatArray, stock: Box, count: int, standoff: float,
                  seams: bool = True, axes: FloatArray | None = None,
                  radial: FloatArray | None = None, max_tilt: float = MAX_TILT,
@@ -247,23 +262,25 @@ def choose_loops(hull: FloatArray, stock: Box, count: int, standoff: float,
     of a round, then of the next best while it says no; each loop asked once): a loop it
     refuses is never chosen.  ``gone(points, shape)``: which voxels of the grid (N, 3),
     ``shape``, the exact cuts take away already (they count for no loop: a part whose exact
-    cuts leave nothing outside its hull gets no loop)."""
+    cuts leave nothing outside its hull gets no loop).  Which voxels each candidate takes
+    is counted once; a round counts those still left."""
     from scipy.spatial import ConvexHull
 
     axes = fibonacci_axes(24) if axes is None else axes
     pts, h, shape = _voxels(stock, VOXELS)
     eq = ConvexHull(hull).equations
-    in_hull = np.all(pts @ eq[:, :3].T + eq[:, 3] <= 0.0, axis=1)
+    in_hull = _all_below(pts, eq[:, :3].T, -eq[:, 3])
     left = ~in_hull if gone is None else ~in_hull & ~gone(pts, shape)
     alive = (pts[left] - stock.centre).astype(np.float32)
     cands = _candidates(hull, standoff, axes, seams, radial, max_tilt)
-    planes = [(c.normals.T.astype(np.float32), (c.support - c.normals @ stock.centre)
-               .astype(np.float32)) for c in cands]  # fmt: skip
+    takes = np.array([~_all_below(alive, c.normals.T.astype(np.float32),
+                                  (c.support - c.normals @ stock.centre).astype(np.float32))
+                      for c in cands]).reshape(len(cands), len(alive))  # fmt: skip
+    still = np.ones(len(alive), dtype=bool)
     chosen, kept = [], []
     verdict: dict[int, bool] = {}
     for _ in range(count):
-        keeps = [np.all(alive @ nt <= sup, axis=1) for nt, sup in planes]
-        gains = np.array([len(alive) - int(k.sum()) for k in keeps])
+        gains = np.count_nonzero(takes & still, axis=1)
         best = None
         for i in np.argsort(-gains, kind="stable"):
             if gains[i] <= 0:
@@ -276,6 +293,6 @@ def choose_loops(hull: FloatArray, stock: Box, count: int, standoff: float,
         if best is None:
             break
         chosen.append(cands[best])
-        alive = alive[keeps[best]]
-        kept.append(float((len(alive) + in_hull.sum()) * h**3))
+        still &= ~takes[best]
+        kept.append(float((np.count_nonzero(still) + in_hull.sum()) * h**3))
     return chosen, kept

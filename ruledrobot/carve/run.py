@@ -15,6 +15,7 @@ import dataclasses
 import math
 import os
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -28,11 +29,12 @@ from .carved import Carved, carve_block
 from .cell import Cell, load_cell
 from .jobs import setups_of, write_jobs
 from .meshquery import MeshQuery
+from .model import CarveCut
 from .plan_cuts import CutPlan, find_cuts
 from .readers import PartMesh, edge_counts, read_part
 from .robotcheck import RobotCheck, next_best
 
-__all__ = ["CarveResult", "carve", "check_fits"]
+__all__ = ["CarveResult", "carve", "cell_cuts", "check_fits", "read_input"]
 
 FORMAT = "ruledrobot.carve/1"
 
@@ -114,26 +116,48 @@ def _offer_turn(plan: CutPlan, check: RobotCheck, cell: Cell) -> CutPlan:
     return dataclasses.replace(plan, faces=faces, notes=(*plan.notes, f"{cut.what}: {words}"))
 
 
+def read_input(cell_path: str | os.PathLike[str]) -> tuple[Cell, PartMesh]:
+    """Read a cell file and its part as :func:`carve` does, every input check made.
+
+    carve's first stage alone: the cell's tables and fields, the part's file, units,
+    mesh and repair (:func:`.readers.read_part`), its fit in the block
+    (:func:`check_fits`); ValueError naming the file on bad input, nothing written."""
+    cell = load_cell(cell_path)
+    part = read_part(cell.part, cell.stock, cell.where)
+    check_fits(part, cell)
+    return cell, part
+
+
+def cell_cuts(cell: Cell, part: PartMesh, query: MeshQuery,
+              check: Callable[[CarveCut], str] | None = None,
+              progress: Callable[[str], None] = lambda msg: None) -> CutPlan:  # fmt: skip
+    """Return the cuts of a cell's part, as :func:`carve` finds them.
+
+    :func:`.plan_cuts.find_cuts` with the cell's tolerance, roughing loops and lead (the
+    planner's default lead when ``[cut]`` names none).  ``check``: the robot
+    (:class:`.robotcheck.RobotCheck`, as :func:`carve` asks it); None: the geometry alone
+    (the block-turn search of a refused face, carve's, is not made)."""
+    from ..wirecut import CutSpec  # its defaults: the lead the planner uses
+
+    lead = float(cell.tables.get("cut", {}).get("lead_in", CutSpec.lead_in))
+    return find_cuts(part, cell.stock, query, cell.part.tolerance, cell.part.rough_cuts, lead,
+                     progress, check)  # fmt: skip
+
+
 def carve(cell_path: str | os.PathLike[str], out: str | os.PathLike[str],
           progress=lambda msg: None) -> CarveResult:  # fmt: skip
     """Carve the part of a cell file into ``out`` (module doc); ValueError on bad input."""
     times: dict[str, float] = {}
     t = time.perf_counter()
-    cell = load_cell(cell_path)
-    part = read_part(cell.part, cell.stock, cell.where)
-    check_fits(part, cell)
+    cell, part = read_input(cell_path)
     staged = StagedFolder(out)  # refuses a folder of the user's own files at once
     times["read"] = time.perf_counter() - t
     with staged:
         t = time.perf_counter()
         query = MeshQuery(part)
-        from ..wirecut import CutSpec  # its defaults: the lead the planner uses
-
-        lead = float(cell.tables.get("cut", {}).get("lead_in", CutSpec.lead_in))
         check = RobotCheck(cell.tables)
         try:
-            plan = find_cuts(part, cell.stock, query, cell.part.tolerance, cell.part.rough_cuts,
-                             lead, progress, check)  # fmt: skip
+            plan = cell_cuts(cell, part, query, check, progress)
             # a face's trouble, not a block out of reach; ``turns = false``: name it only
             if plan.refused and plan.cuts and cell.part.turns:
                 progress("trying the block turned for the largest face the arm cannot make")

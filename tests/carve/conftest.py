@@ -42,6 +42,17 @@ def run_carve(cell, out):
     return res, report
 
 
+def cuts_alone(cell):
+    """carve's input stage and cut plan without the robot (no file written): ``(cell,
+    part, plan)``; for what the geometry alone decides, where a run of ``carve`` would
+    add only the robot's wire-pose search of every cut (seconds each)."""
+    from ruledrobot.carve.meshquery import MeshQuery
+    from ruledrobot.carve.run import cell_cuts, read_input
+
+    spec, part = read_input(cell)
+    return spec, part, cell_cuts(spec, part, MeshQuery(part))
+
+
 @pytest.fixture
 def carve_cli():
     return run_carve

@@ -51,15 +51,14 @@ def ellipsoid(axes=(0.09, 0.06, 0.045), nu=64, nv=32):
 
 def write_stl_ascii(path, v, f, scale=1.0):
     """An ASCII STL of the mesh (coordinates divided by ``scale``: 0.001 writes mm)."""
-    lines = ["solid part"]
-    for tri in v[f] / scale:
-        n = np.cross(tri[1] - tri[0], tri[2] - tri[0])
-        n = n / (np.linalg.norm(n) or 1.0)
-        lines += [f"facet normal {n[0]:.9g} {n[1]:.9g} {n[2]:.9g}", "outer loop"]
-        lines += [f"vertex {p[0]:.12g} {p[1]:.12g} {p[2]:.12g}" for p in tri]
-        lines += ["endloop", "endfacet"]
-    lines.append("endsolid part")
-    path.write_text("\n".join(lines) + "\n")
+    tri = v[f] / scale
+    n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    length = np.linalg.norm(n, axis=1)
+    n = n / np.where(length > 0.0, length, 1.0)[:, None]
+    facet = ("facet normal %.9g %.9g %.9g\nouter loop\n" + "vertex %.12g %.12g %.12g\n" * 3
+             + "endloop\nendfacet\n")  # fmt: skip
+    body = (facet * len(tri)) % tuple(np.concatenate([n[:, None], tri], axis=1).ravel().tolist())
+    path.write_text("solid part\n" + body + "endsolid part\n")
     return path
 
 
