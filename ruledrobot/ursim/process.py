@@ -4,8 +4,8 @@ ur_rtde's Python bindings keep the GIL while they wait for the controller
 (the interface constructors, ``moveJ``, ...).  An emulator on threads of the
 same process can then never answer: the client deadlocks.  :class:`Emulator`
 therefore runs the :class:`~.server.ThreadedEmulator` in a child process
-(``python -c``, talking over a socket pair) and forwards fault injection and
-state queries to it.  With
+(forked from a warm process, :mod:`.zygote`, talking over a socket pair) and
+forwards fault injection and state queries to it.  With
 ``in_process=True`` it runs the threaded emulator here instead (for clients
 in other processes, or raw-socket clients).
 
@@ -20,8 +20,6 @@ import gc
 import os
 import signal
 import socket
-import subprocess
-import sys
 import threading
 import time
 from collections.abc import Callable, Iterator
@@ -39,6 +37,7 @@ from .arm.backend import ArmBackend
 from .arm.emulated import emulated_model
 from .ports.tcp import try_realtime_priority
 from .server import ThreadedEmulator
+from .zygote import Child, fork_child
 
 __all__ = ["EMBEDDED_HOST", "Emulator", "embedded_emulator"]
 
@@ -79,11 +78,10 @@ _PROPS = frozenset(
 )
 
 
-def _kill(proc: subprocess.Popen) -> None:
-    with contextlib.suppress(OSError):
-        proc.kill()
-    with contextlib.suppress(subprocess.TimeoutExpired):
-        proc.wait(2.0)
+def _kill(proc: Child) -> None:
+    proc.kill()
+    proc.wait(2.0)
+    proc.close()
 
 
 def _child_entry(fd: int) -> None:  # pragma: no cover - runs in the child
@@ -214,14 +212,10 @@ class Emulator:
         if self._proc is not None:
             return self
         ours, theirs = socket.socketpair()
-        env = dict(os.environ)
-        env["PYTHONPATH"] = os.pathsep.join(p for p in sys.path if p)
-        code = f"from {__name__} import _child_entry; _child_entry({theirs.fileno()})"
-        proc = subprocess.Popen(
-            [sys.executable, "-c", code], pass_fds=(theirs.fileno(),), env=env,
-            stdin=subprocess.DEVNULL,
-        )  # fmt: skip
-        theirs.close()
+        try:
+            proc = fork_child(theirs.fileno())
+        finally:
+            theirs.close()
         conn = Connection(ours.detach())
         try:
             conn.send(dict(self._kwargs, find_free_host=self.find_free_host))
@@ -234,7 +228,7 @@ class Emulator:
             _kill(proc)
             conn.close()
             raise RuntimeError(
-                f"emulator on {self.host}: the child process died ({exc or proc.poll()})"
+                f"emulator on {self.host}: the child process died ({exc or 'it exited'})"
             ) from None
         except BaseException:
             _kill(proc)
@@ -267,9 +261,9 @@ class Emulator:
                 while conn.poll(max(0.0, deadline - time.monotonic())):
                     if conn.recv()[0] == "closed":
                         break
-        try:
-            proc.wait(max(0.1, deadline - time.monotonic()))
-        except subprocess.TimeoutExpired:
+        if proc.wait(max(0.1, deadline - time.monotonic())):
+            proc.close()
+        else:
             _kill(proc)
         with contextlib.suppress(OSError):
             conn.close()
@@ -285,7 +279,7 @@ class Emulator:
         """True while the emulator serves: the child process lives, or the in-process clock runs."""
         if self._local is not None:
             return self._local.running
-        return self._proc is not None and self._proc.poll() is None
+        return self._proc is not None and self._proc.running
 
     @property
     def pid(self) -> int | None:

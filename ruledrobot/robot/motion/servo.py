@@ -20,7 +20,6 @@ from __future__ import annotations
 
 import numpy as np
 from numpy.typing import ArrayLike
-from scipy.signal import lfilter
 
 from .._checks import FloatArray
 
@@ -61,5 +60,8 @@ def servo_track(x: ArrayLike, dt: float, tau: float) -> FloatArray:
     v = np.asarray(x, dtype=np.float64)
     if v.shape[0] == 0 or tau <= dt:
         return v.copy()
+    from scipy.signal import lfilter  # here: scipy.signal takes 1-2 s to import, and the
+    # emulator's and the runner's child processes import this module without filtering
+
     a = dt / tau
     return lfilter([a], [1.0, a - 1.0], v - v[0], axis=0) + v[0]

@@ -167,6 +167,7 @@ class Controller(IOMixin, SafetyMixin):
         self._watch_last = 0.0
         self._power_off_when_stopped = False
         self.values: dict[str, object] = {}
+        self._kin_memo: dict[str, tuple] = {}  # _kin_state: the last state of each
         warm_up()  # the URScript parser, before any clock runs
         self._init_values()
         self._update_values()
@@ -244,11 +245,11 @@ class Controller(IOMixin, SafetyMixin):
         qd = st.qd.tolist()
         tq = st.target_q.tolist()
         tqd = st.target_qd.tolist()
-        pose, speed, elbow = self.kin.state(q, qd)
+        pose, speed, elbow = self._kin_state("actual", q, qd)
         if tq == q and tqd == qd:
             tpose, tspeed = pose, speed
         else:
-            tpose, tspeed, _ = self.kin.state(tq, tqd)
+            tpose, tspeed, _ = self._kin_state("target", tq, tqd)
         self.history.append(q)
         running = self.robot_mode == RobotMode.RUNNING
         if running:
@@ -294,6 +295,20 @@ class Controller(IOMixin, SafetyMixin):
                 "script_control_line": self._script_line(),
             }
         )
+
+    def _kin_state(
+        self, which: str, q: list[float], qd: list[float]
+    ) -> tuple[tuple[float, ...], ...]:
+        """:meth:`ArmKinematics.state` of ``(q, qd)``, the last result of ``which`` (``"actual"``
+        or ``"target"``) again when neither they nor the TCP changed: an arm at rest costs no
+        kinematics per period (they were 60 % of an idle emulator's CPU)."""
+        model = self.kin.model  # a new TCP is a new model (ArmKinematics.set_model)
+        last = self._kin_memo.get(which)
+        if last is not None and last[0] is model and last[1] == q and last[2] == qd:
+            return last[3]
+        out = self.kin.state(q, qd)
+        self._kin_memo[which] = (model, q, qd, out)
+        return out
 
     def _script_line(self) -> int:
         r = self.runner
