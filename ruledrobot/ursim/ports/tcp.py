@@ -316,6 +316,8 @@ class TcpServer:
         """Stop accepting, close every connection, join the threads (bounded by ``timeout``)."""
         self._stop.set()
         if self._listener is not None:
+            with contextlib.suppress(OSError):  # wakes the accept() at once (Linux; a close
+                self._listener.shutdown(socket.SHUT_RDWR)  # alone waits out its POLL timeout)
             with contextlib.suppress(OSError):
                 self._listener.close()
         for c in self.connections():
