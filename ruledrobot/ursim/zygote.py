@@ -10,10 +10,11 @@ does the same, but re-runs the parent's ``__main__`` in every child.)
 Each child gets the parent's standard output and error and working directory as they
 are when it starts (as a child the parent started itself would), and the child's end
 of the parent's socket pair; it runs :func:`.process._child_entry` on it and exits.
-The zygote ignores SIGINT (as the children do; the parent stops them) and reaps its
-children, and exits when the parent does (its socket closes); a child exits when its
-pipe closes.  The parent watches a child through a pidfd (:class:`Child`): it is not
-the child's parent, so the exit code is the zygote's to reap, not known here.
+The zygote ignores SIGINT (as the children do; the parent stops them), reaps its
+children (so their CPU time counts in the parent's children), and exits when the
+parent does (its socket closes); a child exits when its pipe closes.  The parent
+watches a child through a pidfd (:class:`Child`): it is not the child's parent, so
+the exit code is the zygote's to reap, not known here.
 """
 
 from __future__ import annotations
@@ -180,7 +181,9 @@ def _at_exit() -> None:
 def _serve(fd: int) -> None:  # pragma: no cover - runs in the zygote
     """The zygote: import, then fork a child per request until the parent's socket closes."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
-    signal.signal(signal.SIGCHLD, signal.SIG_IGN)  # the kernel reaps the children
+    # reaped here (not SIG_IGN, which lets the kernel reap them) so that their CPU time
+    # counts in the zygote's children, and so in its parent's (``time make test``)
+    signal.signal(signal.SIGCHLD, _reap)
     from .process import _child_entry
     from .script.syntax import warm_up
 
@@ -209,6 +212,13 @@ def _serve(fd: int) -> None:  # pragma: no cover - runs in the zygote
         for f in fds:
             os.close(f)
         sock.sendall(struct.pack("<q", pid))
+
+
+def _reap(_signum: int, _frame: object) -> None:  # pragma: no cover - runs in the zygote
+    """SIGCHLD: wait for every child that ended."""
+    with contextlib.suppress(ChildProcessError):
+        while os.waitpid(-1, os.WNOHANG)[0] > 0:
+            pass
 
 
 def _run_child(sock: socket.socket, fds: list[int], cwd: bytes, entry) -> None:  # pragma: no cover

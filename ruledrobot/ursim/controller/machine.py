@@ -602,10 +602,9 @@ class Controller(IOMixin, SafetyMixin):
             st = self.backend.state()
             if st.limited:
                 self.limit_events += 1
-            if self._can_move() and (
-                np.any(st.q <= self.model.lower) or np.any(st.q >= self.model.upper)
-            ):
-                j = int(np.argmax((st.q <= self.model.lower) | (st.q >= self.model.upper)))
-                self.protective_stop(f"joint {j} position limit")
+            if self._can_move():
+                out = (st.q <= self.model.lower) | (st.q >= self.model.upper)
+                if out.any():
+                    self.protective_stop(f"joint {int(np.argmax(out))} position limit")
             self._update_values(time.perf_counter() - t0)
             return self.values
