@@ -69,7 +69,7 @@ def _run_with(fault: str, emu: Emulator, proxy: FaultProxy, tmp_path: Path):
     # servoj: ur_rtde's hangs in the stream's safe stop and the watchdog (a forwarded run's
     # program talks to the runner directly and stops along the path: test_forward.py)
     res = run_trajectory(src, proxy.listen, progress=progress, lookahead=0.05, mode="servoj")
-    assert fired, "the fault was never injected"
+    assert fired, f"the fault was never injected: the run ended first ({res.status}: {res.message})"
     elapsed = time.monotonic() - fired[0][1]
     # the runner returned in time, not completed (the CLI's exit status 1), and says where
     assert not res.completed and res.moved, res
