@@ -25,13 +25,13 @@ demo: $(STAMP)
 
 ## Run the whole test suite (what CI runs): the tests that are not real-time on both
 ## cores (pytest-xdist; a module's tests on one worker, so its module fixtures are built
-## once), then the real-time ones (emulator streams) apart from them, in two groups of
-## whole modules (their tolerances are sized for a loaded 2-core machine; README,
-## "Development").
+## once), then the real-time ones (emulator streams) apart from them, in three groups of
+## whole modules: they mostly wait for the emulator's clock (their tolerances are sized
+## for a loaded 2-core machine; README, "Development").
 test: $(STAMP)
 	$(BIN)/ruff check ruledrobot tests scripts
 	$(PYTEST) -q -n 2 --dist loadscope -m "not realtime"
-	$(PYTEST) -q -n 2 --dist loadfile -m realtime
+	$(PYTEST) -q -n 3 --dist loadfile -m realtime
 
 ## The edit loop: ruff and the fast tests on both cores (no real-time streams, no slow
 ## tests: SLOW_MODULES and SLOW_TESTS in tests/conftest.py, chosen by measured
