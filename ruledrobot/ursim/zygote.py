@@ -4,7 +4,9 @@ A fresh interpreter per emulator imports the package anew: 0.4-1.5 s of CPU and
 seconds of wall time on a busy machine, and the tests start hundreds of emulators.
 The zygote (one per parent process, started on first use: ``python -c`` and a socket
 pair) imports :mod:`.process` and builds the URScript parser once, then forks a child
-per request; a child is serving in about 0.1 s.  (multiprocessing's ``forkserver``
+per request; a child is serving in about 0.1 s.  The zygote is told which function a
+child runs (``"module:function"``, :data:`EMULATOR_CHILD`), not importing it by name: the
+emulator's process module imports this one.  (multiprocessing's ``forkserver``
 does the same, but re-runs the parent's ``__main__`` in every child.)
 
 Each child gets the parent's standard output and error and working directory as they
@@ -22,6 +24,7 @@ from __future__ import annotations
 import atexit
 import contextlib
 import gc
+import importlib
 import os
 import select
 import signal
@@ -33,19 +36,24 @@ import threading
 import time
 import traceback
 
-__all__ = ["Child", "fork_child"]
+__all__ = ["EMULATOR_CHILD", "Child", "fork_child"]
+
+#: what a child runs: the emulator served to the parent over one socket (its fd)
+EMULATOR_CHILD = "ruledrobot.ursim.process:_child_entry"
 
 #: s: the longest a request may wait for the zygote (its start imports the package)
 ZYGOTE_TIMEOUT = 60.0
 
 _lock = threading.Lock()
-#: the zygote of this process: (owner pid, socket, process); replaced after a fork
-_zygote: tuple[int, socket.socket, subprocess.Popen] | None = None
+#: the zygote of this process per entry point: (owner pid, socket, process); replaced
+#: after a fork
+_zygotes: dict[str, tuple[int, socket.socket, subprocess.Popen]] = {}
 
 
 class Child:
-    """A child the zygote forked: :attr:`pid`, watched through a pidfd (Linux 5.3+; elsewhere
-    by signal 0 every 10 ms)."""
+    """A child the zygote forked: its :attr:`pid`, watched through a pidfd.
+
+    A pidfd needs Linux 5.3+; elsewhere the child is probed by signal 0 every 10 ms."""
 
     def __init__(self, pid: int) -> None:
         self.pid = pid
@@ -99,12 +107,14 @@ class Child:
             self._fd = None
 
 
-def fork_child(fd: int) -> Child:
-    """Fork an emulator child that serves the parent on socket ``fd`` (the caller closes
-    its copy); RuntimeError when the zygote cannot start or fork."""
+def fork_child(fd: int, entry: str = EMULATOR_CHILD) -> Child:
+    """Fork an emulator child that serves this process on socket ``fd``.
+
+    The child runs ``entry`` (``"module:function"``, called with ``fd``); the caller closes
+    its copy of ``fd``.  RuntimeError when the zygote cannot start or fork."""
     with _lock:
         for attempt in (0, 1):  # a dead zygote (killed, crashed) is started again, once
-            sock = _zygote_socket(fresh=attempt > 0)
+            sock = _zygote_socket(entry, fresh=attempt > 0)
             try:
                 return Child(_request(sock, fd))
             except OSError as exc:
@@ -141,23 +151,25 @@ def _is_open(fd: int) -> bool:
         return False
 
 
-def _zygote_socket(fresh: bool) -> socket.socket:
-    """This process's zygote (started when there is none, it belongs to the process this
-    one was forked from, or ``fresh``)."""
-    global _zygote
-    if _zygote is not None and _zygote[0] == os.getpid() and not fresh:
-        return _zygote[1]
-    if _zygote is not None and _zygote[0] == os.getpid():
-        _stop(_zygote)
+def _zygote_socket(entry: str, fresh: bool) -> socket.socket:
+    """The socket to this process's zygote for ``entry``, started first when needed.
+
+    Started when there is none, when it belongs to the process this one was forked from,
+    or when ``fresh``."""
+    zygote = _zygotes.get(entry)
+    if zygote is not None and zygote[0] == os.getpid() and not fresh:
+        return zygote[1]
+    if zygote is not None and zygote[0] == os.getpid():
+        _stop(zygote)
     ours, theirs = socket.socketpair()
     env = dict(os.environ)
     env["PYTHONPATH"] = os.pathsep.join(p for p in sys.path if p)
-    code = f"from {__name__} import _serve; _serve({theirs.fileno()})"
+    code = f"from {__name__} import _serve; _serve({theirs.fileno()}, {entry!r})"
     proc = subprocess.Popen([sys.executable, "-c", code], pass_fds=(theirs.fileno(),), env=env,
                             stdin=subprocess.DEVNULL)  # fmt: skip
     theirs.close()
     ours.settimeout(ZYGOTE_TIMEOUT)
-    _zygote = (os.getpid(), ours, proc)
+    _zygotes[entry] = (os.getpid(), ours, proc)
     return ours
 
 
@@ -174,18 +186,21 @@ def _stop(zygote: tuple[int, socket.socket, subprocess.Popen]) -> None:
 
 @atexit.register
 def _at_exit() -> None:
-    if _zygote is not None and _zygote[0] == os.getpid():
-        _stop(_zygote)
+    for zygote in _zygotes.values():
+        if zygote[0] == os.getpid():
+            _stop(zygote)
 
 
-def _serve(fd: int) -> None:  # pragma: no cover - runs in the zygote
+def _serve(fd: int, entry: str) -> None:  # pragma: no cover - runs in the zygote
     """The zygote: import, then fork a child per request until the parent's socket closes."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     # reaped here (not SIG_IGN, which lets the kernel reap them) so that their CPU time
     # counts in the zygote's children, and so in its parent's (``time make test``)
     signal.signal(signal.SIGCHLD, _reap)
-    from .process import _child_entry
     from .script.syntax import warm_up
+
+    module, name = entry.split(":")
+    target = getattr(importlib.import_module(module), name)
 
     warm_up()
     gc.collect()
@@ -208,7 +223,7 @@ def _serve(fd: int) -> None:  # pragma: no cover - runs in the zygote
         except OSError as exc:
             pid = -(exc.errno or 11)
         if pid == 0:
-            _run_child(sock, fds, msg, _child_entry)
+            _run_child(sock, fds, msg, target)
         for f in fds:
             os.close(f)
         sock.sendall(struct.pack("<q", pid))

@@ -38,7 +38,7 @@ from threading import RLock
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ...protocol.modes import JointMode, RobotMode, RuntimeState, SafetyMode, SafetyStatusBit
+from ...protocol.modes import JointMode, RobotMode, RuntimeState, SafetyMode
 from ...robot import RobotModel
 from ...robot.motion.arm_kinematics import ArmKinematics
 from ...robot.motion.ur_motion import MotionError, PathMotion, Segment, StopMotion
@@ -50,7 +50,7 @@ from ..script.runner import move_segment
 from ..script.syntax import warm_up
 from .programs import program_in
 from .registers import IN_DOUBLE, IN_INT, OUT_DOUBLE, OUT_INT, IOMixin
-from .safety import SafetyMixin
+from .safety import SAFETY_BITS, SafetyMixin
 
 __all__ = ["DEFAULT_Q", "Controller", "Event"]
 
@@ -63,20 +63,6 @@ DEFAULT_Q = (0.0, -1.5707963267948966, 1.5707963267948966, -1.5707963267948966,
 
 _ZERO6 = np.zeros(6)
 
-_SAFETY_BITS = {
-    SafetyMode.NORMAL: 1 << SafetyStatusBit.NORMAL_MODE,
-    SafetyMode.REDUCED: 1 << SafetyStatusBit.REDUCED_MODE,
-    SafetyMode.PROTECTIVE_STOP: (1 << SafetyStatusBit.PROTECTIVE_STOPPED)
-    | (1 << SafetyStatusBit.STOPPED_DUE_TO_SAFETY),
-    SafetyMode.RECOVERY: 1 << SafetyStatusBit.RECOVERY_MODE,
-    SafetyMode.SAFEGUARD_STOP: 1 << SafetyStatusBit.SAFEGUARD_STOPPED,
-    SafetyMode.SYSTEM_EMERGENCY_STOP: (1 << SafetyStatusBit.SYSTEM_EMERGENCY_STOPPED)
-    | (1 << SafetyStatusBit.EMERGENCY_STOPPED),
-    SafetyMode.ROBOT_EMERGENCY_STOP: (1 << SafetyStatusBit.ROBOT_EMERGENCY_STOPPED)
-    | (1 << SafetyStatusBit.EMERGENCY_STOPPED),
-    SafetyMode.VIOLATION: 1 << SafetyStatusBit.VIOLATION,
-    SafetyMode.FAULT: 1 << SafetyStatusBit.FAULT,
-}
 
 Event = tuple[float, int, str]
 
@@ -280,7 +266,7 @@ class Controller(IOMixin, SafetyMixin):
                 "joint_mode": (int(jm),) * 6,
                 "safety_mode": int(self.safety_mode),
                 "safety_status": int(self.safety_mode),
-                "safety_status_bits": _SAFETY_BITS.get(self.safety_mode, 0),
+                "safety_status_bits": SAFETY_BITS.get(self.safety_mode, 0),
                 "robot_status_bits": int(powered) | (int(playing) << 1),
                 "runtime_state": int(self.runtime_state),
                 "speed_scaling": self.speed_fraction if running else 0.0,
@@ -296,12 +282,11 @@ class Controller(IOMixin, SafetyMixin):
             }
         )
 
-    def _kin_state(
-        self, which: str, q: list[float], qd: list[float]
-    ) -> tuple[tuple[float, ...], ...]:
-        """:meth:`ArmKinematics.state` of ``(q, qd)``, the last result of ``which`` (``"actual"``
-        or ``"target"``) again when neither they nor the TCP changed: an arm at rest costs no
-        kinematics per period (they were 60 % of an idle emulator's CPU)."""
+    def _kin_state(self, which: str, q: list, qd: list) -> tuple:
+        """:meth:`ArmKinematics.state` of ``(q, qd)``, computed only when they or the TCP change.
+
+        ``which`` (``"actual"``, ``"target"``) keeps its last result: an arm at rest costs no
+        kinematics per period (60 % of an idle emulator's tick)."""
         model = self.kin.model  # a new TCP is a new model (ArmKinematics.set_model)
         last = self._kin_memo.get(which)
         if last is not None and last[0] is model and last[1] == q and last[2] == qd:

@@ -11,10 +11,26 @@ import time
 from threading import RLock
 from typing import Any
 
-from ...protocol.modes import RobotMode, SafetyMode
+from ...protocol.modes import RobotMode, SafetyMode, SafetyStatusBit
 from ...robot.motion.ur_motion import StopMotion
 
-__all__ = ["SafetyMixin"]
+__all__ = ["SAFETY_BITS", "SafetyMixin"]
+
+#: the safety status bits (RTDE ``safety_status_bits``) of each safety mode
+SAFETY_BITS = {
+    SafetyMode.NORMAL: 1 << SafetyStatusBit.NORMAL_MODE,
+    SafetyMode.REDUCED: 1 << SafetyStatusBit.REDUCED_MODE,
+    SafetyMode.PROTECTIVE_STOP: (1 << SafetyStatusBit.PROTECTIVE_STOPPED)
+    | (1 << SafetyStatusBit.STOPPED_DUE_TO_SAFETY),
+    SafetyMode.RECOVERY: 1 << SafetyStatusBit.RECOVERY_MODE,
+    SafetyMode.SAFEGUARD_STOP: 1 << SafetyStatusBit.SAFEGUARD_STOPPED,
+    SafetyMode.SYSTEM_EMERGENCY_STOP: (1 << SafetyStatusBit.SYSTEM_EMERGENCY_STOPPED)
+    | (1 << SafetyStatusBit.EMERGENCY_STOPPED),
+    SafetyMode.ROBOT_EMERGENCY_STOP: (1 << SafetyStatusBit.ROBOT_EMERGENCY_STOPPED)
+    | (1 << SafetyStatusBit.EMERGENCY_STOPPED),
+    SafetyMode.VIOLATION: 1 << SafetyStatusBit.VIOLATION,
+    SafetyMode.FAULT: 1 << SafetyStatusBit.FAULT,
+}
 
 
 class SafetyMixin:
