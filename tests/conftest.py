@@ -19,7 +19,7 @@ settings.load_profile("ci" if os.environ.get("CI") else "dev")
 
 #: tests that run real-time servers (500 Hz streams, a controller's clock, timed faults):
 #: marked ``realtime`` so that ``make test`` runs them apart from the parallel rest, where
-#: they do not compete with CPU-bound tests for the two cores (in two groups of modules:
+#: they do not compete with CPU-bound tests for the two cores (in three groups of modules:
 #: mostly waiting for the controller's clock, they leave each other room)
 REALTIME_DIRS = ("tests/export/", "tests/ursim/")
 REALTIME_TESTS = frozenset({"tests/cli/test_cli.py::test_run_streams_to_the_embedded_emulator"})
