@@ -16,6 +16,7 @@ from typer.testing import CliRunner
 
 from ruledrobot.cli import app
 from tests.architecture.imports import graph
+from tests.support.processes import popen_as_from_a_terminal
 
 from .conftest import FAST_JOB, deadline
 
@@ -90,25 +91,6 @@ def _alive(pids: list[int]) -> list[int]:
     return alive
 
 
-def _popen_as_from_a_terminal(cmd: list[str], env: dict[str, str]) -> subprocess.Popen:
-    """Start ``cmd`` with Ctrl-C at its default, as a terminal's foreground job has it.
-
-    A test run started in the background (``nohup``, ``&`` in a script) ignores SIGINT and
-    its children inherit that: the batch then never saw the test's Ctrl-C and planned to
-    the end (exit 0).  Here SIGINT has a handler while the child starts, which ``exec``
-    resets to the default (signal handlers are set from the main thread only)."""
-    import threading
-
-    main = threading.current_thread() is threading.main_thread()
-    old = signal.signal(signal.SIGINT, signal.default_int_handler) if main else None
-    try:
-        return subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
-                                env=env, start_new_session=True, text=True)  # fmt: skip
-    finally:
-        if main:
-            signal.signal(signal.SIGINT, old)
-
-
 def test_ctrl_c_stops_cleanly_and_the_same_command_resumes(tmp_path):
     pytest.importorskip("distributed")
     jobs = tmp_path / "jobs"
@@ -123,7 +105,8 @@ def test_ctrl_c_stops_cleanly_and_the_same_command_resumes(tmp_path):
            str(out), "--workers", "2"]  # fmt: skip
     env = dict(os.environ, MUJOCO_GL=os.environ.get("MUJOCO_GL", "egl"), COLUMNS="200")
     with deadline(240):
-        proc = _popen_as_from_a_terminal(cmd, env)
+        proc = popen_as_from_a_terminal(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                                        env=env, start_new_session=True, text=True)
         t0 = time.monotonic()
         while time.monotonic() - t0 < 150:
             try:

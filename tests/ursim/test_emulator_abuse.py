@@ -29,6 +29,7 @@ from ruledrobot.ursim.script.program import (
     parse_call,
 )
 from tests.support.emulators import _address, start_emulator
+from tests.support.processes import popen_as_from_a_terminal
 from tests.support.rawclient import UR_RTDE_RECEIVE_RECIPE, RawRTDEClient
 
 
@@ -604,7 +605,8 @@ def test_ursim_injects_faults_on_a_timer_and_on_a_signal(tmp_path: Path) -> None
            "--host", host, "--duration", "20", "--programs", str(tmp_path),
            "--fault", "protective_stop@1s", "--fault", "emergency_stop@SIGUSR1",
            "--fault", "clear@SIGUSR2"]  # fmt: skip
-    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    proc = popen_as_from_a_terminal(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                                    text=True)  # stopped by SIGINT below
     try:
         assert proc.stdout is not None
         lines = []

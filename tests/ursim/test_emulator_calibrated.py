@@ -24,6 +24,7 @@ from ruledrobot.protocol.primary import PRIMARY_PORT, SECONDARY_PORT, read_kinem
 from ruledrobot.robot import load, random_calibration
 from ruledrobot.ursim import DEFAULT_Q, Emulator, ThreadedEmulator
 from tests.support.emulators import UR, _address, start_emulator
+from tests.support.processes import popen_as_from_a_terminal
 
 pytest.importorskip("rtde_control")
 
@@ -207,7 +208,8 @@ def test_ursim_serves_a_seeded_random_calibration() -> None:
     host = _address("test_ursim_serves_a_seeded_random_calibration", 0)
     cmd = [sys.executable, "-c", "from ruledrobot.cli import app; app()", "ursim",
            "--host", host, "--duration", "20", "--calibration", "random:7"]  # fmt: skip
-    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    proc = popen_as_from_a_terminal(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                                    text=True)  # stopped by SIGINT below
     try:
         assert proc.stdout is not None
         for line in proc.stdout:
