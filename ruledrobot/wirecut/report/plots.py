@@ -6,8 +6,8 @@ wire ends and the heat schedule (:mod:`.plot_heat`).
 
 Each time panel is one function ``panel(ax, plan)`` (:data:`TIME_PANELS`); a panel
 added to the tuple (or handed to :func:`plot_plan`) gets its own row; a
-:class:`ShownWhen` panel only when its rule holds for the plan.  The layout is
-matplotlib's constrained layout: no title or label is clipped.
+:class:`ShownWhen` panel only when its rule holds for the plan.  The layout has fixed
+margins (:data:`MARGINS`, in inches, so that they hold for any number of rows).
 """
 
 from __future__ import annotations
@@ -36,6 +36,11 @@ TimePanel = Callable[[Any, Plan], None]
 #: the picture's size [in] (its height grows by ``ROW_HEIGHT`` for every time panel past
 #: two) and resolution
 SIZE, ROW_HEIGHT, DPI = (15.0, 9.0), 4.0, 90
+#: the margins [in] round the panels, the gap [in] between two time panels (a title above,
+#: "t (s)" below) and the space between the 3-D and the time columns (a fraction of a
+#: column's width: the time panels' tick labels)
+MARGINS = {"left": 0.15, "right": 0.15, "top": 0.35, "bottom": 0.55, "gap": 0.75,
+           "wspace": 0.1}
 
 
 def _phase_bands(ax: Any, t: FloatArray, labels: np.ndarray) -> None:
@@ -126,10 +131,17 @@ def plan_figure(plan: Plan, part: Mesh | None = None, surface: Mesh | None = Non
 
     panels = [p for p in panels if _shown(p, plan)]
     rows = max(1, len(panels))
-    fig = Figure(figsize=(SIZE[0], SIZE[1] + ROW_HEIGHT * max(0, rows - 2)),
-                 layout="constrained")  # fmt: skip
+    height = SIZE[1] + ROW_HEIGHT * max(0, rows - 2)
+    fig = Figure(figsize=(SIZE[0], height))
     FigureCanvasAgg(fig)
-    grid = fig.add_gridspec(rows, 2, width_ratios=(1.0, 1.0))
+    # fixed margins in inches (room for the panels' titles, tick labels and "t (s)"): a
+    # layout engine measures every text first, a third of the picture's drawing time
+    top, bottom, gap = MARGINS["top"], MARGINS["bottom"], MARGINS["gap"]
+    axis_h = (height - top - bottom - gap * (rows - 1)) / rows
+    grid = fig.add_gridspec(rows, 2, width_ratios=(1.0, 1.0), left=MARGINS["left"] / SIZE[0],
+                            right=1.0 - MARGINS["right"] / SIZE[0], top=1.0 - top / height,
+                            bottom=bottom / height, wspace=MARGINS["wspace"],
+                            hspace=gap / axis_h)  # fmt: skip
     scene_panel(fig.add_subplot(grid[:, 0], projection="3d"), plan, part, surface)
     t = plan.motion.timed.t
     first = None
