@@ -134,8 +134,11 @@ def carve_figure(part: PartMesh, plan: CutPlan, carved, stock: Box,
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
-    fig = Figure(figsize=(14, 7), layout="constrained")
+    fig = Figure(figsize=(14, 7))
     FigureCanvasAgg(fig)
+    # fixed margins (room for the two-line title of the right panel): a layout engine
+    # measures every text first, a third of the drawing time
+    fig.subplots_adjust(left=0.0, right=0.96, bottom=0.08, top=0.92, wspace=0.08)
     colours = cut_colours(len(plan.cuts))
     ax1 = fig.add_subplot(1, 2, 1, projection="3d")
     _frame(ax1, stock, "the part, each face coloured by the cut that makes it, and the cuts' "
