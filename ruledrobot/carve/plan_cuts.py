@@ -114,33 +114,39 @@ def _robot_accepts(check: Callable[[CarveCut], str] | None, centre: FloatArray,
 
 def _fitted(part: PartMesh, regions: list[Region], tolerance: float,
             notes: list[str]) -> list[tuple[Region, Fit]]:  # fmt: skip
-    """Fit every region; one no ruled surface fits is split at the finer creases of
-    :data:`~.segment.CREASES` and replaced by its pieces when each piece fits (a plane or
-    a ruled quadric; :data:`~.segment.MAX_PIECES` at most), said in ``notes``.
-    ``regions`` holds the pieces (new indices) in place of the region split."""
+    """Every region with its fit.
+
+    A region no ruled surface fits is split at the finer creases of
+    :data:`~.segment.CREASES` and replaced by its pieces (new indices, after the last
+    region's) when each piece fits (a plane or a ruled quadric;
+    :data:`~.segment.MAX_PIECES` at most), said in ``notes``."""
     out: list[tuple[Region, Fit]] = []
-    for r in list(regions):
+    first = max((r.index for r in regions), default=-1) + 1
+    for r in regions:
         fit = fit_region(r, tolerance)
-        if fit.kind not in ("plane", "ruled") and len(r.faces) > 1:
-            for sharp in CREASES:
-                pieces = segment(part, sharp, r.faces,
-                                 first=max(x.index for x in regions) + 1)
-                if not 2 <= len(pieces) <= MAX_PIECES:
-                    continue
-                fits = [fit_region(p, tolerance) for p in pieces]
-                if all(f.kind in ("plane", "ruled") for f in fits):
-                    regions[:] = [x for x in regions if x is not r] + pieces
-                    notes.append(f"region {r.index} (no one surface fits it) is "
-                                 f"{len(pieces)} faces meeting at creases of "
-                                 f"{np.degrees(sharp):.3g} degrees or more: regions "
-                                 f"{pieces[0].index}-{pieces[-1].index}")  # fmt: skip
-                    out += list(zip(pieces, fits, strict=True))
-                    break
-            else:
-                out.append((r, fit))
-            continue
-        out.append((r, fit))
+        pieces = [] if fit.kind in ("plane", "ruled") else _pieces(part, r, tolerance, first)
+        if pieces:
+            first += len(pieces)
+            notes.append(f"region {r.index} (no one surface fits it) is {len(pieces)} faces "
+                         f"meeting at creases: regions {pieces[0][0].index}-"
+                         f"{pieces[-1][0].index}")  # fmt: skip
+        out += pieces or [(r, fit)]
     return out
+
+
+def _pieces(part: PartMesh, region: Region, tolerance: float,
+            first: int) -> list[tuple[Region, Fit]]:  # fmt: skip
+    """The pieces of ``region`` split at the first crease angle of :data:`~.segment.CREASES`
+    where each fits, with their fits; [] when none does."""
+    if len(region.faces) < 2:
+        return []
+    for sharp in CREASES:
+        pieces = segment(part, sharp, region.faces, first=first)
+        if 2 <= len(pieces) <= MAX_PIECES:
+            fits = [fit_region(p, tolerance) for p in pieces]
+            if all(f.kind in ("plane", "ruled") for f in fits):
+                return list(zip(pieces, fits, strict=True))
+    return []
 
 
 def find_cuts(part: PartMesh, stock: Box, query: MeshQuery, tolerance: float,
@@ -158,7 +164,9 @@ def find_cuts(part: PartMesh, stock: Box, query: MeshQuery, tolerance: float,
     refused: list[CarveCut] = []
     notes: list[str] = []
     progress(f"fitting {len(regions)} regions")
-    for r, fit in _fitted(part, regions, tolerance, notes):
+    fitted = _fitted(part, regions, tolerance, notes)
+    regions = [r for r, _ in fitted]
+    for r, fit in fitted:
         if fit.kind == "plane" and block_face(fit, stock, tolerance):
             faces[r.index] = "block face"
             continue
