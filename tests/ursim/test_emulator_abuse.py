@@ -269,9 +269,13 @@ def test_clients_that_do_not_read_cost_only_themselves(n: int, roomy: Emulator) 
     # VM's own noise, one reader and no slow client, reaches 16-48 ms gaps and a p99 of
     # 7.7 ms at times, so the test bounds what the fix guarantees, against the noise
     # measured just before: nothing near the 300-500 ms stalls of before, no more long
-    # gaps than the noise explains, p99 within 3 ms of the noise's.
+    # gaps than the noise explains, p99 within 3 ms of the noise's.  One gap of 101 ms
+    # happens in about one run in ten with 100 slow clients beside two busy processes
+    # (measured 6 Dec 2026: 3 of 30 runs, each 101.1-101.4 ms, when the slow clients'
+    # sockets are closed; with the clock not real-time, single gaps of 40-220 ms); it
+    # failed CI at the old 100 ms bound.  250 ms still tells the old stalls apart.
     noise = base["gaps_over_10ms"] * 2.0  # the baseline lasted half as long
-    assert stats["gap_max_ms"] < 100.0, (base, stats)
+    assert stats["gap_max_ms"] < 250.0, (base, stats)
     assert stats["gaps_over_10ms"] <= max(10.0, 3.0 * noise), (base, stats)
     assert stats["gap_p99_ms"] < min(10.0, max(5.0, base["gap_p99_ms"] + 3.0)), (base, stats)
     # while the slow clients' kernel buffers fill (a fraction of a second) every period
