@@ -212,25 +212,20 @@ def _touching(
     """(n,) the bow (rods and wire ``w`` (n, 4, 2, 3), ``hub`` (n, 2, 3)) touches a link
     other than the flange's or the base (:data:`BOW_ARM`), and (n,) the arm's capsules
     ``ends`` (n, S, 2, 3) touch each other or the base (:data:`ARM_ARM`), for a
-    ``self_collision`` cell.  Vectorised: a broad phase of bounding spheres (centre
-    distance less both half lengths, a lower bound of the axes' distance) and the exact
-    distance of the pairs it keeps."""
+    ``self_collision`` cell.  The compiled kernel
+    (:func:`ruledrobot.geometry._capsule_kernel.pairs_within`): a broad phase of bounding
+    spheres and the exact distance of the axes of the pairs it keeps."""
+    from ...geometry._capsule_kernel import pairs_within
+
     t = cell.touch
     n = len(ends)
     parts = [np.broadcast_to(t.base, (n, 1, 2, 3)), ends, w]
     if hub is not None:
         parts.append(hub[:, None])
-    E = np.concatenate(parts, axis=1)  # (n, C, 2, 3)
-    c = 0.5 * (E[:, :, 0] + E[:, :, 1])  # (n, C, 3)
-    d = c[:, t.I] - c[:, t.J]  # (n, P, 3)
-    gap = np.sqrt(np.einsum("npi,npi->np", d, d)) - t.half[t.I] - t.half[t.J]
-    k, p = np.nonzero(gap < t.reach)
-    hit = np.zeros((n, len(t.I)), dtype=bool)
-    if k.size:
-        ia, ib = t.I[p], t.J[p]
-        dist = segment_distance(E[k, ia, 0], E[k, ia, 1], E[k, ib, 0], E[k, ib, 1])
-        hit[k, p] = dist < t.reach[p]
-    return hit[:, t.bow].any(axis=1), hit[:, ~t.bow].any(axis=1)
+    E = np.ascontiguousarray(np.concatenate(parts, axis=1))  # (n, C, 2, 3)
+    out = np.zeros((n, 2), dtype=bool)
+    pairs_within(E, t.I, t.J, t.reach, t.half, t.bow, out)
+    return out[:, 1], out[:, 0]
 
 
 def clearance(cell: Cell, q: FloatArray, P: FloatArray) -> dict[str, np.ndarray]:
