@@ -27,11 +27,12 @@ demo: $(STAMP)
 ## cores (pytest-xdist; a module's tests on one worker, so its module fixtures are built
 ## once), then the real-time ones (emulator streams) apart from them, in three groups of
 ## whole modules: they mostly wait for the emulator's clock (their tolerances are sized
-## for a loaded 2-core machine; README, "Development").
+## for a loaded 2-core machine; README, "Development").  The longest modules are handed
+## out first (tests/conftest.py, LONGEST_FIRST; xdist's own order is by number of tests).
 test: $(STAMP)
 	$(BIN)/ruff check ruledrobot tests scripts
-	$(PYTEST) -q -n 2 --dist loadscope -m "not realtime"
-	$(PYTEST) -q -n 3 --dist loadfile -m realtime
+	$(PYTEST) -q -n 2 --dist loadscope --no-loadscope-reorder -m "not realtime"
+	$(PYTEST) -q -n 3 --dist loadfile --no-loadscope-reorder -m realtime
 
 ## The edit loop: ruff and the fast tests on both cores (no real-time streams, no slow
 ## tests: SLOW_MODULES and SLOW_TESTS in tests/conftest.py, chosen by measured

@@ -120,15 +120,44 @@ def pytest_ignore_collect(collection_path: Path, config: pytest.Config) -> bool 
     return None
 
 
+#: the modules that take longest (worker seconds, ``--durations``, 6 Dec 2026), longest
+#: first: ``make test`` hands whole modules to its workers in collection order
+#: (``--no-loadscope-reorder``; xdist's default order, by number of tests, handed the
+#: one-test modules of 20-35 s out last, and one worker ran them alone at the end)
+LONGEST_FIRST: tuple[str, ...] = (
+    # not real-time
+    "tests/place/test_place.py", "tests/view/test_browser.py",
+    "tests/carve/test_developables.py", "tests/carve/test_samples_made.py",
+    "tests/carve/test_carved_exact.py", "tests/wirecut/reach/test_reach_agree.py",
+    "tests/batch/test_cli.py", "tests/formats/test_formats_matrix.py",
+    "tests/batch/test_cluster.py", "tests/carve/test_demo_carve.py",
+    "tests/batch/test_place_dask.py", "tests/wirecut/test_killed_plan.py",
+    "tests/make/test_make_column.py", "tests/wirecut/motion/test_polyline_corners.py",
+    "tests/wirecut/test_parts.py", "tests/carve/test_tessellation.py",
+    "tests/carve/test_rough_and_input.py", "tests/carve/test_exact.py",
+    "tests/carve/test_cad_meshes.py", "tests/wirecut/motion/test_transit_ompl.py",
+    # real-time
+    "tests/export/test_path_programs.py", "tests/export/test_forward.py",
+    "tests/export/test_run_part.py", "tests/export/test_run_calibrated.py",
+    "tests/ursim/test_emulator_abuse.py", "tests/export/test_run_path.py",
+    "tests/export/test_runner.py", "tests/ursim/test_emulator_primary.py",
+    "tests/export/test_heat_corner_forward.py", "tests/ursim/test_client.py",
+)  # fmt: skip
+
+
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
     """Mark the real-time tests (:data:`REALTIME_DIRS`, :data:`REALTIME_TESTS`) and the slow
-    ones (:data:`SLOW_MODULES`, :data:`SLOW_TESTS`)."""
+    ones (:data:`SLOW_MODULES`, :data:`SLOW_TESTS`); put the modules of
+    :data:`LONGEST_FIRST` first, in its order (each module's tests stay together and in
+    their order)."""
     for item in items:
         nodeid = item.nodeid.replace("\\", "/")
         if nodeid.startswith(REALTIME_DIRS) or nodeid.split("[")[0] in REALTIME_TESTS:
             item.add_marker(pytest.mark.realtime)
         if nodeid.split("::")[0] in SLOW_MODULES or nodeid.split("[")[0] in SLOW_TESTS:
             item.add_marker(pytest.mark.slow)
+    rank = {m: k for k, m in enumerate(LONGEST_FIRST)}
+    items.sort(key=lambda it: rank.get(it.nodeid.replace("\\", "/").split("::")[0], len(rank)))
 
 
 def random_rotations(rng: np.random.Generator, n: int) -> np.ndarray:
