@@ -64,6 +64,7 @@ i.e. ``|det J| / (|a2 a3| (|a2| + |a3| + |d5|))``.
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 from typing import NamedTuple
 
@@ -115,6 +116,11 @@ class IKSolutions:
     elbow: FloatArray
     shoulder: FloatArray
     measure: FloatArray
+
+    def __getitem__(self, index: int | slice | tuple) -> IKSolutions:
+        """The solutions of the poses ``index`` picks on the batch axes (every field alike)."""
+        return dataclasses.replace(self, **{f.name: getattr(self, f.name)[index]
+                                            for f in dataclasses.fields(self)})  # fmt: skip
 
 
 def _atan2(y: FloatArray, x: FloatArray) -> FloatArray:

@@ -275,6 +275,7 @@ def path_ik(
     singular_tol: float = 0.05,
     weights: ArrayLike | None = None,
     max_messages: int = 20,
+    solutions: _ik.IKSolutions | None = None,
 ) -> PathIKResult:
     """One continuous joint solution per TCP pose of a path.
 
@@ -291,6 +292,9 @@ def path_ik(
         (|a2| + |a3| + |d5|)) at either end is below this.
     weights : (6,) per-joint weights of the squared joint distance (default 1).
     max_messages : at most this many lines in ``messages``.
+    solutions : the poses' IK (``model.ik(poses, return_info=True, check=False)``) when
+        the caller solved a batch of paths in one call (the wire-pose search's candidates:
+        one call for all of them is many times faster than one per path).
 
     Returns
     -------
@@ -315,7 +319,9 @@ def path_ik(
     max_messages = int(max_messages)
     lower, upper = model.lower, model.upper
 
-    sols = model.ik(T, return_info=True, check=False)
+    sols = model.ik(T, return_info=True, check=False) if solutions is None else solutions
+    if sols.q.shape[:1] != (N,):
+        raise ValueError(f"solutions: IK of {sols.q.shape[0]} poses for a path of {N}")
     Q, valid = sols.q, sols.valid
     Qz = np.where(valid[..., None], Q, 0.0)
     feas = valid & _representable(Qz, lower, upper).all(axis=-1)

@@ -255,14 +255,15 @@ def search_wire_pose(
         slides += [np.full(m, L + 0.1 * (H - L)), np.full(m, H - 0.1 * (H - L))]
 
     def scores_of(cands: list[tuple[float, bool, int]]) -> list[_Score]:
-        """Candidates (roll, reverse, slide option) scored on the sampled rulings: path IK
-        one candidate at a time, the clearance rules on all of them in one batch."""
-        poses, iks = [], []
-        for psi, reverse, k in cands:
-            P = flange_poses(wire_poses(F[idx], np.full(idx.size, psi), slides[k][idx], reverse),
-                             cell.W)  # fmt: skip
-            poses.append(P)
-            iks.append(path_ik(model, P, q_start=q_start, jump_threshold=jump_threshold * stride))
+        """Candidates (roll, reverse, slide option) scored on the sampled rulings: the IK
+        of every candidate's poses in one batch, path IK one candidate at a time, the
+        clearance rules on all of them in one batch."""
+        poses = [flange_poses(wire_poses(F[idx], np.full(idx.size, psi), slides[k][idx],
+                                         reverse), cell.W)
+                 for psi, reverse, k in cands]  # fmt: skip
+        sols = model.ik(np.stack(poses), return_info=True, check=False)  # (C, n, 8, ...)
+        iks = [path_ik(model, P, q_start=q_start, jump_threshold=jump_threshold * stride,
+                       solutions=sols[c]) for c, P in enumerate(poses)]  # fmt: skip
         # the clearance of a candidate counts only where its IK holds: those with none
         # (a cut out of reach) are left out of the batch, exactly
         live = [c for c, ik in enumerate(iks) if ik.ok.any()]
