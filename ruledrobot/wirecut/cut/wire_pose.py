@@ -377,8 +377,13 @@ def _ladder_roll(
     valid &= meas >= cell.singular_min
     if not valid.any(axis=(1, 2)).all():  # a sampled ruling with no node: no path (exact),
         return None  # and the clearance of every node (most of the time) is not needed
-    for bad in clearance(cell, q, np.broadcast_to(P[:, :, None], (n, k, 8, 4, 4))).values():
-        valid &= ~bad
+    # the clearance of the nodes still valid only (those with no IK, or near a
+    # singularity, are out either way)
+    at = np.nonzero(valid)
+    bad = np.zeros(at[0].size, dtype=bool)
+    for b in clearance(cell, q[at], P[at[:2]]).values():
+        bad |= b
+    valid[at] = ~bad
     qn = np.nan_to_num(q).reshape(n, k * 8, 6)
     node_ok = valid.reshape(n, k * 8)
     roll_of = np.repeat(grid, 8)
