@@ -128,11 +128,28 @@ class Box:
         hit = t_out > t_in
         return np.where(hit, t_in, np.nan), np.where(hit, t_out, np.nan), hit
 
-    def segment_hits(self, a: ArrayLike, b: ArrayLike, margin: float = 0.0) -> np.ndarray:
-        """Whether segments ``a -> b`` (..., 3) touch the box grown by ``margin``."""
+    def segment_hits(self, a: ArrayLike, b: ArrayLike, margin: ArrayLike = 0.0) -> np.ndarray:
+        """Whether segments ``a -> b`` (..., 3) touch the box grown by ``margin``.
+
+        ``margin`` [m]: a number, or one per segment as an array that broadcasts against
+        the points (..., 3) as in :meth:`clip_lines` (e.g. (S, 1) for segments (n, S, 3)).
+        The slab method of :meth:`clip_lines`, compiled
+        (:func:`ruledrobot.geometry._collide_kernel.segments_hit_box`); a point segment
+        touches when the point is inside (:meth:`contains`).
+        """
+        from ._collide_kernel import segments_hit_box
+
         a = np.asarray(a, dtype=np.float64)
-        d = np.asarray(b, dtype=np.float64) - a
-        degenerate = np.all(d == 0.0, axis=-1)
-        t_in, t_out, hit = self.clip_lines(a, np.where(degenerate[..., None], 1.0, d), margin)
-        seg = hit & (t_out >= 0.0) & (t_in <= 1.0)
-        return np.where(degenerate, self.contains(a, margin), seg)
+        b = np.asarray(b, dtype=np.float64)
+        points = np.broadcast_shapes(a.shape, b.shape)
+        shape = points[:-1]
+        n = int(np.prod(shape))
+        m = np.broadcast_to(np.asarray(margin, dtype=np.float64), points)[..., 0]
+        out = np.empty(n, dtype=bool)
+        segments_hit_box(
+            np.ascontiguousarray(np.broadcast_to(a, points).reshape(n, 3)),
+            np.ascontiguousarray(np.broadcast_to(b, points).reshape(n, 3)),
+            np.ascontiguousarray(m.reshape(n)),
+            self.centre, np.ascontiguousarray(self.rotation), 0.5 * self.size, out,
+        )  # fmt: skip
+        return out.reshape(shape)

@@ -213,9 +213,9 @@ def _touching(
     other than the flange's or the base (:data:`BOW_ARM`), and (n,) the arm's capsules
     ``ends`` (n, S, 2, 3) touch each other or the base (:data:`ARM_ARM`), for a
     ``self_collision`` cell.  The compiled kernel
-    (:func:`ruledrobot.geometry._capsule_kernel.pairs_within`): a broad phase of bounding
+    (:func:`ruledrobot.geometry._collide_kernel.pairs_within`): a broad phase of bounding
     spheres and the exact distance of the axes of the pairs it keeps."""
-    from ...geometry._capsule_kernel import pairs_within
+    from ...geometry._collide_kernel import pairs_within
 
     t = cell.touch
     n = len(ends)

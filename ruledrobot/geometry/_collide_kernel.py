@@ -1,4 +1,4 @@
-"""Compiled (numba) kernel: which pairs of capsules come nearer than their reach.
+"""Compiled (numba) kernels of the clearance rules: capsule pairs, segments and a box.
 
 :func:`pairs_within` answers, for each of ``n`` configurations, whether any pair of a
 group of capsule pairs is nearer than the pair's reach (the radii plus a margin): the
@@ -11,10 +11,15 @@ Ericson, *Real-Time Collision Detection*, 5.1.9), and a group stops at its first
 The numpy path built (n, P, 3) temporaries and took 6.6 ms a call on the carve tests'
 batches, a third of the robot check's time (measured, issue 34).
 
-Imported on the first use of :func:`ruledrobot.wirecut.cut.clearance.clearance` in a
-``self_collision`` cell (``import ruledrobot`` does not load numba); compiled once and
+:func:`segments_hit_box` is :meth:`ruledrobot.geometry.box.Box.segment_hits` (the slab
+method of :meth:`~ruledrobot.geometry.box.Box.clip_lines`, one segment at a time): 18
+times faster than the numpy path's temporaries on the clearance's batches (54,000
+segments: 0.9 ms against 16.7 ms, measured).
+
+Imported on first use (``import ruledrobot`` does not load numba); compiled once and
 cached next to this file (``cache=True``).  It imports nothing of the project so that
-numba's cache stays valid.  No ``fastmath``.
+numba's cache stays valid.  No ``fastmath``.  ``tests/geometry/test_collide_kernel.py``
+holds each kernel to its numpy formula.
 """
 
 from __future__ import annotations
@@ -30,6 +35,7 @@ _F8_4D = types.Array(types.float64, 4, "C", readonly=True)
 _F8_1D = types.Array(types.float64, 1, "C", readonly=True)
 _I8_1D = types.Array(types.int64, 1, "C", readonly=True)
 _B_1D = types.Array(types.boolean, 1, "C", readonly=True)
+_F8_2D = types.Array(types.float64, 2, "C", readonly=True)
 
 
 @nb.njit(cache=True, nogil=True, error_model="numpy")
@@ -93,3 +99,44 @@ def pairs_within(E, I, J, reach, half, group, out):  # pragma: no cover - compil
                 continue
             if segment_distance(a[0], a[1], b[0], b[1]) < reach[k]:
                 out[i, g] = True
+
+
+@nb.njit(
+    types.void(_F8_2D, _F8_2D, _F8_1D, _F8_1D, _F8_2D, _F8_1D, types.boolean[::1]),
+    cache=True, nogil=True, error_model="numpy",
+)
+def segments_hit_box(a, b, margin, centre, R, half, out):  # pragma: no cover - compiled
+    """Set ``out[i]``: segment ``a[i] -> b[i]`` (N, 3) touches the box grown by ``margin[i]``.
+
+    The box: ``centre`` (3,), axes the columns of ``R`` (3, 3), half edge lengths
+    ``half`` (3,) [m].  The slab method in box coordinates (``p = (a - centre) R``,
+    ``d = (b - a) R``): the line meets slab ``k`` for ``t`` between ``(+-h_k - p_k) / d_k``,
+    everywhere or nowhere when ``|d_k| <= 1e-15``; the segment touches when the chord
+    ``t_in < t_out`` meets ``[0, 1]``.  A point segment: whether the point is inside.
+    """
+    for i in range(a.shape[0]):
+        a0, a1, a2 = a[i, 0] - centre[0], a[i, 1] - centre[1], a[i, 2] - centre[2]
+        e0, e1, e2 = b[i, 0] - a[i, 0], b[i, 1] - a[i, 1], b[i, 2] - a[i, 2]
+        point = e0 == 0.0 and e1 == 0.0 and e2 == 0.0
+        t_in, t_out = -math.inf, math.inf
+        inside = True
+        for k in range(3):
+            p = a0 * R[0, k] + a1 * R[1, k] + a2 * R[2, k]
+            h = half[k] + margin[i]
+            if abs(p) > h:
+                inside = False
+            if point:
+                continue
+            d = e0 * R[0, k] + e1 * R[1, k] + e2 * R[2, k]
+            if abs(d) <= 1e-15:
+                if abs(p) > h:
+                    t_in, t_out = math.inf, -math.inf
+            else:
+                t1 = (-h - p) / d
+                t2 = (h - p) / d
+                t_in = max(t_in, min(t1, t2))
+                t_out = min(t_out, max(t1, t2))
+        if point:
+            out[i] = inside
+        else:
+            out[i] = t_out > t_in and t_out >= 0.0 and t_in <= 1.0

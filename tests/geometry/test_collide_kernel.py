@@ -1,6 +1,6 @@
-"""The compiled capsule-pair kernel against the numpy segment distance (its oracle).
+"""The compiled clearance kernels against their numpy formulas (the oracles).
 
-:func:`ruledrobot.geometry._capsule_kernel.pairs_within` decides, per configuration and
+:func:`ruledrobot.geometry._collide_kernel.pairs_within` decides, per configuration and
 group, whether a pair of capsules is nearer than its reach; the oracle computes every
 pair's distance with :func:`ruledrobot.geometry.segments.segment_distance` (tested
 against dense sampling in test_segments.py) and no broad phase.
@@ -12,8 +12,10 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from ruledrobot.geometry._capsule_kernel import pairs_within, segment_distance
+from ruledrobot.geometry._collide_kernel import pairs_within, segment_distance
+from ruledrobot.geometry.box import Box
 from ruledrobot.geometry.segments import segment_distance as segment_distance_numpy
+from tests.conftest import random_rotations
 
 
 def _segments(rng: np.random.Generator, n: int) -> np.ndarray:
@@ -60,3 +62,28 @@ def test_pairs_within_is_the_brute_force_answer(seed: int, n: int, C: int, scale
     hit = dist < reach
     want = np.stack([hit[:, ~group].any(axis=1), hit[:, group].any(axis=1)], axis=1)
     np.testing.assert_array_equal(out, want)
+
+
+def _segment_hits_numpy(box: Box, a: np.ndarray, b: np.ndarray, margin) -> np.ndarray:
+    """The numpy formula: :meth:`Box.clip_lines`' chord met by [0, 1], or the point inside."""
+    d = b - a
+    point = np.all(d == 0.0, axis=-1)
+    t_in, t_out, hit = box.clip_lines(a, np.where(point[..., None], 1.0, d), margin)
+    return np.where(point, box.contains(a, margin), hit & (t_out >= 0.0) & (t_in <= 1.0))
+
+
+@settings(max_examples=40, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), n=st.integers(1, 40), S=st.integers(1, 6))
+def test_segment_hits_is_the_slab_formula(seed: int, n: int, S: int):
+    rng = np.random.default_rng(seed)
+    box = Box(rng.normal(size=3) * 0.1, rng.uniform(0.05, 0.3, size=3),
+              random_rotations(rng, 1)[0])  # fmt: skip
+    a = box.centre + rng.normal(size=(n, S, 3)) * 0.2
+    b = a + rng.normal(size=(n, S, 3)) * 0.2
+    b[:, 0] = a[:, 0]  # point segments
+    b[: n // 2, -1] = a[: n // 2, -1] + np.array([0.3, 0.0, 0.0]) @ box.rotation.T  # along an axis
+    margin = rng.uniform(-0.01, 0.02, size=(S, 1))
+    np.testing.assert_array_equal(box.segment_hits(a, b, margin),
+                                  _segment_hits_numpy(box, a, b, margin))  # fmt: skip
+    np.testing.assert_array_equal(box.segment_hits(a, b, 0.01),
+                                  _segment_hits_numpy(box, a, b, 0.01))  # fmt: skip
