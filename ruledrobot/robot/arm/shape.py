@@ -179,8 +179,12 @@ def arm_capsules(
     segs, _ = link_segments(model.nominal)
     B = body_frames(model, q.reshape(-1, model.n_joints))  # (n, J, 4, 4)
     body = np.array([k for k, ss in enumerate(segs) for _ in ss], dtype=np.intp)
-    local = np.array([[sg.a, sg.b] for ss in segs for sg in ss], dtype=np.float64)  # (S, 2, 3)
     radius = np.array([sg.radius for ss in segs for sg in ss], dtype=np.float64)
-    Bb = B[:, body]  # (n, S, 4, 4)
-    ends = transform_points(Bb, local)  # (n, S, 2, 3)
+    ends = np.empty((len(B), len(body), 2, 3))
+    i = 0
+    for k, ss in enumerate(segs):  # a body's segments in its frame (no (n, S, 4, 4) gather)
+        if ss:
+            local = np.array([[sg.a, sg.b] for sg in ss], dtype=np.float64)  # (S_k, 2, 3)
+            ends[:, i : i + len(ss)] = transform_points(B[:, k, None], local)
+            i += len(ss)
     return ends.reshape(*shape, len(body), 2, 3), radius, body
