@@ -75,12 +75,8 @@ def cut(tmp_path_factory: pytest.TempPathFactory) -> Trajectory:
     names = {p.name: p for p in traj.meta.phases}
     k0 = names["preheat"].start
     assert traj.meta.heat.windows == ((k0, traj.n),), traj.meta.heat
-    part = traj.sliced(k0)
-    # Trajectory.sliced carries the phases, in_stock and the cut over to the slice, not
-    # the heat windows (they stay in the whole plan's samples): shifted here
-    heat = dataclasses.replace(traj.meta.heat, windows=((0, part.n),))
-    part = Trajectory(part.t, part.q, part.tcp, part.meta.replace(heat=heat))
-    assert part.meta.cut is not None
+    part = traj.sliced(k0)  # the phases, in_stock, the cut and the heat renumbered
+    assert part.meta.cut is not None and part.meta.heat.windows == ((0, part.n),)
     return part
 
 
