@@ -33,8 +33,8 @@ def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
 
 @pytest.fixture(scope="session")
 def fast_demo(tmp_path_factory: pytest.TempPathFactory) -> Trajectory:
-    """The demo planned at 25 mm/s, with what it cuts (``meta.cut``): test_run_path refuses
-    its path program at coarse tolerances (the narrowed demo's passes them)."""
+    """The demo planned at 25 mm/s, with what it cuts (``meta.cut``): streamed in real time
+    by test_run_path (13.5 s of motion)."""
     job = tmp_path_factory.mktemp("fast_demo") / "job.toml"
     assert FAST_DEMO_JOB.count("feed_speed = 0.025 ") == 1
     job.write_text(FAST_DEMO_JOB)
@@ -47,8 +47,7 @@ def fast_demo(tmp_path_factory: pytest.TempPathFactory) -> Trajectory:
 def short_demo(tmp_path_factory: pytest.TempPathFactory) -> Trajectory:
     """The narrowed demo at 25 mm/s (:data:`SHORT_DEMO_JOB`), with what it cuts: streamed
     in real time by test_path_programs (its cut, lead-in to lead-out: 4.7 s of motion
-    instead of the fast demo's 9.7 s) and test_run_path (the whole plan: 9.1 s instead of
-    13.5 s)."""
+    instead of the fast demo's 9.7 s)."""
     job = tmp_path_factory.mktemp("short_demo") / "job.toml"
     assert SHORT_DEMO_JOB.count("u = [-0.06, 0.06]") == 1
     assert SHORT_DEMO_JOB.count("size = [0.08, 0.2, 0.15]") == 1
