@@ -39,19 +39,20 @@ from ruledrobot.export.run_verdict import align_recording, measure_run
 from ruledrobot.robot import model_for
 from ruledrobot.robot.motion.trajectory import Trajectory
 from ruledrobot.ursim import Emulator, embedded_emulator
-from ruledrobot.wirecut.job.demo import DEMO_JOB
 from ruledrobot.wirecut.job.load import load_job
 from ruledrobot.wirecut.planner import plan
 from tests.support.emulators import start_emulator
 from tests.support.rawclient import RawRTDEClient
 
+from .conftest import SHORT_DEMO_JOB
+
 pytest.importorskip("rtde_control")
 
-#: the demo job at 25 mm/s (its own 10 mm/s is planned and verified in tests/wirecut),
-#: its wire's heat on standard digital output 0 with a 0.2 s pre-heat
-FAST_HOT_DEMO_JOB = (DEMO_JOB.replace("feed_speed = 0.01 ", "feed_speed = 0.025 ")
-                     .replace("mass = 1.0\n", 'mass = 1.0\nheat = { output = "standard:0", '
-                              'preheat = 0.2 }\n'))  # fmt: skip
+#: the narrowed demo at 25 mm/s (SHORT_DEMO_JOB, tests/export/conftest.py: the demo's
+#: surface 12 cm wide through a block 8 cm wide; its own 10 mm/s is planned and verified
+#: in tests/wirecut), its wire's heat on standard digital output 0 with a 0.2 s pre-heat
+FAST_HOT_DEMO_JOB = SHORT_DEMO_JOB.replace("mass = 1.0\n", 'mass = 1.0\nheat = { output = '
+                                           '"standard:0", preheat = 0.2 }\n')  # fmt: skip
 #: the recorded feed in the block against the set feed (the issue's bound)
 FEED_BOUND = 0.02
 #: the wire's largest distance from the planned wire through a controlled stop [m]
@@ -63,8 +64,8 @@ HEAT_OFF_BOUND = 0.1
 @pytest.fixture(scope="module")
 def cut(tmp_path_factory: pytest.TempPathFactory) -> Trajectory:
     """The fast demo from the start of its pre-heat to its end (the approach left out: the
-    emulator's arm starts where the pre-heat does): 0.2 s pre-heat, lead-in, 8.3 s in the
-    block at 25 mm/s, lead-out; 10 s of motion, the heat on throughout."""
+    emulator's arm starts where the pre-heat does): 0.2 s pre-heat, lead-in, 3.3 s in the
+    block at 25 mm/s, lead-out; 4.9 s of motion, the heat on throughout."""
     folder = tmp_path_factory.mktemp("forward_demo")
     job = folder / "job.toml"
     assert FAST_HOT_DEMO_JOB.count("heat = {") == 1
@@ -74,12 +75,8 @@ def cut(tmp_path_factory: pytest.TempPathFactory) -> Trajectory:
     names = {p.name: p for p in traj.meta.phases}
     k0 = names["preheat"].start
     assert traj.meta.heat.windows == ((k0, traj.n),), traj.meta.heat
-    part = traj.sliced(k0)
-    # Trajectory.sliced carries the phases, in_stock and the cut over to the slice, not
-    # the heat windows (they stay in the whole plan's samples): shifted here
-    heat = dataclasses.replace(traj.meta.heat, windows=((0, part.n),))
-    part = Trajectory(part.t, part.q, part.tcp, part.meta.replace(heat=heat))
-    assert part.meta.cut is not None
+    part = traj.sliced(k0)  # the phases, in_stock, the cut and the heat renumbered
+    assert part.meta.cut is not None and part.meta.heat.windows == ((0, part.n),)
     return part
 
 

@@ -187,13 +187,14 @@ def _record(host: str, emu, program: str, timeout: float) -> tuple[np.ndarray, n
 
 
 @pytest.mark.parametrize("mode", ["servoj", "movel", "movep"])
-def test_each_mode_cuts_at_the_plans_feed_on_the_emulator(fast_demo: Trajectory, mode: str,
+def test_each_mode_cuts_at_the_plans_feed_on_the_emulator(short_demo: Trajectory, mode: str,
                                                           request) -> None:  # fmt: skip
-    """The demo's cut (lead-in to lead-out) exported in each mode, run by the emulator
+    """The demo's cut (lead-in to lead-out; the narrowed demo at 25 mm/s, 4.7 s of motion:
+    ``short_demo`` in tests/export/conftest.py) exported in each mode, run by the emulator
     from its script port; the joints it recorded, through the one model of the wire
     against the block: the feed within the plan's tolerance, the wire on the plan's."""
-    names = {p.name: p for p in fast_demo.meta.phases}
-    cut = fast_demo.sliced(names["lead_in"].start, names["lead_out"].stop)
+    names = {p.name: p for p in short_demo.meta.phases}
+    cut = short_demo.sliced(names["lead_in"].start, names["lead_out"].stop)
     program = urscript_program(cut, mode=mode)
     emu = start_emulator(request.node.nodeid, model="ur5e", q0=cut.q[0])
     try:
