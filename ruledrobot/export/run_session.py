@@ -122,6 +122,10 @@ class Session:
         self.recording = False
         self._buf: list[tuple[float, list[float], list[float], int, list[float]]] = []
         self._fresh = False  # the last recorded sample awaits its deviation match
+        #: output int registers read with each snapshot, from its data package
+        #: (:meth:`snapshot`); ``registers`` holds their values of the last one
+        self.watch_registers: tuple[int, ...] = ()
+        self.registers: dict[int, int] = {}
         self._last_ts = -math.inf
         self._ts0: float | None = None
         self._last_flush = 0.0
@@ -251,15 +255,21 @@ class Session:
 
         Outputs: the digital output bits and the two standard analog outputs, where the wire's
         heat is switched.  ur_rtde's getters each read the newest package, so a package arriving
-        between them would mix two; the timestamp read again tells."""
+        between them would mix two; the timestamp read again tells.  The output int registers
+        of :attr:`watch_registers` are read in the same package, into :attr:`registers` (a
+        forwarded run's sample playing: read apart from the joints, while ur_rtde's receive
+        thread caught up on a backlog, it was up to 0.1 s newer than them)."""
         r = self.r
+        regs: dict[int, int] = {}
         for _ in range(4):
             ts = r.getTimestamp()
             q, tcp = r.getActualQ(), r.getActualTCPPose()
             outs = [float(r.getActualDigitalOutputBits()), float(r.getStandardAnalogOutput0()),
                     float(r.getStandardAnalogOutput1())]  # fmt: skip
+            regs = {i: int(r.getOutputIntRegister(i)) for i in self.watch_registers}
             if r.getTimestamp() == ts:
                 break
+        self.registers = regs
         return ts, q, tcp, outs
 
     def info(self) -> dict:

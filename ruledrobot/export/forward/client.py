@@ -107,6 +107,7 @@ def _play(s: Session, conn: socket.socket, q_grid: np.ndarray, hot: np.ndarray |
     s.max_latency = max(s.max_latency, settings.buffer)
     s.start_recording()
     s.start_clock()
+    s.watch_registers = (REG_SAMPLE,)  # the sample playing, from the joints' own package
     stop: Stop | None = None
     dt = 1.0 / s.frequency
     while True:
@@ -116,8 +117,11 @@ def _play(s: Session, conn: socket.socket, q_grid: np.ndarray, hot: np.ndarray |
             break
         try:
             qa = s.poll()
-            s.check_deviation(q_grid, qa, max(playing, 0), timed=playing >= 0,
-                              anchored=playing >= 0)
+            # the deviation match anchored at the sample the controller played when it
+            # measured qa (read apart, the two came from packages up to 0.1 s apart after
+            # a stall of this process, and the match was put that far ahead of the arm)
+            at = s.registers[REG_SAMPLE]
+            s.check_deviation(q_grid, qa, max(at, 0), timed=at >= 0, anchored=at >= 0)
             s.service()
         except Stop as st:
             if st.status == "program_stopped" and int(r.getOutputIntRegister(REG_STATE)) in (
