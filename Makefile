@@ -11,12 +11,10 @@ PYTEST := PYTHONDONTWRITEBYTECODE= $(BIN)/pytest
 
 .PHONY: setup demo test test-fast lint bench clean
 
-# --no-compile: pip compiled every installed module (15 of the install's 35 s here); the
-# modules a run imports are compiled by that run and kept (bytecode written, see PYTEST)
 $(STAMP): pyproject.toml
 	$(PY) -m venv $(VENV)
 	$(BIN)/pip install --quiet --upgrade pip
-	$(BIN)/pip install --quiet --no-compile -e '.[test]'
+	$(BIN)/pip install --quiet -e '.[test]'
 	touch $(STAMP)
 
 setup: $(STAMP)
