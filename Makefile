@@ -11,10 +11,16 @@ PYTEST := PYTHONDONTWRITEBYTECODE= $(BIN)/pytest
 
 .PHONY: setup demo test test-fast lint bench clean
 
+# uv (from PyPI, into the venv) installs the package and its dependencies: it downloads
+# and compiles in parallel (a fresh venv here: 26 s against pip's 41 s, bytecode compiled
+# either way; without it a test run's workers compile what they import, and the first
+# stage took 10-24 s longer)
+UV := $(BIN)/uv pip install --python $(BIN)/python --quiet --compile-bytecode
+
 $(STAMP): pyproject.toml
 	$(PY) -m venv $(VENV)
-	$(BIN)/pip install --quiet --upgrade pip
-	$(BIN)/pip install --quiet -e '.[test]'
+	$(BIN)/pip install --quiet uv
+	$(UV) -e '.[test]'
 	touch $(STAMP)
 
 setup: $(STAMP)
@@ -45,7 +51,7 @@ lint: $(STAMP)
 	$(BIN)/ruff check ruledrobot tests scripts
 
 bench: $(STAMP)
-	$(BIN)/pip install --quiet -e '.[test,bench]'
+	$(UV) -e '.[test,bench]'
 	$(BIN)/python scripts/bench_geometry.py
 
 clean:
