@@ -373,9 +373,11 @@ def test_truncated_and_closing_primary_clients_do_not_disturb_rtde(
     # missed controller periods: the same bound as the rate above (measured 0-3.3 % while
     # hostile clients connect and close hundreds of times a second on 2 cores)
     assert stats["primary_errors"] == 0 and stats["missed_fraction"] < 0.05, stats
-    # the well-behaved primary client kept its (dense) stream (the first gap is the old
-    # 100 ms period the publisher was waiting out when the test changed it)
-    gaps = np.diff([t for t, _ in good.states()][2:])
+    # the well-behaved primary client kept its (dense) stream while the attackers ran
+    # (measured from their start: before it, the publisher waits out its old 100 ms
+    # period once after the test changed it, and on a busy machine the reader's first
+    # states can come late enough that this gap was the third, not the first)
+    gaps = np.diff([t for t, _ in good.states() if t >= t0])
     assert len(gaps) > 500 and float(gaps.max()) < 0.05, float(gaps.max())
     # the clients that never read were dropped while the test ran; now all are gone
     assert stats["primary_dropped"] >= 1, stats
