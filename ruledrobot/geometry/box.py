@@ -97,6 +97,30 @@ class Box:
         """World points (..., 3) in box coordinates."""
         return (np.asarray(points, dtype=np.float64) - self.centre) @ self.rotation
 
+    def signed_distance(self, points: ArrayLike) -> FloatArray:
+        """Signed distance [m] of world points (N, 3) to the box's surface (N,): negative inside.
+
+        ``|max(q, 0)| + min(max_k q_k, 0)`` with ``q = |p_box| - size / 2`` (the exact
+        distance of an axis-aligned box, Quilez), one box axis at a time over the points'
+        columns: no (N, 3) temporaries (5e6 points in 0.2-0.3 s against 0.5-1.5 s)."""
+        cols = np.asarray(points, dtype=np.float64).T  # (3, N), a view
+        c, R, half = self.centre, self.rotation, 0.5 * self.size
+        outside = np.zeros(cols.shape[1])
+        inside = np.full(cols.shape[1], -np.inf)
+        for k in range(3):
+            qk = (cols[0] - c[0]) * R[0, k]
+            qk += (cols[1] - c[1]) * R[1, k]
+            qk += (cols[2] - c[2]) * R[2, k]
+            np.abs(qk, out=qk)
+            qk -= half[k]
+            np.maximum(inside, qk, out=inside)
+            np.maximum(qk, 0.0, out=qk)
+            qk *= qk
+            outside += qk
+        np.sqrt(outside, out=outside)
+        np.minimum(inside, 0.0, out=inside)
+        return outside + inside
+
     def contains(self, points: ArrayLike, margin: float = 0.0) -> np.ndarray:
         """Whether points (..., 3) lie inside the box grown by ``margin`` (m) on every side."""
         return np.all(np.abs(self.to_box(points)) <= 0.5 * self.size + margin, axis=-1)

@@ -1,5 +1,6 @@
 """Box.corners and Box.edges: the one home of a block's corners (plots, transits,
-placement, scene); Box.moved and Box.grown: a block placed elsewhere, grown by a margin."""
+placement, scene); Box.moved and Box.grown: a block placed elsewhere, grown by a margin;
+Box.signed_distance: the part mesh's distance to the block."""
 
 from __future__ import annotations
 
@@ -70,3 +71,24 @@ def test_a_box_shrunk_away_or_moved_by_a_non_pose_is_refused():
         box.grown(-0.1)
     with pytest.raises(ValueError, match=r"T: expected a pose"):
         box.moved(np.eye(3))
+
+
+@settings(max_examples=60, deadline=None)
+@given(c=st.tuples(*[st.floats(-1.0, 1.0)] * 3), s=st.tuples(*[st.floats(0.01, 0.5)] * 3),
+       rv=st.tuples(*[st.floats(-3.0, 3.0)] * 3), seed=st.integers(0, 2**31))  # fmt: skip
+def test_the_signed_distance_is_the_nearest_point_of_the_box(c, s, rv, seed):
+    """Outside: the distance to the nearest point of the solid box (box coordinates clipped
+    to its half sizes); inside: minus the distance to the nearest face.  Points near the
+    faces, edges and corners as well as far ones."""
+    box = Box(np.array(c), np.array(s), pose_from_rotvec(np.array(rv), np.zeros(3))[:3, :3])
+    rng = np.random.default_rng(seed)
+    local = rng.uniform(-1.0, 1.0, (400, 3)) * box.size
+    local[:100] = np.clip(local[:100], -0.5 * box.size, 0.5 * box.size)  # on the surface
+    local[100:200] *= 0.5  # near it
+    world = local @ box.rotation.T + box.centre
+    half = 0.5 * box.size
+    nearest = np.clip(local, -half, half)
+    outside = np.linalg.norm(local - nearest, axis=1)
+    inside = (half - np.abs(local)).min(axis=1)
+    truth = np.where(outside > 0.0, outside, -inside)
+    np.testing.assert_allclose(box.signed_distance(world), truth, atol=1e-12)

@@ -220,10 +220,7 @@ def part_sdf(job: Job, passes: tuple[CutPath, ...], world: FloatArray,
     within ``band`` of a cut.
     """
     stock = job.stock
-    local = stock.to_box(world)
-    q = np.abs(local) - 0.5 * stock.size
-    out = np.linalg.norm(np.maximum(q, 0.0), axis=1) + np.minimum(q.max(axis=1), 0.0)
-    out = out.reshape(shape)
+    out = stock.signed_distance(world).reshape(shape)
     domain = out <= 0.0
     step = _grid_step(world, shape)
     for cut in job.cuts:
@@ -279,9 +276,13 @@ def stock_mesh(stock: Box, resolution: float, sdf: GridSDF) -> Mesh | None:
     h = max(resolution, float(np.prod(stock.size + 4 * resolution) / MAX_POINTS) ** (1 / 3))
     counts = np.ceil((stock.size + 4.0 * h) / h).astype(int) + 1
     axes = [(np.arange(c) - (c - 1) / 2.0) * h for c in counts]
-    X, Y, Z = np.meshgrid(*axes, indexing="ij")
-    local = np.stack([X, Y, Z], axis=-1).reshape(-1, 3)
-    world = local @ stock.rotation.T + stock.centre
+    R = stock.rotation  # world = centre + x R[:, 0] + y R[:, 1] + z R[:, 2], by broadcasting
+    world = np.empty((*counts, 3))
+    world[...] = stock.centre
+    world += axes[0][:, None, None, None] * R[:, 0]
+    world += axes[1][None, :, None, None] * R[:, 1]
+    world += axes[2][None, None, :, None] * R[:, 2]
+    world = world.reshape(-1, 3)
     f = _off_grid_points(sdf(world, tuple(counts), h), h)
     if f.min() >= 0.0:
         return None
