@@ -23,6 +23,8 @@ FLAGS = [
     "--disable-component-update", "--disable-sync",
 ]  # fmt: skip
 VIEWPORT = {"width": 1000, "height": 640}
+#: seconds between looks at the canvas while waiting for it to draw or change
+POLL = 0.3
 
 
 @pytest.fixture(scope="module")
@@ -73,7 +75,7 @@ class Page:
         """The canvas once it shows a scene: many colours, not one flat fill."""
         end = time.monotonic() + timeout
         while True:
-            time.sleep(1.0)
+            time.sleep(POLL)
             img = self.canvas()
             colours = np.unique(img.reshape(-1, 3) // 8, axis=0).shape[0]
             if (img.std() > 20 and colours > 100) or time.monotonic() > end:
@@ -82,7 +84,7 @@ class Page:
     def wait_changed(self, before: np.ndarray, timeout: float = 20.0) -> np.ndarray:
         end = time.monotonic() + timeout
         while True:
-            time.sleep(1.0)
+            time.sleep(POLL)
             img = self.canvas()
             if _changed(before, img) > 0.01 or time.monotonic() > end:
                 return img
