@@ -35,6 +35,7 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+from collections.abc import Collection
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -49,7 +50,8 @@ from ...robot.tool import BowTool
 from ..job.spec import ToolSpec
 
 __all__ = ["ARM_ARM", "ARM_STOCK", "ARM_TABLE", "BOW_ARM", "BOW_STOCK", "BOW_TABLE", "MARGIN",
-           "RULES", "SINGULAR_MIN", "Cell", "base_capsule", "clearance", "self_pairs"]
+           "RULES", "SINGULAR_MIN", "Cell", "Posed", "base_capsule", "broken", "clearance",
+           "self_pairs"]
 
 #: the planner's thresholds, one home for the wire-pose search (:mod:`.wire_pose`), the
 #: transits, the reach map's rules (:class:`ruledrobot.wirecut.reach.margins.Rules`) and
@@ -171,15 +173,16 @@ class _Touch:
     """The capsule pairs of a ``self_collision`` cell, built once per cell.
 
     The capsules are stacked as the base, the arm's ``S`` (:func:`arm_capsules`) and the
-    tool's (rods, wire, hub); ``I``, ``J`` (P,) index pairs of them, ``reach`` (P,) [m]
-    the distance their axes must keep (radii plus the margin), ``bow`` (P,) the pairs of
+    tool's (rods, wire, hub); ``I``, ``J`` (P,) index pairs of them, ``radii`` (P,) [m]
+    the sum of their radii (the distance their axes must keep, less the margin: the touch
+    holds at any margin), ``bow`` (P,) the pairs of
     the bow with a link (the others: the arm with itself), ``half`` (C,) [m] each rigid
     capsule's half length (a bound for the broad phase)."""
 
     base: FloatArray  # (2, 3) the base's axis, robot base frame
     I: np.ndarray
     J: np.ndarray
-    reach: FloatArray
+    radii: FloatArray
     bow: np.ndarray
     half: FloatArray
 
@@ -203,16 +206,16 @@ def _touch_pairs(cell: Cell) -> _Touch:
     I, Jp = np.r_[a, ta], np.r_[b, tb]
     bow = np.r_[np.zeros(len(a), bool), np.ones(len(ta), bool)]
     half = 0.5 * np.linalg.norm(segs[:, 1] - segs[:, 0], axis=1)
-    return _Touch(axis, I, Jp, r[I] + r[Jp] + cell.margin, bow, half)
+    return _Touch(axis, I, Jp, r[I] + r[Jp], bow, half)
 
 
 def _touching(
-    cell: Cell, w: FloatArray, hub: FloatArray | None, ends: FloatArray
+    cell: Cell, margin: float, w: FloatArray, hub: FloatArray | None, ends: FloatArray
 ) -> tuple[np.ndarray, np.ndarray]:
-    """(n,) the bow (rods and wire ``w`` (n, 4, 2, 3), ``hub`` (n, 2, 3)) touches a link
-    other than the flange's or the base (:data:`BOW_ARM`), and (n,) the arm's capsules
-    ``ends`` (n, S, 2, 3) touch each other or the base (:data:`ARM_ARM`), for a
-    ``self_collision`` cell.  The compiled kernel
+    """At ``margin`` [m]: (n,) the bow (rods and wire ``w`` (n, 4, 2, 3), ``hub`` (n, 2,
+    3)) touches a link other than the flange's or the base (:data:`BOW_ARM`), and (n,) the
+    arm's capsules ``ends`` (n, S, 2, 3) touch each other or the base (:data:`ARM_ARM`),
+    for a ``self_collision`` cell.  The compiled kernel
     (:func:`ruledrobot.geometry._collide_kernel.pairs_within`): a broad phase of bounding
     spheres and the exact distance of the axes of the pairs it keeps."""
     from ...geometry._collide_kernel import pairs_within
@@ -224,54 +227,108 @@ def _touching(
         parts.append(hub[:, None])
     E = np.ascontiguousarray(np.concatenate(parts, axis=1))  # (n, C, 2, 3)
     out = np.zeros((n, 2), dtype=bool)
-    pairs_within(E, t.I, t.J, t.reach, t.half, t.bow, out)
+    pairs_within(E, t.I, t.J, t.radii + margin, t.half, t.bow, out)
     return out[:, 1], out[:, 0]
+
+
+@dataclass(frozen=True, eq=False)
+class Posed:
+    """The cell's bodies at ``n`` configurations: what the clearance rules measure.
+
+    Everything the rules read that a margin or a stock does not change — the forward
+    kinematics of the arm's capsules and the bow carried by the flange poses — computed
+    once (:meth:`of`) and judged at any margin and stock by :func:`broken` (the reach
+    map's margin ladder, :func:`ruledrobot.wirecut.reach.margins.clearance_margins`, judges
+    one batch at several levels).  Indexing (``posed[idx]``, an index or mask array over
+    the configurations) takes a subset.  Robot base frame, metres.
+    """
+
+    w: FloatArray  # (n, 4, 2, 3) the bow's three rods and the wire (the last)
+    hub: FloatArray | None  # (n, 2, 3) the hub's axis; None: a cell with no hub
+    ends: FloatArray  # (n, S, 2, 3) the arm's capsules' axes (arm_capsules)
+    radius: FloatArray  # (S,) their radii [m]
+    body: np.ndarray  # (S,) the link body of each (0: the column over the base)
+
+    @classmethod
+    def of(cls, cell: Cell, q: FloatArray, P: FloatArray) -> Posed:
+        """The bodies of ``cell`` at joints ``q`` (..., 6) (NaN read as 0) with flange poses
+        ``P`` (..., 4, 4), flattened to ``n`` configurations."""
+        qf = np.nan_to_num(q.reshape(-1, q.shape[-1]))
+        Pf = P.reshape(-1, 4, 4)
+        rods = np.concatenate([cell.rods, cell.wire[None]], axis=0)  # (4, 2, 3)
+        hub = None if cell.hub is None else transform_points(Pf, cell.hub)
+        ends, radius, body = arm_capsules(cell.model, qf)  # (n, S, 2, 3), (S,), (S,)
+        return cls(transform_points(Pf[:, None], rods), hub, ends, radius, body)
+
+    def __len__(self) -> int:
+        return len(self.ends)
+
+    def __getitem__(self, idx: np.ndarray) -> Posed:
+        """The configurations ``idx`` (an index or mask array)."""
+        return dataclasses.replace(self, w=self.w[idx], ends=self.ends[idx],
+                                   hub=None if self.hub is None else self.hub[idx])  # fmt: skip
 
 
 def clearance(cell: Cell, q: FloatArray, P: FloatArray) -> dict[str, np.ndarray]:
     """Per configuration (...): which clearance rule it breaks (dict of bool arrays).
 
-    ``q`` (..., 6) joints and ``P`` (..., 4, 4) their flange poses.  The arm is the
-    MuJoCo model's own link geometry as capsules (:func:`ruledrobot.robot.arm.shape.arm_capsules`:
-    housings and tubes, the UR's side offset included), the bow rods have the
-    simulated bow's rod radius.  The wire inside the stock is the cut, not a collision.
-    A cell with ``self_collision`` adds :data:`ARM_ARM` (the arm against itself) and tests
-    the bow against every link but the flange's and the base (module doc).
+    ``q`` (..., 6) joints and ``P`` (..., 4, 4) their flange poses: the cell's bodies there
+    (:meth:`Posed.of`) judged by the rules at the cell's margin (:func:`broken`).
     """
-    model, stock, margin = cell.model, cell.stock, cell.margin
-    shape = q.shape[:-1]
-    qf = np.nan_to_num(q.reshape(-1, q.shape[-1]))
-    Pf = P.reshape(-1, 4, 4)
-    rods = np.concatenate([cell.rods, cell.wire[None]], axis=0)  # (4, 2, 3)
-    w = transform_points(Pf[:, None], rods)  # (n, 4, 2, 3)
-    ends, radius, body = arm_capsules(model, qf)  # (n, S, 2, 3), (S,), (S,)
-    n, S = len(qf), len(radius)
+    out = broken(cell, Posed.of(cell, q, P))
+    return {key: v.reshape(q.shape[:-1]) for key, v in out.items()}
+
+
+def broken(
+    cell: Cell, at: Posed, margin: float | None = None, stock: Box | None = None,
+    only: Collection[str] = RULES,
+) -> dict[str, np.ndarray]:
+    """Per configuration (n,): which clearance rule the bodies ``at`` break (bool arrays).
+
+    At ``margin`` [m] against ``stock`` (a :class:`~ruledrobot.geometry.box.Box` or one
+    box per configuration, :class:`~ruledrobot.wirecut.reach.grid.RowBoxes`), the cell's
+    by default; the rules named in ``only`` (default all; keys in :data:`RULES`' order).
+    The arm is the MuJoCo model's own link geometry as capsules
+    (:func:`ruledrobot.robot.arm.shape.arm_capsules`: housings and tubes, the UR's side
+    offset included), the bow rods have the simulated bow's rod radius.  The wire inside
+    the stock is the cut, not a collision.  A cell with ``self_collision`` adds
+    :data:`ARM_ARM` (the arm against itself) and tests the bow against every link but the
+    flange's and the base (module doc).
+    """
+    margin = cell.margin if margin is None else margin
+    stock = cell.stock if stock is None else stock
+    w, h, ends, radius, body = at.w, at.hub, at.ends, at.radius, at.body
+    n, S = len(at), len(radius)
+    out = {key: np.zeros(n, bool) for key in RULES
+           if key in only and (key != ARM_ARM or cell.self_collision)}  # fmt: skip
     # one batch of segments against the stock, each with its own grown margin: the bow's
     # rods (tubes of the bow's arm radius; the wire is the cut, not a collision), the hub
     # on the flange (a short cylinder, as a capsule) and the arm's capsules
-    seg_a, seg_b = [w[:, :3, 0]], [w[:, :3, 1]]
-    grow = [np.full(3, margin + BowTool.arm_radius)]
-    if cell.hub is not None:
-        h = transform_points(Pf, cell.hub)
-        seg_a.append(h[:, None, 0])
-        seg_b.append(h[:, None, 1])
-        grow.append(np.array([margin + cell.hub_radius]))
-    seg_a.append(ends[:, :, 0])
-    seg_b.append(ends[:, :, 1])
-    grow.append(margin + radius)
-    hits = stock.segment_hits(np.concatenate(seg_a, axis=1), np.concatenate(seg_b, axis=1),
-                              np.concatenate(grow)[:, None])  # (n, segments)  # fmt: skip
-    out = {
-        BOW_STOCK: hits[:, : hits.shape[1] - S].any(axis=1),
-        ARM_STOCK: hits[:, hits.shape[1] - S :].any(axis=1),
-        BOW_ARM: np.zeros(n, bool),
-        BOW_TABLE: np.zeros(n, bool),
-        ARM_TABLE: np.zeros(n, bool),
-    }
-    if cell.self_collision:
-        hub = None if cell.hub is None else transform_points(Pf, cell.hub)
-        out[BOW_ARM], out[ARM_ARM] = _touching(cell, w, hub, ends)
-    else:
+    seg_a, seg_b, grow = [], [], []
+    if BOW_STOCK in out:
+        seg_a.append(w[:, :3, 0])
+        seg_b.append(w[:, :3, 1])
+        grow.append(np.full(3, margin + BowTool.arm_radius))
+        if h is not None:
+            seg_a.append(h[:, None, 0])
+            seg_b.append(h[:, None, 1])
+            grow.append(np.array([margin + cell.hub_radius]))
+    if ARM_STOCK in out:
+        seg_a.append(ends[:, :, 0])
+        seg_b.append(ends[:, :, 1])
+        grow.append(margin + radius)
+    if seg_a:
+        hits = stock.segment_hits(np.concatenate(seg_a, axis=1), np.concatenate(seg_b, axis=1),
+                                  np.concatenate(grow)[:, None])  # (n, segments)  # fmt: skip
+        n_bow = hits.shape[1] - S if ARM_STOCK in out else hits.shape[1]
+        if BOW_STOCK in out:
+            out[BOW_STOCK] = hits[:, :n_bow].any(axis=1)
+        if ARM_STOCK in out:
+            out[ARM_STOCK] = hits[:, n_bow:].any(axis=1)
+    if cell.self_collision and (BOW_ARM in out or ARM_ARM in out):
+        bow_arm, arm_arm = _touching(cell, margin, w, h, ends)
+        out.update({k: v for k, v in ((BOW_ARM, bow_arm), (ARM_ARM, arm_arm)) if k in out})
+    elif BOW_ARM in out:
         near = np.isin(body, _BODIES_NEAR_BOW)
         if near.any():  # the capsules of the links near the bow against its rods and wire
             e = ends[:, near]  # (n, K, 2, 3)
@@ -279,19 +336,20 @@ def clearance(cell: Cell, q: FloatArray, P: FloatArray) -> dict[str, np.ndarray]
             dist = segment_distance(a, b, w[:, None, :, 0], w[:, None, :, 1])  # (n, K, 4)
             reach = radius[near] + BowTool.arm_radius + margin
             out[BOW_ARM] = (dist < reach[None, :, None]).any(axis=(1, 2))
-    if cell.table_z is not None:
+    if cell.table_z is not None and BOW_TABLE in out:
         # the rods are capsules of the bow's arm radius in MuJoCo: lowest at an end point
         # less the radius; the hub is a cylinder: lowest on an end's rim, r sqrt(1 - a_z^2)
         # below the end's centre (a: its unit axis)
         low = w[:, :3, :, 2].min(axis=(1, 2)) - BowTool.arm_radius
-        if cell.hub is not None:
+        if h is not None:
             a_z = (h[:, 1, 2] - h[:, 0, 2]) / np.linalg.norm(h[:, 1] - h[:, 0], axis=1)
             rim = cell.hub_radius * np.sqrt(np.clip(1.0 - a_z**2, 0.0, None))
             low = np.minimum(low, h[:, :, 2].min(axis=1) - rim)
         out[BOW_TABLE] = low < cell.table_z + margin
+    if cell.table_z is not None and ARM_TABLE in out:
         # every link from the shoulder on (the column stands on the base, on the table);
         # a capsule is lowest at an end point
         up = body >= 1
         low = ends[:, up][..., 2].min(axis=2) - radius[up]  # (n, S_up)
         out[ARM_TABLE] = (low < cell.table_z + margin).any(axis=1)
-    return {key: v.reshape(shape) for key, v in out.items()}
+    return out

@@ -37,7 +37,6 @@ breaks first, in the order reach, joint limits, singularity, clearance.
 
 from __future__ import annotations
 
-import dataclasses
 from dataclasses import dataclass
 from enum import IntEnum
 from typing import TYPE_CHECKING
@@ -54,9 +53,11 @@ from ..cut.clearance import (
     BOW_STOCK,
     BOW_TABLE,
     MARGIN,
+    RULES,
     SINGULAR_MIN,
     Cell,
-    clearance,
+    Posed,
+    broken,
 )
 
 if TYPE_CHECKING:
@@ -110,6 +111,8 @@ _RULES = {REASON_TEXT[r]: r for r in (Reason.BOW_STOCK, Reason.ARM_STOCK, Reason
                                        Reason.BOW_TABLE, Reason.ARM_TABLE)}  # fmt: skip
 #: rules of the tool against the stock and the wrist: pass or fail, not part of the value
 GATES = (BOW_STOCK, BOW_ARM)
+#: the rules that give the clearance's value (the others: :data:`GATES`)
+_VALUED = tuple(key for key in RULES if key not in GATES)
 
 
 @dataclass(frozen=True)
@@ -226,9 +229,15 @@ def clearance_margins(
     failure is worth 20 mm below the lowest level).  A broken gate makes the value at
     most ``-margin``.
     ``cell.stock`` may hold one box per configuration (:class:`~.grid.RowBoxes`).
+
+    The bodies are posed once (:class:`~..cut.clearance.Posed`: the arm's forward
+    kinematics, the bow carried by ``P``) and the rules judged on them at each level, on
+    the configurations the level is tried for; above the margin only the rules that give
+    the value (the gates are decided at the margin).
     """
     n = len(q)
-    first = clearance(dataclasses.replace(cell, margin=rules.margin), q, P)
+    at = Posed.of(cell, q, P)
+    first = broken(cell, at, margin=rules.margin)
     reason = _first_failure(first, n)
     gate = np.zeros(n, bool)
     env = np.zeros(n, bool)
@@ -244,11 +253,9 @@ def clearance_margins(
 
     def kept(level: float, idx: np.ndarray) -> np.ndarray:
         stock = cell.stock.take(idx) if hasattr(cell.stock, "take") else cell.stock
-        res = clearance(dataclasses.replace(cell, margin=level, stock=stock), q[idx], P[idx])
         bad = np.zeros(idx.size, bool)
-        for key, b in res.items():
-            if key not in GATES:
-                bad |= b
+        for b in broken(cell, at[idx], margin=level, stock=stock, only=_VALUED).values():
+            bad |= b
         return ~bad
 
     pending = np.flatnonzero(~env)
