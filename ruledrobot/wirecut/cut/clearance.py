@@ -3,6 +3,10 @@ each other, for batches of configurations (the planner's own collision model).
 
 The arm is the MuJoCo model's own link geometry as capsules (so the planner and
 the simulation agree); the bow rods have the simulated bow's rod radius.
+:func:`clearance` poses the bodies at the configurations (:class:`Posed`: the arm's
+forward kinematics, the bow carried by the flange poses) and judges the rules on them
+(:func:`broken`); a caller that judges one batch at several margins (the reach map's
+margin ladder) poses it once and calls :func:`broken` per margin.
 
 **The arm against itself** (:data:`ARM_ARM`, on in a cell with ``self_collision``: the
 transits') tests every pair of capsules of link bodies that MuJoCo lets touch
