@@ -255,8 +255,10 @@ class Posed:
 
     @classmethod
     def of(cls, cell: Cell, q: FloatArray, P: FloatArray) -> Posed:
-        """The bodies of ``cell`` at joints ``q`` (..., 6) (NaN read as 0) with flange poses
-        ``P`` (..., 4, 4), flattened to ``n`` configurations."""
+        """Return the bodies of ``cell`` posed at configurations, flattened to ``n``.
+
+        Joints ``q`` (..., 6) (NaN read as 0) with their flange poses ``P`` (..., 4, 4).
+        """
         qf = np.nan_to_num(q.reshape(-1, q.shape[-1]))
         Pf = P.reshape(-1, 4, 4)
         rods = np.concatenate([cell.rods, cell.wire[None]], axis=0)  # (4, 2, 3)
