@@ -25,9 +25,8 @@ import numpy as np
 
 from ...geometry.box import Box
 from ...geometry.mesh import Mesh
-from ...geometry.ranges import runs_of
 from ...io.axes3d import cube_axes, draw_box, draw_mesh
-from ...robot.motion.trajectory import HEATED_PHASES, PHASE_COLOURS
+from ...robot.motion.trajectory import HEATED_PHASES, PHASE_COLOURS, phases_from_labels
 from ...robot.tool import BowTool
 from ...robot.wire.in_stock import flange_wire_ends
 from ..plan import Plan
@@ -63,10 +62,11 @@ def _view(stock: Box) -> tuple[np.ndarray, float]:
 
 
 def phase_runs(labels: np.ndarray) -> list[tuple[str, int, int]]:
-    """The runs ``(phase, start, stop)`` (half-open) of equal labels (M,), in time order."""
-    lab = labels.astype(str)
-    runs = [(p, a, b) for p in np.unique(lab) for a, b in runs_of(lab == p)]
-    return sorted(runs, key=lambda r: r[1])
+    """The runs ``(phase, start, stop)`` (half-open) of equal labels (M,), in time order.
+
+    By :func:`~ruledrobot.robot.motion.trajectory.phases_from_labels` (one comparison of
+    neighbours, no sort of the labels)."""
+    return [(p.name, p.start, p.stop) for p in phases_from_labels(labels)]
 
 
 def _wire_at(plan: Plan, idx: np.ndarray) -> np.ndarray:
@@ -126,7 +126,7 @@ def _path(ax: Any, plan: Plan, runs: list[tuple[str, int, int]]) -> None:
 def _labels(ax: Any, plan: Plan) -> None:
     """Each pass's number and cut name at the wire's midpoint where its cut begins."""
     mo = plan.motion
-    cut = mo.labels.astype(str) == "cut"
+    cut = mo.labels == "cut"
     for k, cp in enumerate(plan.passes):
         first = np.flatnonzero(cut & (mo.pass_of == k))
         if not first.size:
@@ -137,12 +137,14 @@ def _labels(ax: Any, plan: Plan) -> None:
                 bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none", "alpha": 0.7})
 
 
-def _legend(ax: Any, plan: Plan, solid: str) -> None:
-    """Legend: the phases present (one entry a colour), the part or surfaces, the block."""
+def _legend(ax: Any, runs: list[tuple[str, int, int]], solid: str) -> None:
+    """Legend: the phases present in ``runs`` (one entry a colour), the part or surfaces,
+    the block."""
     from matplotlib.lines import Line2D
     from matplotlib.patches import Patch
 
-    present = [p for p in PHASE_COLOURS if p in set(np.unique(plan.motion.labels.astype(str)))]
+    seen = {phase for phase, _, _ in runs}
+    present = [p for p in PHASE_COLOURS if p in seen]
     by_colour: dict[str, list[str]] = {}
     for p in present:
         by_colour.setdefault(PHASE_COLOURS[p], []).append(PHASE_WORDS[p])
@@ -156,7 +158,8 @@ def _legend(ax: Any, plan: Plan, solid: str) -> None:
 
 
 def scene_panel(ax: Any, plan: Plan, part: Mesh | None = None,
-                surface: Mesh | None = None) -> None:  # fmt: skip
+                surface: Mesh | None = None,
+                runs: list[tuple[str, int, int]] | None = None) -> None:  # fmt: skip
     """Draw the 3-D panel (module doc) on the 3-D axes ``ax``.
 
     Parameters
@@ -167,6 +170,8 @@ def scene_panel(ax: Any, plan: Plan, part: Mesh | None = None,
         The part (:func:`~.part_mesh.part_mesh`) [m, base frame], drawn shaded.
     surface : Mesh or None
         The cut surfaces in the block (``surface.stl``), drawn when there is no part.
+    runs : list of (str, int, int) or None
+        The motion's :func:`phase_runs` when the caller has them (else found here).
     """
     job = plan.job
     ax.computed_zorder = False
@@ -178,11 +183,11 @@ def scene_panel(ax: Any, plan: Plan, part: Mesh | None = None,
                   else SURFACE_COLOUR, MM, alpha=0.95 if part is not None else 0.8,
                   zorder=1)  # fmt: skip
     centre, half = _view(job.stock)
-    runs = phase_runs(plan.motion.labels)
+    runs = phase_runs(plan.motion.labels) if runs is None else runs
     _wires(ax, plan, runs)
     _path(ax, plan, runs)
     _labels(ax, plan)
-    _legend(ax, plan, solid)
+    _legend(ax, runs, solid)
     cube_axes(ax, centre * MM, half * MM, "mm", zoom=ZOOM)
     names = ", ".join(dict.fromkeys(cp.name for cp in plan.passes))
     comp = "; wire kerf compensated" if any(cp.compensated for cp in plan.passes) else ""

@@ -43,10 +43,26 @@ MARGINS = {"left": 0.15, "right": 0.15, "top": 0.35, "bottom": 0.55, "gap": 0.75
            "wspace": 0.1}
 
 
-def _phase_bands(ax: Any, t: FloatArray, labels: np.ndarray) -> None:
-    """The phases as bands of their colour behind a time panel."""
-    for phase, a, b in phase_runs(labels):
-        ax.axvspan(t[a], t[b - 1], color=PHASE_COLOURS.get(phase, "0.9"), alpha=0.12, lw=0)
+def _phase_bands(ax: Any, t: FloatArray, runs: list[tuple[str, int, int]]) -> None:
+    """The phases (:func:`.plot3d.phase_runs`) as bands of their colour behind a time panel.
+
+    One collection of full-height rectangles (x in time, y in axes units), as
+    ``ax.axvspan`` draws them one patch each; their times join the x data limits."""
+    from matplotlib.collections import PolyCollection
+    from matplotlib.colors import to_rgba_array
+
+    if not runs:
+        return
+    a = np.array([r[1] for r in runs])
+    x0, x1 = t[a], t[np.array([r[2] for r in runs]) - 1]
+    verts = np.stack([np.c_[x0, np.zeros_like(x0)], np.c_[x0, np.ones_like(x0)],
+                      np.c_[x1, np.ones_like(x1)], np.c_[x1, np.zeros_like(x1)]], axis=1)
+    colours = to_rgba_array([PHASE_COLOURS.get(r[0], "0.9") for r in runs], alpha=0.12)
+    ax.add_collection(PolyCollection(verts, facecolors=colours, edgecolors=colours,
+                                     linewidths=0, transform=ax.get_xaxis_transform()),
+                      autolim=False)  # fmt: skip
+    ax.update_datalim(np.c_[np.r_[x0, x1], np.zeros(2 * len(a))], updatey=False)
+    ax.autoscale_view(scaley=False)
 
 
 def joints_panel(ax: Any, plan: Plan) -> None:
@@ -79,7 +95,7 @@ def feed_panel(ax: Any, plan: Plan) -> None:
             ax.hlines(cut.feed_speed * 1e3, t[rows].min(), t[rows].max(), color="k", lw=0.8)
     ax.set_title("feed of the wire inside the stock (mm/s), measured on the samples",
                  fontsize=9)  # fmt: skip
-    present = set(np.unique(mo.labels).astype(str))
+    present = {phase for phase, _, _ in phase_runs(mo.labels)}
     words: dict[str, list[str]] = {}
     for p, c in PHASE_COLOURS.items():
         if p in present:
@@ -132,7 +148,7 @@ def plan_figure(plan: Plan, part: Mesh | None = None, surface: Mesh | None = Non
     panels = [p for p in panels if _shown(p, plan)]
     rows = max(1, len(panels))
     height = SIZE[1] + ROW_HEIGHT * max(0, rows - 2)
-    fig = Figure(figsize=(SIZE[0], height))
+    fig = Figure(figsize=(SIZE[0], height), dpi=DPI)
     FigureCanvasAgg(fig)
     # fixed margins in inches (room for the panels' titles, tick labels and "t (s)"): a
     # layout engine measures every text first, a third of the picture's drawing time
@@ -142,13 +158,14 @@ def plan_figure(plan: Plan, part: Mesh | None = None, surface: Mesh | None = Non
                             right=1.0 - MARGINS["right"] / SIZE[0], top=1.0 - top / height,
                             bottom=bottom / height, wspace=MARGINS["wspace"],
                             hspace=gap / axis_h)  # fmt: skip
-    scene_panel(fig.add_subplot(grid[:, 0], projection="3d"), plan, part, surface)
+    runs = phase_runs(plan.motion.labels)
+    scene_panel(fig.add_subplot(grid[:, 0], projection="3d"), plan, part, surface, runs)
     t = plan.motion.timed.t
     first = None
     for k, panel in enumerate(panels):
         ax = fig.add_subplot(grid[k, 1], sharex=first)
         first = first or ax
-        _phase_bands(ax, t, plan.motion.labels)
+        _phase_bands(ax, t, runs)
         panel(ax, plan)
         ax.set_xlabel("t (s)")
     return fig
