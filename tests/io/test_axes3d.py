@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from ruledrobot.io.axes3d import cube_axes
 
@@ -108,3 +110,17 @@ def test_the_block_and_a_mesh_are_drawn_with_their_colours():
         return a[np.lexsort(np.round(a, 9).T[::-1])]
 
     np.testing.assert_allclose(rows(got), rows(want), atol=1e-9)
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 40), st.integers(1, 4), st.sampled_from([3, 1_000, 2**40]),
+       st.integers(0, 2**32))  # fmt: skip
+def test_unique_rows_by_keys_are_numpys_unique_rows(n, k, spread, seed):
+    """The key shortcut gives np.unique(rows, axis=0)'s rows order, inverse and first
+    indices (the oracle), also where the keys would overflow (rows sorted as records)."""
+    from ruledrobot.io.axes3d import _unique_rows
+
+    rows = np.random.default_rng(seed).integers(-spread, spread, (n, k))
+    for kw in ({"return_inverse": True}, {"return_index": True}):
+        want = np.unique(rows, axis=0, **kw)[1].reshape(-1)
+        np.testing.assert_array_equal(_unique_rows(rows, **kw)[1].reshape(-1), want)
