@@ -15,7 +15,7 @@ import numpy as np
 from ..geometry import se3
 from ..geometry.checks import FloatArray
 from ..geometry.rotations import angle_between
-from ..io.atomic import atomic_open, atomic_write_json
+from ..io.atomic import atomic_write_json
 from ..robot.arm.model import RobotModel
 from ..robot.motion.rates import RATIO_MAX
 from ..robot.verdict import Check, Verdict
@@ -266,7 +266,7 @@ class PlaybackResult:
         matplotlib.use("Agg", force=False)
         from matplotlib.figure import Figure
 
-        from ..io.pictures import thinned_series
+        from ..io.pictures import thinned_series, write_png
 
         out = Path(out_dir)
         t = self.t
@@ -275,7 +275,7 @@ class PlaybackResult:
 
         # fixed margins (where constrained layout put the axes of the planner's plots):
         # a layout engine measures every tick label first, a third of the drawing time
-        fig = Figure(figsize=(9, 8))
+        fig = Figure(figsize=(9, 8), dpi=100)
         fig.subplots_adjust(left=0.09, right=0.99, bottom=0.06, top=0.95, hspace=0.07)
         ax = fig.subplots(3, 1, sharex=True)
         ax[0].plot(*thinned_series(t, self.joint_error() * 1e3), lw=0.8)
@@ -291,9 +291,9 @@ class PlaybackResult:
             for a in ax:
                 a.axvspan(c.start, max(c.end, c.start + self.timestep), color="red", alpha=0.15)
         fig.suptitle(f"{self.robot.name}: tracking ({self.feedforward} feed-forward)")
-        paths = {"tracking_plot": _save_fig(fig, out / "tracking.png")}
+        paths = {"tracking_plot": write_png(fig, out / "tracking.png")}
 
-        fig = Figure(figsize=(9, 6))
+        fig = Figure(figsize=(9, 6), dpi=100)
         fig.subplots_adjust(left=0.075, right=0.99, bottom=0.08, top=0.93, hspace=0.06)
         ax = fig.subplots(2, 1, sharex=True)
         lim_t = np.where(np.isfinite(self.robot.max_torque), self.robot.max_torque, np.inf)
@@ -306,11 +306,5 @@ class PlaybackResult:
         ax[1].set_ylabel("|speed| / limit")
         ax[1].set_xlabel("time [s]")
         fig.suptitle(f"{self.robot.name}: joint torques and speeds against their limits")
-        paths["limits_plot"] = _save_fig(fig, out / "limits.png")
+        paths["limits_plot"] = write_png(fig, out / "limits.png")
         return paths
-
-
-def _save_fig(fig: Any, path: Path) -> Path:
-    with atomic_open(path, "wb") as fh:
-        fig.savefig(fh, format="png", dpi=100)
-    return path

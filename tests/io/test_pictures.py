@@ -5,6 +5,7 @@ line crosses the same pixels."""
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -44,3 +45,23 @@ def test_one_series_stays_one_dimensional_and_gaps_stay():
     assert yk.max() == y.max() and yk.min() == y.min()
     y[100] = np.nan
     assert thinned_series(t, y)[1] is not None and len(thinned_series(t, y)[0]) == len(t)
+
+
+def test_write_png_keeps_the_figures_pixels(tmp_path):
+    """The PNG (compressed at PNG_COMPRESS_LEVEL, lossless) holds the pixels Agg drew."""
+    pytest.importorskip("matplotlib")
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+    from PIL import Image
+
+    from ruledrobot.io.pictures import write_png
+
+    fig = Figure(figsize=(2, 1.5), dpi=50)
+    FigureCanvasAgg(fig)
+    fig.add_subplot().plot([0, 1, 0.3], "r-")
+    path = write_png(fig, tmp_path / "f.png")
+    fig.canvas.draw()
+    drawn = np.asarray(fig.canvas.buffer_rgba())
+    with Image.open(path) as im:
+        assert im.format == "PNG" and im.size == (100, 75)
+        np.testing.assert_array_equal(np.asarray(im.convert("RGBA")), drawn)

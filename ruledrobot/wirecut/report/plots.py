@@ -12,7 +12,6 @@ margins (:data:`MARGINS`, in inches, so that they hold for any number of rows).
 
 from __future__ import annotations
 
-import io
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -22,8 +21,7 @@ import numpy as np
 
 from ...geometry.checks import FloatArray
 from ...geometry.mesh import Mesh
-from ...io.atomic import atomic_write_bytes
-from ...io.pictures import thinned_series
+from ...io.pictures import thinned_series, write_png
 from ..plan import Plan
 from .plot3d import PHASE_COLOURS, PHASE_WORDS, phase_runs, scene_panel
 from .plot_heat import has_heat_schedule, has_kerf_model, heat_panel, kerf_panel
@@ -175,6 +173,4 @@ def plot_plan(path: str | Path, plan: Plan, part: Mesh | None = None,
               surface: Mesh | None = None, panels: Sequence[TimePanel] = TIME_PANELS
               ) -> Path:  # fmt: skip
     """Write the plan's picture (:func:`plan_figure`) to ``path`` (PNG) atomically."""
-    buf = io.BytesIO()
-    plan_figure(plan, part, surface, panels).savefig(buf, format="png", dpi=DPI)
-    return atomic_write_bytes(path, buf.getvalue())
+    return write_png(plan_figure(plan, part, surface, panels), path)
