@@ -14,11 +14,11 @@ commit before a change) in a child process and prints the ratio; both use only
 Measured on this 2-core machine (shared), best of 7, before the "fastpics" changes
 (main at 5a9e241) and after them:
 
-    job   picture        before   after
-    demo  plot_plan      0.27 s   0.20 s
-    demo  sim figures    0.22 s   0.19 s
-    part  plot_plan      0.53 s   0.31 s
-    part  sim figures    0.26 s   0.22 s
+    job   picture        before   after   ratio
+    demo  plot_plan      0.27 s   0.22 s   0.84
+    demo  sim figures    0.21 s   0.20 s   0.93
+    part  plot_plan      0.50 s   0.33 s   0.65
+    part  sim figures    0.25 s   0.23 s   0.90
 
 Prints figures; asserts nothing.
 """
