@@ -477,7 +477,11 @@ def _move(
              for a, b in info.get("skipped_ranges", ())]  # fmt: skip
     if rec is not None:
         tags = np.concatenate([c[3] for c in out.chunks])
-        kg = align_recording(q_grid, rec.q, tags, window)
+        # a recorded sample the live match did not tag (the child silent while the
+        # controller plays on, forwarded, up to its buffer) is matched in a window that
+        # reaches past what the controller can play alone
+        ahead = o["buffer"] if mode == "forward" else 0.0
+        kg = align_recording(q_grid, rec.q, tags, window + math.ceil(ahead / dt))
         plan_index = to_input[np.clip(kg, 0, to_input.size - 1)]
     else:
         plan_index = np.zeros(0, dtype=np.int64)

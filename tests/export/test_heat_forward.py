@@ -54,9 +54,11 @@ def _record(host: str, done: threading.Event, rows: list) -> None:
 
 def test_a_forwarded_run_sets_the_analog_output_with_each_sample(request, tmp_path):
     traj = _ramp_trajectory()
-    # the set-points as sent: as the arm, trailing its servoj, reaches each sample
-    want = written_levels(servo_levels(traj.heat_power / FULL_SCALE, traj.period,
-                                       SERVO_LOOKAHEAD, SERVO_GAIN))
+    # the set-points as sent: as the arm, trailing its servoj, reaches each sample, on the
+    # controller's period (the run's grid: with the samples' own spacing, 2e-3 + 2e-18 s,
+    # a level a rounding away from a band's edge fell in the next band)
+    want = written_levels(servo_levels(traj.heat_power / FULL_SCALE,
+                                       traj.meta.control_period, SERVO_LOOKAHEAD, SERVO_GAIN))
     emu = start_emulator(request.node.nodeid, model="ur5e", unlock_delay=0.0, q0=traj.q[0])
     rows: list = []
     done = threading.Event()

@@ -22,6 +22,7 @@ from ruledrobot.geometry.se3 import pose_from_ur_vector, ur_vector_from_pose
 from ruledrobot.io.calibration import save_calibration
 from ruledrobot.protocol.primary import PRIMARY_PORT, SECONDARY_PORT, read_kinematics_info
 from ruledrobot.robot import load, random_calibration
+from ruledrobot.robot.motion.servo import servo_time_constant
 from ruledrobot.ursim import DEFAULT_Q, Emulator, ThreadedEmulator
 from tests.support.emulators import UR, _address, start_emulator
 from tests.support.processes import popen_as_from_a_terminal
@@ -142,9 +143,9 @@ def test_everything_reported_uses_the_calibrated_arm(calibrated: Emulator, cur: 
     for k in range(1, 126):
         t0 = c.initPeriod()
         x = start + (goal - start) * min(1.0, k / 100)
-        assert c.servoL(x.tolist(), 0.5, 0.5, 0.008, 0.03, 2000)  # filter: tau 6 ms
+        assert c.servoL(x.tolist(), 0.5, 0.5, 0.008, 0.03, 2000)  # filter: tau 30 ms
         c.waitPeriod(t0)
-    time.sleep(0.3)
+    time.sleep(25 * servo_time_constant(0.03, 2000))  # settled: e^-25 of 36 mm, 5e-13 m
     assert _pose_err(r.getActualTCPPose(), goal) < 1e-9
     assert c.servoStop()
     # a path move: through the waypoints (6-digit text in the re-uploaded script)

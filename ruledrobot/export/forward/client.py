@@ -137,11 +137,19 @@ def _play(s: Session, conn: socket.socket, q_grid: np.ndarray, hot: np.ndarray |
         if playing >= 0 and sent < K:
             upto = min(K, playing + 1 + ahead)
             if upto > sent:
-                conn.sendall(part(sent, upto))
+                try:
+                    conn.sendall(part(sent, upto))
+                    if upto == K:
+                        conn.sendall(end_message(K))
+                except OSError:
+                    # the program closed its end: it ended (ran dry and stopped, or was
+                    # stopped) while this process was held past its buffer; the state it
+                    # reports says which (found: a 1 s stall of this process, the dry
+                    # stop and its settle over in 0.8 s, reported as a dead client)
+                    _wait_stopped(s, settings)
+                    break
                 s.sent = upto - 1
                 sent = upto
-                if sent == K:
-                    conn.sendall(end_message(K))
         time.sleep(dt)
     s.sent = max(s.sent, int(r.getOutputIntRegister(REG_SAMPLE)))
     s.flush(force=True)

@@ -86,6 +86,10 @@ class CutMeasurements:
     wire_lag: str | None = None
     #: the compensation follows the kerf ``[material]`` predicts per point, not ``kerf_mm``
     per_point: bool = False
+    #: the predicted face's largest distance from the part as servoj follows the plan
+    #: (None: not judged: no face, or a burn, which ``face_error`` reports), and where
+    followed_face_mm: float | None = None
+    followed_detail: str = ""
 
 
 @dataclass(frozen=True)
@@ -144,6 +148,10 @@ def _cut_checks(c: CutMeasurements, single: bool) -> list[Check]:
         # the face decides; the feed window is the time law's target, shown
         checks = [dataclasses.replace(ch, gating=False) if ch.name.startswith("feed_") else ch
                   for ch in checks]  # fmt: skip
+    if c.followed_face_mm is not None:
+        checks.append(Check.at_most(
+            "face_followed" + key, "the same as servoj follows the plan" + of,
+            c.followed_face_mm, c.tolerance_mm, "mm", c.followed_detail))  # fmt: skip
     return checks
 
 
