@@ -40,7 +40,7 @@ from .forward.client import forward
 from .run_motion import approach, preheat, run_program, stream
 from .run_session import Link, Session, SessionError, Stop
 
-__all__ = ["NICE", "RT_PRIORITY", "main", "raise_priority"]
+__all__ = ["NICE", "RT_PRIORITY", "client_defect", "main", "raise_priority"]
 
 #: SCHED_RR priority of the streaming process: low (1-99), below the emulator's clock
 #: (10) and servers (5), so that a controller emulated on the same machine goes first
@@ -125,6 +125,22 @@ def _motion(s: Session, m: dict) -> None:
         s.set_heat(False)
 
 
+def client_defect(exc: BaseException) -> str:
+    """The words of an error this process did not expect (a defect, not the robot's).
+
+    The exception, the file and line it came from (its traceback also goes to stderr,
+    which the supervisor keeps as the client's output) and what was done: it once read as
+    a dead client, "exit code 0", when a forwarded run's socket closed under it."""
+    import traceback
+
+    traceback.print_exception(exc, file=sys.stderr)
+    frames = traceback.extract_tb(exc.__traceback__)
+    where = f", at {os.path.basename(frames[-1].filename)}:{frames[-1].lineno}" if frames else ""
+    return (f"the run's client failed ({type(exc).__name__}: {exc}{where}): the arm was "
+            "stopped as on any stop; this is a defect of ruledrobot, please report it with "
+            "this message")
+
+
 def _run(s: Session, m: dict) -> None:
     link = s.link
     s.window = int(m["window"])
@@ -137,6 +153,8 @@ def _run(s: Session, m: dict) -> None:
         stop = Stop("command_failed", str(exc))
     except RuntimeError as exc:
         stop = s.classify("ur_rtde", exc)
+    except Exception as exc:  # a defect of this program: the arm is stopped as on any stop
+        stop = Stop("client_error", client_defect(exc))
     if stop is None:
         s.safe_stop(m["mode"], m["stop_deceleration"], m["stop_budget"])  # end of program
     else:

@@ -84,8 +84,10 @@ class RunResult:
     ``"connection_lost"``, ``"controller_slow"``, ``"client_slow"``, ``"buffer_dry"`` (a
     forwarded run's samples ran short: the controller stopped along the path),
     ``"program_stopped"``,
-    ``"command_failed"``, ``"interrupted"``, ``"client_died"`` (the ur_rtde
-    process crashed), ``"client_hung"`` (it stopped answering and was killed).
+    ``"command_failed"``, ``"interrupted"``, ``"client_error"`` (an error the ur_rtde
+    process did not expect: a defect; it stopped the arm as on any stop and says the
+    error and where), ``"client_died"`` (the ur_rtde process crashed), ``"client_hung"``
+    (it stopped answering and was killed).
     ``start_index``: the first sample streamed (the entry), ``requested_index``:
     the sample asked for; ``stop_index``: the input sample the arm reached
     (``n_samples`` when completed) — resume with it; ``stop``: where, in words
