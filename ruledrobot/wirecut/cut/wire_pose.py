@@ -48,6 +48,7 @@ from ...robot.ik.path import JUMP_THRESHOLD
 from ...robot.tool import BowTool
 from ..job.spec import ToolSpec
 from .clearance import MARGIN, SINGULAR_MIN, Cell, clearance
+from .search_memo import memoized
 from .wire_geometry import chords, flange_poses, slide_bounds, wire_poses
 
 __all__ = [
@@ -181,8 +182,19 @@ def search_wire_pose(
     """Run :func:`solve_redundancy` in ``cell``.
 
     ``cell``: robot, bow, stock, table and thresholds (the cell of ``options``,
-    :meth:`SearchOptions.cell`); ``tool`` gives the wire's length and clearance.
+    :meth:`SearchOptions.cell`); ``tool`` gives the wire's length and clearance.  A search
+    asked again with the same inputs (carve's robot check, then the plan, in ``make``) is
+    answered from :mod:`.search_memo`.
     """
+    F = np.asarray(frames, dtype=np.float64)
+    return memoized(lambda: _search(F, tool, cell, options),
+                    "wire_pose.search", F, tool, cell, options)  # fmt: skip
+
+
+def _search(
+    frames: FloatArray, tool: ToolSpec, cell: Cell, options: SearchOptions
+) -> RedundancyResult:
+    """:func:`search_wire_pose`, computed."""
     rolls, sample, jump_threshold = options.rolls, options.sample, options.jump_threshold
     singular_min, strategy, q_start = cell.singular_min, options.strategy, cell.q_start
     model, stock = cell.model, cell.stock
