@@ -13,7 +13,7 @@ from hypothesis import strategies as st
 
 from ruledrobot.export.run_session import Session, Stop
 
-WINDOW = 200  # samples: (3 x lookahead + 0.1 s) at 500 Hz, as the runner sets it for lookahead 0.1 s
+WINDOW = 200  # samples: (3 x lookahead + 0.1 s) at 500 Hz, the runner's for lookahead 0.1 s
 
 
 def session(limit: float = 0.05) -> Session:
