@@ -66,3 +66,17 @@ def test_servo_levels_follow_the_arm_and_rest_on_the_set_point():
     assert abs((y[k] - 0.1) / 0.4 - np.exp(-1.0)) < 0.02
     assert y[499] == 0.1  # settled: the set-point itself, exactly
     assert np.all(y[:100] == 0.5) and y[510] < 0.5
+
+
+@given(st.floats(0.0021, 2.0), st.sampled_from([0.002, 0.008]), st.integers(1, 3000),
+       st.integers(0, 2**31))  # fmt: skip
+def test_servo_track_is_scipys_first_order_filter(tau, dt, n, seed):
+    """The block recursion against scipy.signal.lfilter (an independent implementation
+    of the same recursion), any time constant above the period, any length."""
+    from scipy.signal import lfilter
+
+    rng = np.random.default_rng(seed)
+    x = np.cumsum(rng.normal(size=(n, 3)), axis=0) * 0.01 + rng.normal(size=3)
+    a = dt / tau
+    want = lfilter([a], [1.0, a - 1.0], x - x[0], axis=0) + x[0]
+    np.testing.assert_allclose(servo_track(x, dt, tau), want, rtol=0, atol=1e-12)

@@ -188,8 +188,8 @@ def _followed_detail(worst: tuple[float, int], tolerance_mm: float, t: float, la
     if worst[0] <= tolerance_mm:
         return words
     return (words + f": the controller's servo lags the plan by about {servo_time_constant():g}"
-            " s and cuts inside tight turns, the more the faster the wire goes: lower the "
-            "cut's feed_speed (a roughing loop's corner: 0.230 mm at 12 mm/s, 0.117 mm at 6)")
+            " s and cuts inside tight turns by about (speed x lag)^2 / 2 x radius: lower the "
+            "cut's feed_speed (half the feed, about a quarter of the error)")
 
 
 def _kerf_range(fe: FaceError) -> dict[str, list[float] | None]:

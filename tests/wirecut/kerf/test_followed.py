@@ -53,3 +53,12 @@ def test_the_followed_face_is_the_emulated_arms(tmp_path, shape):
     check = verdict["face_followed"]
     assert check.gating and check.value == pytest.approx(finite.max() * 1e3, abs=1e-6)
     assert check.ok is bool(finite.max() <= truth.tolerance)
+
+
+def test_a_failing_followed_face_says_where_and_what_to_change():
+    from ruledrobot.wirecut.report.outcome import _followed_detail
+
+    ok = _followed_detail((0.05, 10), 0.1, 1.234, "cut")
+    bad = _followed_detail((0.2, 10), 0.1, 1.234, "cut")
+    assert ok == "worst at t = 1.234 s (cut)"
+    assert bad.startswith(ok) and "feed_speed" in bad and "0.03 s" in bad  # the lag said
